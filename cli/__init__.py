@@ -1,0 +1,1 @@
+"""The `designer` command: a thin typer layer over the `designer` library."""

@@ -1,0 +1,166 @@
+"""Coefficient tables: the schema, the loader with its checks, and the bundled study table.
+
+A coefficient table has one row per specimen: the six factors (`density`, `length`, `width`,
+`height`, `layer`, `raster`) and, per identified axis, `c_<axis>`, `k_<axis>` and optionally
+`m_<axis>`, all in rig units (see `designer.units`). Column names may carry the study's unit
+suffixes (`density_pct`, `k_x_N_per_mm`, ...); a suffix naming another unit is rejected.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import re
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from . import space, units
+from .errors import DesignerError
+
+BUNDLED_NAME = "study_table3_x.csv"
+
+# accepted unit suffixes per factor and per (quantity, rotational)
+_FACTOR_SUFFIXES = {
+    "density": ("pct", "percent"),
+    "length": ("mm",),
+    "width": ("mm",),
+    "height": ("mm",),
+    "layer": ("mm",),
+    "raster": ("deg",),
+}
+_COEF_SUFFIXES = {
+    ("k", False): ("N_per_mm", "N/mm"),
+    ("c", False): ("Ns_per_mm", "N.s/mm", "N_s_per_mm"),
+    ("m", False): ("kg",),
+    ("k", True): ("Nmm_per_rad", "N.mm/rad", "N_mm_per_rad"),
+    ("c", True): ("Nmms_per_rad", "N.mm.s/rad", "N_mm_s_per_rad"),
+    ("m", True): ("kg_m2", "kg.m^2", "kgm2"),
+}
+_COEF_RE = re.compile(r"^(?P<q>[mck])_(?P<axis>x|y|z|theta|phi|psi)(?:_(?P<unit>.+))?$")
+
+
+def bundled_path() -> Path:
+    """Path of the study's 44-run table shipped inside the package."""
+    return Path(str(resources.files("designer") / "bundled" / BUNDLED_NAME))
+
+
+def coefficient_columns(table: pd.DataFrame) -> list[str]:
+    """The canonical coefficient columns present (`c_x`, `k_x`, `m_theta`, ...), in axis order."""
+    return [
+        f"{q}_{a}" for a in units.AXES for q in units.QUANTITIES if f"{q}_{a}" in table.columns
+    ]
+
+
+def axes_present(table: pd.DataFrame) -> list[str]:
+    """Axes that have both c and k in the table."""
+    return [a for a in units.AXES if f"c_{a}" in table.columns and f"k_{a}" in table.columns]
+
+
+def _canonical_name(col: str, source: str) -> str | None:
+    """Map a column name to its canonical name, checking any unit suffix; None if not ours."""
+    name = col.strip()
+    for fac, suffixes in _FACTOR_SUFFIXES.items():
+        if name == fac:
+            return fac
+        if name.startswith(fac + "_"):
+            suffix = name[len(fac) + 1 :]
+            if suffix in suffixes:
+                return fac
+            raise DesignerError(
+                f"{source}: column '{col}' gives {fac} in '{suffix}'",
+                f"the table uses {space.factor(fac).unit}: convert the column and name it '{fac}'",
+            )
+    m = _COEF_RE.match(name)
+    if not m:
+        return None
+    q, axis, unit = m["q"], m["axis"], m["unit"]
+    if unit is not None and unit not in _COEF_SUFFIXES[(q, units.is_rotational(axis))]:
+        raise DesignerError(
+            f"{source}: column '{col}' gives {q}_{axis} in '{unit}'",
+            f"the table uses {units.rig_unit(q, axis)}: convert the column and name it '{q}_{axis}'",
+        )
+    return f"{q}_{axis}"
+
+
+def normalise(raw: pd.DataFrame, source: str = "table") -> pd.DataFrame:
+    """Rename, check and order a raw table; raise DesignerError naming the first problem."""
+    mapping: dict[str, str] = {}
+    for col in raw.columns:
+        canon = _canonical_name(str(col), source)
+        if canon is None:
+            continue
+        if canon in mapping.values():
+            raise DesignerError(f"{source}: two columns give '{canon}'", "keep one of them")
+        mapping[col] = canon
+    table = raw.rename(columns=mapping)
+    missing = [f for f in space.FACTOR_NAMES if f not in table.columns]
+    if missing:
+        raise DesignerError(
+            f"{source}: missing factor column(s) {', '.join(missing)}",
+            "a coefficient table needs density, length, width, height, layer, raster",
+        )
+    if not axes_present(table):
+        raise DesignerError(
+            f"{source}: no coefficient columns",
+            "give c_<axis> and k_<axis> for at least one axis (x y z theta phi psi)",
+        )
+    if len(table) == 0:
+        raise DesignerError(f"{source}: the table has no rows", "add at least one specimen")
+    keep = list(space.FACTOR_NAMES) + coefficient_columns(table)
+    extra = [c for c in table.columns if c not in keep]
+    out = table[keep + extra].copy()
+    for col in keep:
+        values = pd.to_numeric(out[col], errors="coerce")
+        bad = values.isna() | ~np.isfinite(values.to_numpy(dtype=float, na_value=np.nan))
+        if bad.any():
+            row = int(np.flatnonzero(bad.to_numpy())[0])
+            raise DesignerError(
+                f"{source}: column '{col}' row {row + 1} is '{out[col].iloc[row]}', not a finite number",
+                "fix or remove that row (designer clean drops runs with missing sensor data)",
+            )
+        out[col] = values.astype(float)
+    for col in coefficient_columns(out):
+        q = col.split("_", 1)[0]
+        bad = out[col] <= 0 if q in ("k", "m") else out[col] < 0
+        if bad.any():
+            row = int(np.flatnonzero(bad.to_numpy())[0])
+            raise DesignerError(
+                f"{source}: column '{col}' row {row + 1} is {out[col].iloc[row]:g}; "
+                + ("it must be positive" if q in ("k", "m") else "it must not be negative"),
+                "check the identification of that run or remove it",
+            )
+    for f in space.CATEGORICAL:
+        levels = np.asarray(f.levels)
+        off = ~np.isclose(out[f.name].to_numpy()[:, None], levels[None, :]).any(axis=1)
+        if off.any():
+            row = int(np.flatnonzero(off)[0])
+            raise DesignerError(
+                f"{source}: {f.name} = {out[f.name].iloc[row]:g} in row {row + 1} is not a level "
+                f"of the study ({f.describe_range()})",
+                "the surrogate treats it as categorical: use a tested level",
+            )
+    return out.reset_index(drop=True)
+
+
+def load_table(path: str | Path | None = None) -> pd.DataFrame:
+    """Load a coefficient table (CSV or Parquet); without a path, the bundled study table."""
+    p = bundled_path() if path is None else Path(path)
+    if not p.exists():
+        raise DesignerError(f"no such table: {p}", "give the path of a CSV or Parquet file")
+    try:
+        raw = pd.read_parquet(p) if p.suffix.lower() in (".parquet", ".pq") else pd.read_csv(p)
+    except (ValueError, OSError, pd.errors.ParserError, UnicodeDecodeError) as exc:
+        raise DesignerError(
+            f"cannot read {p}: {str(exc).splitlines()[0]}", "give a CSV or Parquet coefficient table"
+        ) from None
+    return normalise(raw, source=p.name)
+
+
+def table_hash(table: pd.DataFrame) -> str:
+    """SHA-256 of the factor and coefficient values, independent of column spelling and extras."""
+    cols = list(space.FACTOR_NAMES) + coefficient_columns(table)
+    h = hashlib.sha256(",".join(cols).encode())
+    h.update(np.ascontiguousarray(table[cols].to_numpy(dtype=np.float64)).tobytes())
+    return h.hexdigest()
