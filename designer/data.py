@@ -48,9 +48,7 @@ def bundled_path() -> Path:
 
 def coefficient_columns(table: pd.DataFrame) -> list[str]:
     """The canonical coefficient columns present (`c_x`, `k_x`, `m_theta`, ...), in axis order."""
-    return [
-        f"{q}_{a}" for a in units.AXES for q in units.QUANTITIES if f"{q}_{a}" in table.columns
-    ]
+    return [f"{q}_{a}" for a in units.AXES for q in units.QUANTITIES if f"{q}_{a}" in table.columns]
 
 
 def axes_present(table: pd.DataFrame) -> list[str]:

@@ -7,10 +7,11 @@ built from coefficients typed by hand, from a design through the surrogate, or f
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from typing import Any, Mapping
+from typing import Any
 
-from . import space, units
+from . import units
 from .errors import DesignerError
 from .mass import specimen_mass
 
@@ -128,7 +129,10 @@ def rotational_from_translational(ac: AxisCoefficients, axis: str, length_mm: fl
         )
     arm_mm = PRB_GAMMA * length_mm
     scale = arm_mm**2  # N/mm * mm^2 = N.mm/rad
-    pi = (lambda p: None if p is None else (p[0] * scale, p[1] * scale))
+
+    def pi(p):
+        return None if p is None else (p[0] * scale, p[1] * scale)
+
     return AxisCoefficients(
         axis=axis,
         k=ac.k * scale,
@@ -150,4 +154,3 @@ def from_coefficients(
         for a, v in coefficients.items()
     }
     return Joint(name=name, axes=axes, provenance={"source": "entered by hand"})
-

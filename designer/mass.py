@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Mapping
+from collections.abc import Mapping
 
 from .space import NOZZLE_MM, WALL_MM
 from .units import MM, TPU_DENSITY

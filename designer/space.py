@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Mapping
 
 from .errors import DesignerError
 
@@ -53,9 +53,7 @@ def factor(name: str) -> Factor:
     try:
         return BY_NAME[name]
     except KeyError:
-        raise DesignerError(
-            f"unknown factor '{name}'", f"use one of: {', '.join(FACTOR_NAMES)}"
-        ) from None
+        raise DesignerError(f"unknown factor '{name}'", f"use one of: {', '.join(FACTOR_NAMES)}") from None
 
 
 def check_value(name: str, value: float, allow_extrapolation: bool = False) -> float:

@@ -1,0 +1,53 @@
+"""What every command shares: JSON output, rich console, progress bars shown only on a terminal."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import sys
+from collections.abc import Callable, Iterator
+from typing import Any
+
+from rich.console import Console
+
+console = Console(highlight=False)
+err_console = Console(stderr=True, highlight=False)
+
+
+def _clean(obj: Any) -> Any:
+    """Make numpy scalars and non-finite floats JSON-safe (NaN and Inf become null)."""
+    if isinstance(obj, dict):
+        return {str(k): _clean(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_clean(v) for v in obj]
+    if hasattr(obj, "item") and callable(obj.item):
+        obj = obj.item()
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+def print_json(data: Any) -> None:
+    """Print machine-readable output on stdout, nothing else."""
+    sys.stdout.write(json.dumps(_clean(data), indent=2) + "\n")
+
+
+@contextlib.contextmanager
+def progress(description: str, enabled: bool = True) -> Iterator[Callable[[float], None]]:
+    """Yield a callback taking the fraction done (0..1); draws a bar only when stderr is a terminal."""
+    if not (enabled and err_console.is_terminal):
+        yield lambda fraction: None
+        return
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    with Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        TextColumn("{task.percentage:>3.0f}%"),
+        TimeRemainingColumn(),
+        console=err_console,
+        transient=True,
+    ) as bar:
+        task = bar.add_task(description, total=1.0)
+        yield lambda fraction: bar.update(task, completed=min(max(fraction, 0.0), 1.0))
