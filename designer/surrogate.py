@@ -1,0 +1,460 @@
+"""Response-surface surrogate of c and k per axis, fitted with CasADi and chosen by leave-one-out.
+
+Each response gets the candidate forms below, each a linear-in-parameters expression of the factors
+(continuous factors coded to [-1, 1] over their tested range, categorical levels as offsets):
+
+- ``mean``: the average of the runs, the baseline every form must beat;
+- ``linear``, ``interactions`` (plus two-factor products), ``quadratic`` (plus squares; the
+  Box-Behnken classic), fitted to the raw response with positivity enforced on the tested grid;
+- ``powerlaw``: log y linear in the logs of the factors (a beam's k ~ E b h^3 / L^3), raster as offset.
+
+The fit is ridge-regularised least squares solved as a QP by CasADi (``conic``/qrqp). The ridge
+penalty is chosen inside the cross-validation (closed-form LOO on each training fold), so the
+reported leave-one-out metrics are honest. Predictions carry 95 % prediction intervals.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import itertools
+import json
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from . import space, units
+from .errors import DesignerError
+from .files import atomic_write
+
+FORMAT = "flexjoint-surrogate/1"
+FORMS: tuple[str, ...] = ("mean", "linear", "interactions", "quadratic", "powerlaw")
+#: ridge penalties tried inside each training fold (features are coded to unit scale)
+ALPHAS: tuple[float, ...] = (0.0, 1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0)
+DEFAULT_NAME = "default.json"
+
+_CONT = [f.name for f in space.CONTINUOUS]
+_PAIRS = list(itertools.combinations(range(len(_CONT)), 2))
+
+
+class _NumpyOps:
+    """Array operations for vectorised prediction."""
+
+    log = staticmethod(np.log)
+
+    @staticmethod
+    def is_level(a: Any, level: float) -> Any:
+        return np.isclose(np.asarray(a, dtype=float), level).astype(float)
+
+
+class _CasadiOps:
+    """The same operations on CasADi symbols, for optimisation."""
+
+    log = staticmethod(ca.log)
+
+    @staticmethod
+    def is_level(a: Any, level: float) -> Any:
+        return ca.if_else(ca.fabs(a - level) < 1e-9, 1, 0)
+
+
+def _coded(x: Any, f: space.Factor, ops: Any, log: bool) -> Any:
+    lo, hi = (np.log(f.low), np.log(f.high)) if log else (f.low, f.high)
+    return ((ops.log(x) if log else x) - (lo + hi) / 2) / ((hi - lo) / 2)
+
+
+def _columns(form: str, x: Mapping[str, Any], ops: Any) -> list[Any]:
+    """Feature columns of a form, without the intercept, as expressions of the factors in `x`."""
+    if form == "mean":
+        return []
+    raster45 = ops.is_level(x["raster"], 45.0)
+    if form == "powerlaw":
+        logs = [_coded(x[f.name], f, ops, log=True) for f in space.CONTINUOUS]
+        return logs + [_coded(x["layer"], space.BY_NAME["layer"], ops, log=True), raster45]
+    z = [_coded(x[f.name], f, ops, log=False) for f in space.CONTINUOUS]
+    offsets = [ops.is_level(x["layer"], 0.16), ops.is_level(x["layer"], 0.2), raster45]
+    cols = list(z)
+    if form in ("interactions", "quadratic"):
+        cols += [z[i] * z[j] for i, j in _PAIRS]
+    if form == "quadratic":
+        cols += [zi * zi for zi in z]
+    return cols + offsets
+
+
+def _as_columns(X: Any) -> dict[str, np.ndarray]:
+    """Factor columns as float arrays from a DataFrame, a mapping of arrays, or one design."""
+    try:
+        cols = {n: np.atleast_1d(np.asarray(X[n], dtype=float)) for n in space.FACTOR_NAMES}
+    except KeyError as exc:
+        raise DesignerError(f"missing factor {exc}", "give all six factors") from None
+    n = max(len(v) for v in cols.values())
+    return {k: np.broadcast_to(v, (n,)) for k, v in cols.items()}
+
+
+def design_matrix(form: str, X: Any) -> np.ndarray:
+    """The (n, p) design matrix of `form` at the designs X, intercept first."""
+    cols = _as_columns(X)
+    n = len(cols["density"])
+    return np.column_stack([np.ones(n)] + [np.broadcast_to(c, (n,)) for c in _columns(form, cols, _NumpyOps)])
+
+
+def _grid() -> dict[str, np.ndarray]:
+    """Every combination of the factors' tested levels: where positivity is enforced."""
+    combos = np.array(list(itertools.product(*[f.levels for f in space.FACTORS])), dtype=float)
+    return {n: combos[:, i] for i, n in enumerate(space.FACTOR_NAMES)}
+
+
+def _penalty(p: int) -> np.ndarray:
+    P = np.eye(p)
+    P[0, 0] = 0.0  # the intercept is not shrunk
+    return P
+
+
+def _press(Z: np.ndarray, y: np.ndarray, alpha: float) -> float:
+    """Closed-form leave-one-out residual sum of squares of an unconstrained ridge fit."""
+    A = Z.T @ Z + alpha * _penalty(Z.shape[1])
+    H = Z @ np.linalg.solve(A, Z.T)
+    h = np.clip(np.diag(H), None, 1 - 1e-12)
+    return float(np.sum(((y - H @ y) / (1 - h)) ** 2))
+
+
+def _ridge_fit(Z: np.ndarray, y: np.ndarray, alpha: float, Zg: np.ndarray | None, lower: float) -> np.ndarray:
+    """Ridge least squares, held >= `lower` at the grid rows Zg, solved as a QP by CasADi's qrqp.
+
+    Cutting planes: the QP is solved with only the grid points found violated so far as
+    constraints, adding the newly violated ones until none is; the result is the optimum of the
+    fully constrained problem, with a few rows instead of hundreds.
+    """
+    p = Z.shape[1]
+    H = 2 * (Z.T @ Z + alpha * _penalty(p))
+    g = -2 * Z.T @ y
+    beta = np.linalg.solve(H, -g) if np.linalg.matrix_rank(H) == p else np.linalg.lstsq(H, -g, rcond=None)[0]
+    if Zg is None:
+        return beta
+    active = np.zeros(len(Zg), dtype=bool)
+    opts = {"print_iter": False, "print_header": False, "print_info": False, "error_on_fail": False}
+    for _ in range(len(Zg)):
+        violated = Zg @ beta < lower * (1 - 1e-9)
+        if not violated.any():
+            return beta
+        active |= violated
+        A = Zg[active]
+        solver = ca.conic(
+            "ridge", "qrqp", {"h": ca.Sparsity.dense(p, p), "a": ca.Sparsity.dense(*A.shape)}, opts
+        )
+        sol = solver(h=H, g=g, a=A, lba=lower, uba=np.inf, x0=beta)
+        if not solver.stats()["success"]:
+            break
+        beta = np.asarray(sol["x"]).ravel()
+    raise DesignerError(
+        "the constrained surrogate fit did not converge", "check the table for extreme values"
+    )
+
+
+@dataclass
+class Prediction:
+    """Predicted values and their 95 % prediction interval, arrays in rig units."""
+
+    value: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+
+
+@dataclass
+class ResponseSurface:
+    """One response's fitted form: coefficients, ridge penalty, and what its intervals need."""
+
+    response: str
+    form: str = "mean"
+    alpha: float = 0.0
+    coef: np.ndarray = field(default_factory=lambda: np.zeros(1))
+    #: A^-1 Z'Z A^-1 with A = Z'Z + alpha P: the coefficients' covariance divided by sigma^2
+    vcov: np.ndarray = field(default_factory=lambda: np.ones((1, 1)))
+    sigma: float = 0.0
+    dof: float = 0.0
+    t95: float = 0.0
+    loo: dict[str, float] = field(default_factory=dict)
+    loo_predictions: dict[str, np.ndarray] = field(default_factory=dict)
+    candidates: dict[str, dict[str, float]] = field(default_factory=dict)
+    observed_range: tuple[float, float] = (0.0, 0.0)
+
+    @property
+    def transform(self) -> str:
+        return "log" if self.form == "powerlaw" else "none"
+
+    @property
+    def quantity(self) -> str:
+        return self.response.split("_", 1)[0]
+
+    @property
+    def axis(self) -> str:
+        return self.response.split("_", 1)[1]
+
+    @property
+    def unit(self) -> str:
+        return units.rig_unit(self.quantity, self.axis)
+
+    @property
+    def predictable(self) -> bool:
+        """Whether any form beats the mean under leave-one-out."""
+        return self.form != "mean" and self.loo.get("q2", 0.0) > 0.0
+
+    def features(self, X: Any) -> np.ndarray:
+        return design_matrix(self.form, X)
+
+    def fit(self, X: Any, y: np.ndarray) -> ResponseSurface:
+        """Fit this form; the ridge penalty is chosen by closed-form LOO on the given rows."""
+        y = np.asarray(y, dtype=float)
+        Z = self.features(X)
+        yt = np.log(y) if self.transform == "log" else y
+        self.alpha = min(ALPHAS, key=lambda a: _press(Z, yt, a))
+        self.coef = _ridge_fit(
+            Z, yt, self.alpha, _positivity_grid(self.form), _lower_bound(y, self.transform)
+        )
+        A_inv = np.linalg.inv(Z.T @ Z + self.alpha * _penalty(Z.shape[1]))
+        self.vcov = A_inv @ Z.T @ Z @ A_inv
+        H_trace = float(np.trace(Z @ A_inv @ Z.T))
+        n = len(y)
+        self.dof = max(n - H_trace, 1.0)
+        self.sigma = float(np.sqrt(np.sum((yt - Z @ self.coef) ** 2) / self.dof))
+        from scipy.stats import t as student_t
+
+        self.t95 = float(student_t.ppf(0.975, self.dof))
+        self.observed_range = (float(y.min()), float(y.max()))
+        return self
+
+    def predict(self, X: Any) -> Prediction:
+        Z = self.features(X)
+        mean = Z @ self.coef
+        half = self.t95 * self.sigma * np.sqrt(1.0 + np.einsum("ij,jk,ik->i", Z, self.vcov, Z))
+        lo, hi = mean - half, mean + half
+        if self.transform == "log":
+            return Prediction(np.exp(mean), np.exp(lo), np.exp(hi))
+        return Prediction(mean, lo, hi)
+
+    def casadi_function(self) -> ca.Function:
+        """value, lo, hi of the 95 % PI as a CasADi function of the six factors (factor order)."""
+        x = ca.SX.sym("x", len(space.FACTOR_NAMES))
+        xs = {n: x[i] for i, n in enumerate(space.FACTOR_NAMES)}
+        z = ca.vertcat(1, *_columns(self.form, xs, _CasadiOps))
+        mean = ca.dot(z, ca.DM(self.coef))
+        half = self.t95 * self.sigma * ca.sqrt(1 + ca.bilin(ca.DM(self.vcov), z, z))
+        out = [mean, mean - half, mean + half]
+        if self.transform == "log":
+            out = [ca.exp(e) for e in out]
+        return ca.Function(self.response, [x], out, ["x"], ["value", "lo", "hi"])
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "form": self.form,
+            "transform": self.transform,
+            "unit": self.unit,
+            "alpha": self.alpha,
+            "coef": self.coef.tolist(),
+            "vcov": self.vcov.tolist(),
+            "sigma": self.sigma,
+            "dof": self.dof,
+            "t95": self.t95,
+            "observed_range": list(self.observed_range),
+            "loo": self.loo,
+            "loo_predictions": {k: np.asarray(v).tolist() for k, v in self.loo_predictions.items()},
+            "candidates": self.candidates,
+        }
+
+    @classmethod
+    def from_dict(cls, response: str, d: Mapping[str, Any]) -> ResponseSurface:
+        if d.get("form") not in FORMS:
+            raise DesignerError(
+                f"surrogate response {response} has unknown form {d.get('form')!r}",
+                "refit it with designer fit",
+            )
+        return cls(
+            response=response,
+            form=d["form"],
+            alpha=float(d["alpha"]),
+            coef=np.asarray(d["coef"], dtype=float),
+            vcov=np.asarray(d["vcov"], dtype=float),
+            sigma=float(d["sigma"]),
+            dof=float(d["dof"]),
+            t95=float(d["t95"]),
+            loo=dict(d["loo"]),
+            loo_predictions={k: np.asarray(v, dtype=float) for k, v in d["loo_predictions"].items()},
+            candidates=dict(d["candidates"]),
+            observed_range=tuple(d["observed_range"]),
+        )
+
+
+def _lower_bound(y: np.ndarray, transform: str) -> float:
+    """Positivity floor on the tested grid for raw-space forms: a thousandth of the smallest run."""
+    return -np.inf if transform == "log" else 1e-3 * float(np.min(y))
+
+
+@functools.cache
+def _positivity_grid(form: str) -> np.ndarray | None:
+    """Where a raw-space form must stay positive: its features at every tested level combination."""
+    return None if form in ("mean", "powerlaw") else design_matrix(form, _grid())
+
+
+def _metrics(y: np.ndarray, pred: Prediction) -> dict[str, float]:
+    err = y - pred.value
+    return {
+        "rmse": float(np.sqrt(np.mean(err**2))),
+        "mape": float(100 * np.mean(np.abs(err / y))),
+        "q2": float(1 - np.sum(err**2) / np.sum((y - y.mean()) ** 2)),
+        "coverage95": float(np.mean((y >= pred.lo) & (y <= pred.hi))),
+    }
+
+
+def leave_one_out(form: str, X: Mapping[str, np.ndarray], y: np.ndarray, response: str) -> Prediction:
+    """Predict each run from a fit to all the others (penalty re-chosen inside every fold)."""
+    n = len(y)
+    value, lo, hi = np.empty(n), np.empty(n), np.empty(n)
+    for i in range(n):
+        keep = np.arange(n) != i
+        model = ResponseSurface(response, form).fit({k: v[keep] for k, v in X.items()}, y[keep])
+        p = model.predict({k: v[i : i + 1] for k, v in X.items()})
+        value[i], lo[i], hi[i] = p.value[0], p.lo[0], p.hi[0]
+    return Prediction(value, lo, hi)
+
+
+def select(
+    X: Mapping[str, np.ndarray], y: np.ndarray, response: str, forms: tuple[str, ...] = FORMS
+) -> ResponseSurface:
+    """Fit every form; keep the simplest whose LOO error is within one standard error of the best.
+
+    The one-standard-error rule (Breiman et al., Hastie et al.) on paired squared LOO errors: a
+    richer form must beat a simpler one by more than the noise of the comparison, so a response
+    the factors do not explain falls back to the mean instead of a form that fits noise.
+    """
+    preds = {form: leave_one_out(form, X, y, response) for form in forms}
+    sq = {form: (y - p.value) ** 2 for form, p in preds.items()}
+    best = min(forms, key=lambda f: sq[f].mean())
+    n_params = {form: design_matrix(form, {k: v[:1] for k, v in X.items()}).shape[1] for form in forms}
+
+    def within_one_se(form: str) -> bool:
+        d = sq[form] - sq[best]
+        return form == best or d.mean() <= d.std(ddof=1) / np.sqrt(len(y))
+
+    chosen = min((f for f in forms if within_one_se(f)), key=lambda f: (n_params[f], forms.index(f)))
+    model = ResponseSurface(response, chosen).fit(X, y)
+    model.loo = _metrics(y, preds[chosen])
+    p = preds[chosen]
+    model.loo_predictions = {"value": p.value, "lo": p.lo, "hi": p.hi}
+    model.candidates = {form: _metrics(y, preds[form]) | {"n_params": n_params[form]} for form in forms}
+    return model
+
+
+@dataclass
+class Surrogate:
+    """Per-response surfaces over the six factors, with the table they were fitted to."""
+
+    models: dict[str, ResponseSurface] = field(default_factory=dict)
+    table_hash: str = ""
+    #: the training runs: the six factors and the responses, in rig units
+    training: dict[str, list[float]] = field(default_factory=dict)
+
+    @property
+    def responses(self) -> list[str]:
+        return list(self.models)
+
+    @property
+    def axes(self) -> list[str]:
+        return [a for a in units.AXES if f"k_{a}" in self.models and f"c_{a}" in self.models]
+
+    @property
+    def id(self) -> str:
+        """Content hash of the fitted surrogate (form, coefficients and training table)."""
+        return hashlib.sha256(self._payload_json(include_id=False).encode()).hexdigest()[:16]
+
+    @property
+    def table(self):  # -> pandas.DataFrame; pandas imported lazily to keep `suggest` fast
+        import pandas as pd
+
+        return pd.DataFrame(self.training)
+
+    def fit(self, table, responses: list[str] | None = None) -> Surrogate:
+        """Fit c and k of every axis present in a coefficient table (see designer.data)."""
+        from .data import axes_present, table_hash
+
+        axes = axes_present(table)
+        responses = responses or [f"{q}_{a}" for a in axes for q in ("c", "k")]
+        if len(table) < 8:
+            raise DesignerError(f"the table has {len(table)} runs", "a surrogate needs at least 8")
+        X = {n: table[n].to_numpy(dtype=float) for n in space.FACTOR_NAMES}
+        self.models = {r: select(X, table[r].to_numpy(dtype=float), r) for r in responses}
+        self.table_hash = table_hash(table)
+        self.training = {c: table[c].astype(float).tolist() for c in list(space.FACTOR_NAMES) + responses}
+        return self
+
+    def model(self, response: str) -> ResponseSurface:
+        try:
+            return self.models[response]
+        except KeyError:
+            raise DesignerError(
+                f"the surrogate has no response '{response}'",
+                f"it has {', '.join(self.models)}; fit one on a table with that axis (designer fit --data)",
+            ) from None
+
+    def predict(self, X: Any, responses: list[str] | None = None) -> dict[str, Prediction]:
+        """Predictions with 95 % PIs for each response at the designs X (DataFrame or mapping)."""
+        return {r: self.model(r).predict(X) for r in (responses or self.responses)}
+
+    def _payload_json(self, include_id: bool = True) -> str:
+        payload: dict[str, Any] = {"format": FORMAT}
+        if include_id:
+            payload["id"] = self.id
+        payload |= {
+            "table_hash": self.table_hash,
+            "n_runs": len(next(iter(self.training.values()), [])),
+            "factors": {
+                f.name: {
+                    "unit": f.unit,
+                    "low": f.low,
+                    "high": f.high,
+                    "levels": list(f.levels),
+                    "categorical": f.categorical,
+                }
+                for f in space.FACTORS
+            },
+            "alphas": list(ALPHAS),
+            "responses": {r: m.to_dict() for r, m in self.models.items()},
+            "training": self.training,
+        }
+        return json.dumps(payload, indent=1)
+
+    def save(self, path: str | Path) -> Path:
+        with atomic_write(path) as fh:
+            fh.write(self._payload_json() + "\n")
+        return Path(path)
+
+    @classmethod
+    def load(cls, path: str | Path) -> Surrogate:
+        p = Path(path)
+        try:
+            d = json.loads(p.read_text())
+        except FileNotFoundError:
+            raise DesignerError(f"no such surrogate: {p}", "give a file written by designer fit") from None
+        except (OSError, ValueError) as exc:
+            raise DesignerError(f"cannot read surrogate {p}: {exc}", "refit it with designer fit") from None
+        if not isinstance(d, dict) or d.get("format") != FORMAT:
+            raise DesignerError(f"{p} is not a {FORMAT} surrogate", "refit it with designer fit")
+        try:
+            models = {r: ResponseSurface.from_dict(r, m) for r, m in d["responses"].items()}
+            return cls(models=models, table_hash=d["table_hash"], training=d["training"])
+        except (KeyError, TypeError, ValueError) as exc:
+            raise DesignerError(
+                f"surrogate {p} is incomplete ({exc})", "refit it with designer fit"
+            ) from None
+
+    @classmethod
+    def load_default(cls) -> Surrogate:
+        """The surrogate shipped with the package, fitted to the bundled study table."""
+        return cls.load(default_path())
+
+
+def default_path() -> Path:
+    return Path(str(resources.files("designer.surrogates") / DEFAULT_NAME))

@@ -1,0 +1,1 @@
+"""C sources of the FlexJoint FMU runtime, shipped as package data and compiled on first export."""

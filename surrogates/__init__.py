@@ -1,0 +1,1 @@
+"""The default fitted surrogate(s) as JSON, reproducible with `designer fit` on the bundled table."""
