@@ -88,10 +88,11 @@ class Master:
             wired[dn][j] = i
             sources[dn].add(self.columns[i].split(".", 1)[0])
         for n, idx in wired.items():
-            missing = [v for v, i in zip(self.systems[n].inputs, idx) if i < 0]
+            missing = [v for v, i in zip(self.systems[n].inputs, idx, strict=True) if i < 0]
             if missing:
                 raise DesignerError(
-                    f"inputs of {n} are not connected: {', '.join(missing)}", "connect every input to an output"
+                    f"inputs of {n} are not connected: {', '.join(missing)}",
+                    "connect every input to an output",
                 )
         self._src = wired
         self._feed = _order(self.systems, sources)
@@ -100,13 +101,17 @@ class Master:
     def _split(self, ref: str) -> tuple[str, str]:
         name, _, var = ref.partition(".")
         if name not in self.systems:
-            raise DesignerError(f"no system '{name}' in connection '{ref}'", f"systems: {', '.join(self.systems)}")
+            raise DesignerError(
+                f"no system '{name}' in connection '{ref}'", f"systems: {', '.join(self.systems)}"
+            )
         return name, var
 
     def _position(self, name: str, var: str, kind: str) -> int:
         names = getattr(self.systems[name], kind)
         if var not in names:
-            raise DesignerError(f"system {name} has no {kind[:-1]} '{var}'", f"its {kind}: {', '.join(names)}")
+            raise DesignerError(
+                f"system {name} has no {kind[:-1]} '{var}'", f"its {kind}: {', '.join(names)}"
+            )
         return names.index(var)
 
     def _index(self, ref: str, kind: str) -> int:

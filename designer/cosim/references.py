@@ -9,12 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DesignerError
-
-#: the study's hub motion: 1 rad amplitude, 0.2 Hz rising to 1.85 Hz over a 2200 s run
-RIG_AMPLITUDE = 1.0
-RIG_F0 = 0.2
-RIG_F1 = 1.85
-RIG_SWEEP = 2200.0
+from ..rig.simulate import DURATION, F0, F1, HUB_AMPLITUDE
+from ..rig.simulate import Chirp as RigChirp
 
 
 @dataclass(frozen=True)
@@ -48,20 +44,16 @@ class Sine:
 
 @dataclass(frozen=True)
 class Chirp:
-    """The rig's hub: q = A sin(2 pi (f0 t + (f1 - f0) t^2 / (2 T))), a linear sweep f0 -> f1 over T s."""
+    """The rig's hub motion: amplitude sin(2 pi (f0 t + (f1 - f0) t^2 / (2 sweep))), the study's sweep."""
 
-    amplitude: float = RIG_AMPLITUDE
-    f0: float = RIG_F0
-    f1: float = RIG_F1
-    sweep: float = RIG_SWEEP
+    amplitude: float = HUB_AMPLITUDE
+    f0: float = F0
+    f1: float = F1
+    sweep: float = DURATION
 
     def __call__(self, t: float) -> tuple[float, float]:
-        rate = (self.f1 - self.f0) / self.sweep
-        phase = 2.0 * math.pi * (self.f0 * t + 0.5 * rate * t * t)
-        return (
-            self.amplitude * math.sin(phase),
-            self.amplitude * 2.0 * math.pi * (self.f0 + rate * t) * math.cos(phase),
-        )
+        q, dq, _ = RigChirp(self.f0, self.f1, self.sweep)(t)
+        return self.amplitude * float(q), self.amplitude * float(dq)
 
 
 @dataclass(frozen=True)

@@ -35,7 +35,7 @@ def planar_arm_xml(lengths: Sequence[float] = ARM_LENGTHS, masses: Sequence[floa
         if not all(np.isfinite(v) and v > 0 for v in values):
             raise DesignerError(f"every link {what} must be a positive number", f"got {list(values)}")
     body = ""
-    for i, (length, mass) in reversed(list(enumerate(zip(lengths, masses), start=1))):
+    for i, (length, mass) in reversed(list(enumerate(zip(lengths, masses, strict=True), start=1))):
         pos = f"{lengths[i - 2]:g} 0 0" if i > 1 else "0 0 0"
         inertia = mass * length**2 / 12.0
         body = (
@@ -46,10 +46,7 @@ def planar_arm_xml(lengths: Sequence[float] = ARM_LENGTHS, masses: Sequence[floa
             f'<geom type="capsule" fromto="0 0 0 {length:g} 0 0" size="0.005" contype="0" conaffinity="0"/>'
             f"{body}</body>"
         )
-    return (
-        '<mujoco model="planar_arm"><option gravity="0 0 -9.81"/>'
-        f"<worldbody>{body}</worldbody></mujoco>"
-    )
+    return f'<mujoco model="planar_arm"><option gravity="0 0 -9.81"/><worldbody>{body}</worldbody></mujoco>'
 
 
 def load_spec(path: str | Path | None = None, lengths=ARM_LENGTHS, masses=ARM_MASSES):
@@ -64,7 +61,9 @@ def load_spec(path: str | Path | None = None, lengths=ARM_LENGTHS, masses=ARM_MA
     try:
         return mujoco.MjSpec.from_file(str(path))
     except Exception as exc:  # mujoco raises a bare ValueError with its parser message
-        raise DesignerError(f"MuJoCo cannot load {path}: {exc}", "give an MJCF or URDF file MuJoCo reads") from None
+        raise DesignerError(
+            f"MuJoCo cannot load {path}: {exc}", "give an MJCF or URDF file MuJoCo reads"
+        ) from None
 
 
 def joint_names(spec) -> list[str]:
@@ -81,7 +80,8 @@ def check_joints(spec, names: Sequence[str]) -> None:
     for name in names:
         if name not in have:
             raise DesignerError(
-                f"the robot has no joint '{name}'", f"its hinge and slide joints are: {', '.join(have) or 'none'}"
+                f"the robot has no joint '{name}'",
+                f"its hinge and slide joints are: {', '.join(have) or 'none'}",
             )
 
 
@@ -166,7 +166,9 @@ class Robot:
         """Advance one physics step (h must be the model's timestep), then move the motors to t + h."""
         for i, (j, law) in enumerate(self.in_engine.items()):
             k = self.joints.index(j)
-            self.data.ctrl[self.actuators[i]] = law.k * (self.motor_q[k] + law.offset) + law.c * self.motor_v[k]
+            self.data.ctrl[self.actuators[i]] = (
+                law.k * (self.motor_q[k] + law.offset) + law.c * self.motor_v[k]
+            )
         self._mj_step(self.model, self.data)
         self._steps += 1
         self.time = self._steps * h
