@@ -131,6 +131,7 @@ class Robot:
         self.model = spec.compile()
         self.data = mujoco.MjData(self.model)
         self._mj_step = mujoco.mj_step
+        self._bad = self.data.warning[mujoco.mjtWarning.mjWARN_BADQACC]
         self.joints = list(motors)
         self.motors = [motors[j] for j in self.joints]
         self.qpos = np.array([self.model.joint(j).qposadr[0] for j in self.joints])
@@ -170,6 +171,11 @@ class Robot:
                 law.k * (self.motor_q[k] + law.offset) + law.c * self.motor_v[k]
             )
         self._mj_step(self.model, self.data)
+        if self._bad.number:
+            raise DesignerError(
+                f"the robot diverged at t = {self.time:g} s (MuJoCo reset it)",
+                "use a smaller step, or the gauss-seidel algorithm",
+            )
         self._steps += 1
         self.time = self._steps * h
         self._motor(self.time)
