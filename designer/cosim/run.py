@@ -189,15 +189,21 @@ def robot_metrics(sc: Scenario, res: Result, laws: dict) -> dict:
 
 
 def rig_log(sc: Scenario, res: Result) -> pd.DataFrame:
-    """The run as a rig log: t, the axis' coordinate and load in rig units, the hub angle."""
+    """The run as a rig log: t, the axis' coordinate and load in rig units, the hub angle.
+
+    The load is held over each step, so the sensor's sample at t_n is the mean of the loads held
+    either side of it: read at one edge, the log would look half a step late (extra damping k h / 2).
+    """
     from ..rig.logs import LOAD
 
     a = sc.rig_joint.axis
+    held = res.column("hub.f")
+    sensed = np.concatenate([held[:1], 0.5 * (held[1:] + held[:-1])])
     return pd.DataFrame(
         {
             "t": res.time,
             a: units.from_si("r", a, res.column(f"joint.{a}.s")),
-            LOAD[a]: units.from_si("F", a, res.column("hub.f")),
+            LOAD[a]: units.from_si("F", a, sensed),
             "hub": res.column("hub.q"),
         }
     )
