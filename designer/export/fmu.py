@@ -324,10 +324,12 @@ def _fmi3_description(joint: Joint, interface: str, variables: list[Variable]) -
     caps = 'canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="true"'
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<fmiModelDescription fmiVersion="3.0" modelName={quoteattr(joint.name)} instantiationToken="{_TOKEN}"',
+        f'<fmiModelDescription fmiVersion="3.0" modelName={quoteattr(joint.name)}',
+        f'  instantiationToken="{_TOKEN}"',
         f"  description={quoteattr(_description(joint, interface))}",
         f'  generationTool="{GENERATOR}" variableNamingConvention="structured">',
-        f'  <ModelExchange modelIdentifier="{build.MODEL_IDENTIFIER}" {caps} needsCompletedIntegratorStep="false"/>',
+        f'  <ModelExchange modelIdentifier="{build.MODEL_IDENTIFIER}" {caps} '
+        'needsCompletedIntegratorStep="false"/>',
         f'  <CoSimulation modelIdentifier="{build.MODEL_IDENTIFIER}" {caps} '
         'canHandleVariableCommunicationStepSize="true" hasEventMode="false"/>',
         *_unit_definitions(variables),
@@ -462,7 +464,7 @@ def export_fmu(
     source_only: bool = False,
     progress: Callable[[float], None] | None = None,
 ) -> Path:
-    """Write `joint` as an FMU at `path` (atomically) and return the path; the same joint gives the same bytes."""
+    """Write `joint` as an FMU at `path` (atomically); the same joint always gives the same bytes."""
     path = Path(path)
     entries = archive_entries(joint, fmi_version, interface, source_only)
     if progress:

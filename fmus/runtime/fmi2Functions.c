@@ -1,6 +1,5 @@
 /* The generic FMI 2.0 layer: calling-sequence checks with per-function state masks, the importer's logger,
    status escalation; everything model-specific is delegated to model.h. */
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -129,23 +128,13 @@ fmi2Status fmi2Reset(fmi2Component c) {
 }
 
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
-    size_t i;
     BEGIN(fmi2Get);
-    CHECK_ARRAY(fmi2GetReal, vr, nvr);
-    CHECK_ARRAY(fmi2GetReal, value, nvr);
-    for (i = 0; i < nvr; i++)
-        if (getFloat64(inst, vr[i], &value[i]) > Warning) return (fmi2Status)escalate(inst, Error);
-    return fmi2OK;
+    return (fmi2Status)escalate(inst, getFloat64s(inst, vr, nvr, value));
 }
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
-    size_t i;
     BEGIN(fmi2Set);
-    CHECK_ARRAY(fmi2SetReal, vr, nvr);
-    CHECK_ARRAY(fmi2SetReal, value, nvr);
-    for (i = 0; i < nvr; i++)
-        if (setFloat64(inst, vr[i], value[i]) > Warning) return (fmi2Status)escalate(inst, Error);
-    return fmi2OK;
+    return (fmi2Status)escalate(inst, setFloat64s(inst, vr, nvr, value));
 }
 
 fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]) {
@@ -172,25 +161,18 @@ fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
     return fmi2OK;
 }
 
-/* the model has no Integer or String variables: any value reference is unknown */
-static fmi2Status noVariables(ModelInstance *inst, const char *type, size_t nvr) {
-    if (nvr == 0) return fmi2OK;
-    logError(inst, "the model has no %s variables", type);
-    return (fmi2Status)escalate(inst, Error);
-}
-
 fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]) {
     (void)vr;
     (void)value;
     BEGIN(fmi2Get);
-    return noVariables(inst, "Integer", nvr);
+    return (fmi2Status)escalate(inst, noVariables(inst, "Integer", nvr));
 }
 
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
     (void)vr;
     (void)value;
     BEGIN(fmi2Get);
-    return noVariables(inst, "String", nvr);
+    return (fmi2Status)escalate(inst, noVariables(inst, "String", nvr));
 }
 
 fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
@@ -198,23 +180,19 @@ fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
     (void)vr;
     (void)value;
     BEGIN(fmi2Set);
-    return noVariables(inst, "Integer", nvr);
+    return (fmi2Status)escalate(inst, noVariables(inst, "Integer", nvr));
 }
 
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
     (void)vr;
     (void)value;
     BEGIN(fmi2Set);
-    return noVariables(inst, "String", nvr);
+    return (fmi2Status)escalate(inst, noVariables(inst, "String", nvr));
 }
 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     BEGIN(fmi2FMUstate);
-    CHECK_ARRAY(fmi2GetFMUstate, FMUstate, 1);
-    if (!*FMUstate && !(*FMUstate = malloc(sizeof(SavedState)))) {
-        logError(inst, "out of memory");
-        return (fmi2Status)escalate(inst, Error);
-    }
+    if (newSavedState(inst, FMUstate) > Warning) return (fmi2Status)escalate(inst, Error);
     saveState(inst, (SavedState *)*FMUstate);
     return fmi2OK;
 }
@@ -259,41 +237,16 @@ fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byt
 
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
                                    fmi2FMUstate *FMUstate) {
-    SavedState saved;
     BEGIN(fmi2FMUstate);
-    CHECK_ARRAY(fmi2DeSerializeFMUstate, serializedState, 1);
-    CHECK_ARRAY(fmi2DeSerializeFMUstate, FMUstate, 1);
-    if (size != sizeof(SavedState) || (memcpy(&saved, serializedState, size), saved.size != size)) {
-        logError(inst, "fmi2DeSerializeFMUstate: the bytes are not a state of this FMU");
-        return (fmi2Status)escalate(inst, Error);
-    }
-    if (!*FMUstate && !(*FMUstate = malloc(sizeof(SavedState)))) {
-        logError(inst, "out of memory");
-        return (fmi2Status)escalate(inst, Error);
-    }
-    memcpy(*FMUstate, &saved, sizeof(SavedState));
-    return fmi2OK;
+    return (fmi2Status)escalate(inst, deserializeState(inst, (const unsigned char *)serializedState, size, FMUstate));
 }
 
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[],
                                         size_t nUnknown, const fmi2ValueReference vKnown_ref[], size_t nKnown,
                                         const fmi2Real dvKnown[], fmi2Real dvUnknown[]) {
-    size_t i, j;
-    double d;
     BEGIN(fmi2GetDirectionalDerivative);
-    CHECK_ARRAY(fmi2GetDirectionalDerivative, vUnknown_ref, nUnknown);
-    CHECK_ARRAY(fmi2GetDirectionalDerivative, dvUnknown, nUnknown);
-    CHECK_ARRAY(fmi2GetDirectionalDerivative, vKnown_ref, nKnown);
-    CHECK_ARRAY(fmi2GetDirectionalDerivative, dvKnown, nKnown);
-    for (i = 0; i < nUnknown; i++) {
-        dvUnknown[i] = 0;
-        for (j = 0; j < nKnown; j++) {
-            if (getPartial(inst, vUnknown_ref[i], vKnown_ref[j], &d) > Warning)
-                return (fmi2Status)escalate(inst, Error);
-            dvUnknown[i] += d * dvKnown[j];
-        }
-    }
-    return fmi2OK;
+    return (fmi2Status)escalate(
+        inst, partialDerivatives(inst, false, vUnknown_ref, nUnknown, vKnown_ref, nKnown, dvKnown, dvUnknown));
 }
 
 /* ---- Model Exchange */
@@ -334,31 +287,15 @@ fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time) {
     return fmi2OK;
 }
 
-static fmi2Status checkStates(ModelInstance *inst, const char *f, size_t nx) {
-    if (nx == numberOfStates(inst)) return fmi2OK;
-    logError(inst, "%s: nx = %zu but the model has %zu continuous states", f, nx, numberOfStates(inst));
-    return (fmi2Status)escalate(inst, Error);
-}
-
 fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t nx) {
-    size_t i;
     BEGIN(fmi2SetContinuousStates);
-    CHECK_ARRAY(fmi2SetContinuousStates, x, nx);
-    if (checkStates(inst, "fmi2SetContinuousStates", nx) != fmi2OK) return fmi2Error;
-    for (i = 0; i < nx; i++) {
-        if (!isfinite(x[i])) {
-            logError(inst, "fmi2SetContinuousStates: x[%zu] = %g is not a finite number", i, x[i]);
-            return (fmi2Status)escalate(inst, Error);
-        }
-    }
-    setStates(inst, x);
-    return fmi2OK;
+    return (fmi2Status)escalate(inst, setContinuousStates(inst, x, nx));
 }
 
 fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real derivatives[], size_t nx) {
     BEGIN(fmi2GetStates);
     CHECK_ARRAY(fmi2GetDerivatives, derivatives, nx);
-    if (checkStates(inst, "fmi2GetDerivatives", nx) != fmi2OK) return fmi2Error;
+    if (checkStateCount(inst, "fmi2GetDerivatives", nx) > Warning) return (fmi2Status)escalate(inst, Error);
     getDerivatives(inst, derivatives);
     return fmi2OK;
 }
@@ -374,7 +311,7 @@ fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real eventIndicators[], s
 fmi2Status fmi2GetContinuousStates(fmi2Component c, fmi2Real x[], size_t nx) {
     BEGIN(fmi2GetStates);
     CHECK_ARRAY(fmi2GetContinuousStates, x, nx);
-    if (checkStates(inst, "fmi2GetContinuousStates", nx) != fmi2OK) return fmi2Error;
+    if (checkStateCount(inst, "fmi2GetContinuousStates", nx) > Warning) return (fmi2Status)escalate(inst, Error);
     getStates(inst, x);
     return fmi2OK;
 }
@@ -383,7 +320,7 @@ fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, fmi2Real x_nominal
     size_t i;
     BEGIN(fmi2GetStates);
     CHECK_ARRAY(fmi2GetNominalsOfContinuousStates, x_nominal, nx);
-    if (checkStates(inst, "fmi2GetNominalsOfContinuousStates", nx) != fmi2OK) return fmi2Error;
+    if (checkStateCount(inst, "fmi2GetNominalsOfContinuousStates", nx) > Warning) return (fmi2Status)escalate(inst, Error);
     for (i = 0; i < nx; i++) x_nominal[i] = 1.0;
     return fmi2OK;
 }
@@ -417,14 +354,7 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
                       fmi2Boolean noSetFMUStatePriorToCurrentCommunicationPoint) {
     (void)noSetFMUStatePriorToCurrentCommunicationPoint;
     BEGIN(fmi2DoStep);
-    if (!(communicationStepSize > 0) || !isfinite(communicationStepSize) || !isfinite(currentCommunicationPoint)) {
-        logError(inst, "fmi2DoStep: the step size must be positive and finite (got %g at t = %g)",
-                 communicationStepSize, currentCommunicationPoint);
-        return (fmi2Status)escalate(inst, Error);
-    }
-    if (doStep(inst, communicationStepSize) > Warning) return (fmi2Status)escalate(inst, Error);
-    inst->time = currentCommunicationPoint + communicationStepSize;
-    return fmi2OK;
+    return (fmi2Status)escalate(inst, stepInstance(inst, currentCommunicationPoint, communicationStepSize));
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c) {

@@ -2,6 +2,7 @@
 #include "instance.h"
 
 #include <ctype.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -204,4 +205,105 @@ Status escalate(ModelInstance *inst, Status status) {
     if (status == Error) inst->state = ErrorState;
     if (status == Fatal) inst->state = FatalState;
     return status;
+}
+
+Status getFloat64s(ModelInstance *inst, const unsigned vr[], size_t n, double value[]) {
+    size_t i;
+    if (n > 0 && (!vr || !value)) {
+        logError(inst, "get: NULL value reference or value array");
+        return Error;
+    }
+    for (i = 0; i < n; i++)
+        if (getFloat64(inst, vr[i], &value[i]) > Warning) return Error;
+    return OK;
+}
+
+Status setFloat64s(ModelInstance *inst, const unsigned vr[], size_t n, const double value[]) {
+    size_t i;
+    if (n > 0 && (!vr || !value)) {
+        logError(inst, "set: NULL value reference or value array");
+        return Error;
+    }
+    for (i = 0; i < n; i++)
+        if (setFloat64(inst, vr[i], value[i]) > Warning) return Error;
+    return OK;
+}
+
+Status noVariables(ModelInstance *inst, const char *type, size_t n) {
+    if (n == 0) return OK;
+    logError(inst, "the model has no %s variables", type);
+    return Error;
+}
+
+Status partialDerivatives(ModelInstance *inst, bool adjoint, const unsigned unknown[], size_t nUnknown,
+                          const unsigned known[], size_t nKnown, const double seed[], double sensitivity[]) {
+    size_t i, j;
+    double d;
+    size_t nSeed = adjoint ? nUnknown : nKnown, nSensitivity = adjoint ? nKnown : nUnknown;
+    if ((nUnknown > 0 && !unknown) || (nKnown > 0 && !known) || (nSeed > 0 && !seed) ||
+        (nSensitivity > 0 && !sensitivity)) {
+        logError(inst, "partial derivatives: NULL array");
+        return Error;
+    }
+    for (i = 0; i < nSensitivity; i++) sensitivity[i] = 0;
+    for (i = 0; i < nUnknown; i++) {
+        for (j = 0; j < nKnown; j++) {
+            if (getPartial(inst, unknown[i], known[j], &d) > Warning) return Error;
+            if (adjoint) sensitivity[j] += d * seed[i];
+            else sensitivity[i] += d * seed[j];
+        }
+    }
+    return OK;
+}
+
+Status checkStateCount(ModelInstance *inst, const char *function, size_t nx) {
+    if (nx == numberOfStates(inst)) return OK;
+    logError(inst, "%s: %zu states passed but the model has %zu", function, nx, numberOfStates(inst));
+    return Error;
+}
+
+Status setContinuousStates(ModelInstance *inst, const double x[], size_t nx) {
+    size_t i;
+    if (checkStateCount(inst, "set continuous states", nx) > Warning || (nx > 0 && !x)) return Error;
+    for (i = 0; i < nx; i++) {
+        if (!isfinite(x[i])) {
+            logError(inst, "set continuous states: x[%zu] = %g is not a finite number", i, x[i]);
+            return Error;
+        }
+    }
+    setStates(inst, x);
+    return OK;
+}
+
+Status stepInstance(ModelInstance *inst, double currentTime, double h) {
+    if (!(h > 0) || !isfinite(h) || !isfinite(currentTime)) {
+        logError(inst, "do step: the step size must be positive and finite (got %g at t = %g)", h, currentTime);
+        return Error;
+    }
+    if (doStep(inst, h) > Warning) return Error;
+    inst->time = currentTime + h;
+    return OK;
+}
+
+Status newSavedState(ModelInstance *inst, void **saved) {
+    if (!saved) {
+        logError(inst, "FMU state: NULL pointer");
+        return Error;
+    }
+    if (!*saved && !(*saved = malloc(sizeof(SavedState)))) {
+        logError(inst, "FMU state: out of memory");
+        return Error;
+    }
+    return OK;
+}
+
+Status deserializeState(ModelInstance *inst, const unsigned char bytes[], size_t size, void **saved) {
+    SavedState s;
+    if (!bytes || size != sizeof(SavedState) || (memcpy(&s, bytes, size), s.size != size)) {
+        logError(inst, "deserialize FMU state: the bytes are not a state of this FMU");
+        return Error;
+    }
+    if (newSavedState(inst, saved) > Warning) return Error;
+    memcpy(*saved, &s, sizeof(s));
+    return OK;
 }

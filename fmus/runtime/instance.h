@@ -63,6 +63,19 @@ typedef struct {
 void saveState(ModelInstance *inst, SavedState *saved);
 void restoreState(ModelInstance *inst, const SavedState *saved);
 
+/* shared implementations of the FMI calls; they log what went wrong and return the status */
+Status getFloat64s(ModelInstance *inst, const unsigned vr[], size_t n, double value[]);
+Status setFloat64s(ModelInstance *inst, const unsigned vr[], size_t n, const double value[]);
+Status noVariables(ModelInstance *inst, const char *type, size_t n);
+/* sensitivity = J seed (directional) or J^T seed (adjoint), J = d unknown / d known */
+Status partialDerivatives(ModelInstance *inst, bool adjoint, const unsigned unknown[], size_t nUnknown,
+                          const unsigned known[], size_t nKnown, const double seed[], double sensitivity[]);
+Status checkStateCount(ModelInstance *inst, const char *function, size_t nx);
+Status setContinuousStates(ModelInstance *inst, const double x[], size_t nx);
+Status stepInstance(ModelInstance *inst, double currentTime, double h);
+Status newSavedState(ModelInstance *inst, void **saved);
+Status deserializeState(ModelInstance *inst, const unsigned char bytes[], size_t size, void **saved);
+
 /* check that `function` may be called in the instance's current state; logs and returns false if not */
 bool allowedIn(ModelInstance *inst, const char *function, int mask);
 
