@@ -28,7 +28,7 @@ reference = {{ type = "step", amplitude = 0.3, at = 0.2 }}
 duration = 0.5
 steps = [2e-3, 1e-3, 5e-4, 2.5e-4]
 """
-J2 = "coefficients = { k = 330, c = 0.83 }\nfmi_version = 2"
+J2 = "coefficients = { k = 330, c = 0.83 }\nfmi_version = 3"
 RIG = """
 [simulation]
 duration = 20.0

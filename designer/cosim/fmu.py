@@ -84,16 +84,19 @@ class FmuSystem:
             self.outputs = [f"{a}.{v}" for a in axes for v in ("s", "v", "a")]
         self._dir = extract(str(path))
         kwargs = dict(
-            unzipDirectory=self._dir, modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name
+            guid=md.guid,
+            unzipDirectory=self._dir,
+            modelIdentifier=md.coSimulation.modelIdentifier,
+            instanceName=name,
         )
         if self.version == 3:
             from fmpy.fmi3 import FMU3Slave
 
-            self.fmu = FMU3Slave(instantiationToken=md.guid, **kwargs)
+            self.fmu = FMU3Slave(**kwargs)
         else:
             from fmpy.fmi2 import FMU2Slave
 
-            self.fmu = FMU2Slave(guid=md.guid, **kwargs)
+            self.fmu = FMU2Slave(**kwargs)
         self.fmu.instantiate()
         for key, value in (parameters or {}).items():
             if key not in refs:
