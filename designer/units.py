@@ -28,6 +28,9 @@ _UNITS: dict[tuple[str, bool], tuple[str, str, float]] = {
     ("r", True): ("rad", "rad", 1.0),
     ("F", False): ("N", "N", 1.0),
     ("F", True): ("N.mm", "N.m", 1e-3),
+    # a rig log's inertia coefficient F / r'' (N over mm/s^2, N.mm over rad/s^2) against m in kg, kg.m^2
+    ("m_log", False): ("N.s^2/mm", "kg", 1e3),
+    ("m_log", True): ("N.mm.s^2/rad", "kg.m^2", 1e-3),
 }
 
 MM = 1e-3  # metres per millimetre
@@ -50,7 +53,7 @@ def _entry(quantity: str, axis: str) -> tuple[str, str, float]:
     try:
         return _UNITS[(quantity, is_rotational(axis))]
     except KeyError:
-        raise DesignerError(f"unknown quantity '{quantity}'", "use m, c, k, r or F") from None
+        raise DesignerError(f"unknown quantity '{quantity}'", "use m, c, k, r, F or m_log") from None
 
 
 def rig_unit(quantity: str, axis: str) -> str:

@@ -1,1 +1,1 @@
-"""C sources of the FlexJoint FMU runtime, shipped as package data and compiled on first export."""
+"""The C runtime of the joint FMU: generic FMI 2 and FMI 3 layers and the FlexJoint model, shipped as data."""

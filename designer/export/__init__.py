@@ -1,0 +1,1 @@
+"""Exporters of a Joint: FMU (FMI 2/3), Modelica package, MJCF and URDF snippets."""

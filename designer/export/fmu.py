@@ -1,0 +1,481 @@
+"""Export a Joint as an FMU (FMI 2.0 or 3.0, Co-Simulation and Model Exchange in one archive).
+
+The binary is generic (see `build`); an export writes modelDescription.xml, the start values the binary
+reads at instantiation (resources/start_values.txt), the provenance (resources/joint.json) and the C
+sources, and zips them with fixed timestamps and order so that the same joint gives the same bytes.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import uuid
+import zipfile
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+from .. import __version__, units
+from ..errors import DesignerError
+from ..files import atomic_path
+from ..joint import AxisCoefficients, Joint
+from . import build
+
+INTERFACES = ("force", "body")
+FMI_VERSIONS = (2, 3)
+GENERATOR = f"flexjoint designer {__version__}"
+_ZIP_DATE = (1980, 1, 1, 0, 0, 0)
+_TOKEN = "@TOKEN@"
+
+#: value reference of a variable: 100 * (axis index + 1) + field (fmus/FlexJoint/config.h)
+_FIELDS = ("m", "c", "k", "offset", "enabled", "s", "v", "f", "a")
+
+# SI units and their base-unit exponents, for UnitDefinitions
+_BASE_UNITS: dict[str, dict[str, int]] = {
+    "s": {"s": 1},
+    "m": {"m": 1},
+    "rad": {"rad": 1},
+    "m/s": {"m": 1, "s": -1},
+    "rad/s": {"rad": 1, "s": -1},
+    "m/s^2": {"m": 1, "s": -2},
+    "rad/s^2": {"rad": 1, "s": -2},
+    "N": {"kg": 1, "m": 1, "s": -2},
+    "N.m": {"kg": 1, "m": 2, "s": -2},
+    "N/m": {"kg": 1, "s": -2},
+    "N.m/rad": {"kg": 1, "m": 2, "s": -2, "rad": -1},
+    "N.s/m": {"kg": 1, "s": -1},
+    "N.m.s/rad": {"kg": 1, "m": 2, "s": -1, "rad": -1},
+    "kg": {"kg": 1},
+    "kg.m^2": {"kg": 1, "m": 2},
+}
+_BASE_ORDER = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
+
+
+def value_reference(axis: str, field: str) -> int:
+    """The fixed value reference of `axis.field`, the same in every FlexJoint FMU."""
+    return 100 * (units.AXES.index(axis) + 1) + _FIELDS.index(field)
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One model variable as both FMI versions declare it."""
+
+    name: str
+    vr: int
+    kind: str  # "Real" or "Boolean"
+    causality: str
+    variability: str
+    description: str
+    start: float | bool | None = None
+    unit: str | None = None
+    initial: str | None = None
+    derivative_of: str | None = None  # name of the state this variable is the derivative of
+    depends_on: tuple[str, ...] | None = None  # for Outputs and derivatives
+
+
+def _pi_text(pi: tuple[float, float] | None, quantity: str, axis: str) -> str:
+    if pi is None:
+        return ""
+    lo, hi = (units.to_si(quantity, axis, v) for v in pi)
+    return f", 95 % PI {lo:.4g} to {hi:.4g} {units.si_unit(quantity, axis)}"
+
+
+def _variables(joint: Joint, interface: str) -> list[Variable]:
+    out = [Variable("time", 0, "Real", "independent", "continuous", "simulation time", unit="s")]
+    for a in units.AXES:
+        if a not in joint.axes:
+            continue
+        ac: AxisCoefficients = joint.axes[a]
+        si = ac.si()
+        r, f = units.si_unit("r", a), units.si_unit("F", a)
+        rot = units.is_rotational(a)
+        what = "torque" if rot else "force"
+
+        def var(field: str, *args, **kw) -> Variable:
+            return Variable(f"{a}.{field}", value_reference(a, field), *args, **kw)  # noqa: B023
+
+        if si["m"] is not None:
+            out.append(
+                var(
+                    "m",
+                    "Real",
+                    "parameter",
+                    "tunable",
+                    f"{'inertia' if rot else 'mass'} on {a}; {ac.origin}",
+                    si["m"],
+                    units.si_unit("m", a),
+                )
+            )
+        out.append(
+            var(
+                "c",
+                "Real",
+                "parameter",
+                "tunable",
+                f"damping on {a}; {ac.origin}" + _pi_text(ac.c_pi95, "c", a),
+                si["c"],
+                units.si_unit("c", a),
+            )
+        )
+        out.append(
+            var(
+                "k",
+                "Real",
+                "parameter",
+                "tunable",
+                f"stiffness on {a}; {ac.origin}" + _pi_text(ac.k_pi95, "k", a),
+                si["k"],
+                units.si_unit("k", a),
+            )
+        )
+        out.append(var("offset", "Real", "parameter", "tunable", f"rest position on {a}", 0.0, r))
+        out.append(var("enabled", "Boolean", "parameter", "tunable", f"spring-damper on {a} active", True))
+        if interface == "force":
+            out.append(
+                var(
+                    "s",
+                    "Real",
+                    "input",
+                    "continuous",
+                    f"relative {'angle' if rot else 'displacement'}",
+                    0.0,
+                    r,
+                )
+            )
+            out.append(var("v", "Real", "input", "continuous", "relative velocity", 0.0, f"{r}/s"))
+            out.append(
+                var(
+                    "f",
+                    "Real",
+                    "output",
+                    "continuous",
+                    f"{what} of the joint, -(k (s - offset) + c v)",
+                    unit=f,
+                    depends_on=(f"{a}.s", f"{a}.v"),
+                )
+            )
+        else:
+            out.append(
+                var(
+                    "s",
+                    "Real",
+                    "output",
+                    "continuous",
+                    f"{'angle' if rot else 'displacement'} (state)",
+                    0.0,
+                    r,
+                    "exact",
+                    depends_on=(f"{a}.s",),
+                )
+            )
+            out.append(
+                var(
+                    "v",
+                    "Real",
+                    "output",
+                    "continuous",
+                    "velocity (state), der(s)",
+                    0.0,
+                    f"{r}/s",
+                    "exact",
+                    derivative_of=f"{a}.s",
+                    depends_on=(f"{a}.v",),
+                )
+            )
+            out.append(var("f", "Real", "input", "continuous", f"load {what} on the body", 0.0, f))
+            out.append(
+                var(
+                    "a",
+                    "Real",
+                    "output",
+                    "continuous",
+                    "acceleration, der(v)",
+                    unit=f"{r}/s^2",
+                    derivative_of=f"{a}.v",
+                    depends_on=(f"{a}.s", f"{a}.v", f"{a}.f"),
+                )
+            )
+    return out
+
+
+def _num(v: float) -> str:
+    return repr(float(v))
+
+
+def _start(v: Variable) -> str:
+    if v.start is None:
+        return ""
+    return (
+        f' start="{"true" if v.start else "false"}"' if v.kind == "Boolean" else f' start="{_num(v.start)}"'
+    )
+
+
+def _unit_definitions(variables: list[Variable]) -> list[str]:
+    lines = ["  <UnitDefinitions>"]
+    for u in sorted({v.unit for v in variables if v.unit}):
+        base = " ".join(f'{k}="{_BASE_UNITS[u][k]}"' for k in _BASE_ORDER if k in _BASE_UNITS[u])
+        lines += [f"    <Unit name={quoteattr(u)}>", f"      <BaseUnit {base}/>", "    </Unit>"]
+    return lines + ["  </UnitDefinitions>"]
+
+
+def _default_experiment(joint: Joint, interface: str) -> str:
+    """A run long enough to settle and a step resolving the fastest axis (body), else 1 s at 1 ms."""
+    stop, step = 1.0, 1e-3
+    if interface == "body":
+        settle, period = [], []
+        for ac in joint.axes.values():
+            si = ac.si()
+            wn = math.sqrt(si["k"] / si["m"])
+            decay = si["c"] / (2 * si["m"])
+            settle.append(8.0 / decay if decay > 0 else 20 * 2 * math.pi / wn)
+            period.append(2 * math.pi / wn)
+        stop = float(f"{max(settle):.1g}")
+        step = float(f"{min(period) / 100:.1g}")
+    return f'  <DefaultExperiment startTime="0.0" stopTime="{_num(stop)}" stepSize="{_num(step)}"/>'
+
+
+def _description(joint: Joint, interface: str) -> str:
+    prov = joint.provenance
+    parts = [f"3D-printed TPU flexible joint '{joint.name}', {interface} interface"]
+    if "params" in prov:
+        parts.append("print settings " + ", ".join(f"{k} {v:g}" for k, v in prov["params"].items()))
+    if "surrogate" in prov:
+        parts.append(f"surrogate {prov['surrogate']}")
+    parts.append("coefficients " + str(prov.get("source", "entered by hand")))
+    return "; ".join(parts) + " (details in resources/joint.json)"
+
+
+def _fmi2_description(joint: Joint, interface: str, variables: list[Variable]) -> str:
+    index = {v.name: i + 1 for i, v in enumerate(variables)}
+    sources = "\n".join(f'      <File name="{Path(p).name}"/>' for p in build.c_sources(2))
+    caps = (
+        'canGetAndSetFMUstate="true" canSerializeFMUstate="true" providesDirectionalDerivative="true" '
+        'canNotUseMemoryManagementFunctions="true"'
+    )
+    lines = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f'<fmiModelDescription fmiVersion="2.0" modelName={quoteattr(joint.name)} guid="{_TOKEN}"',
+        f"  description={quoteattr(_description(joint, interface))}",
+        f'  generationTool="{GENERATOR}" variableNamingConvention="structured" numberOfEventIndicators="0">',
+        f'  <ModelExchange modelIdentifier="{build.MODEL_IDENTIFIER}" {caps} '
+        'completedIntegratorStepNotNeeded="true">',
+        f"    <SourceFiles>\n{sources}\n    </SourceFiles>",
+        "  </ModelExchange>",
+        f'  <CoSimulation modelIdentifier="{build.MODEL_IDENTIFIER}" {caps} '
+        'canHandleVariableCommunicationStepSize="true">',
+        f"    <SourceFiles>\n{sources}\n    </SourceFiles>",
+        "  </CoSimulation>",
+        *_unit_definitions(variables),
+        "  <LogCategories>",
+        '    <Category name="logEvents" description="life-cycle events"/>',
+        '    <Category name="logStatusError" description="errors"/>',
+        "  </LogCategories>",
+        _default_experiment(joint, interface),
+        "  <ModelVariables>",
+    ]
+    for i, v in enumerate(variables, 1):
+        attrs = [
+            f"name={quoteattr(v.name)}",
+            f'valueReference="{v.vr}"',
+            f"description={quoteattr(v.description)}",
+            f'causality="{v.causality}"',
+            f'variability="{v.variability}"',
+        ]
+        if v.initial:
+            attrs.append(f'initial="{v.initial}"')
+        inner = [_start(v).strip()] if v.start is not None else []
+        if v.kind == "Real":
+            if v.unit:
+                inner.insert(0, f"unit={quoteattr(v.unit)}")
+            if v.derivative_of:
+                inner.append(f'derivative="{index[v.derivative_of]}"')
+        lines.append(f"    <!-- index {i} -->")
+        lines.append(f"    <ScalarVariable {' '.join(attrs)}>")
+        lines.append(f"      <{v.kind} {' '.join(inner)}/>".replace(" />", "/>"))
+        lines.append("    </ScalarVariable>")
+    lines += ["  </ModelVariables>", "  <ModelStructure>"]
+
+    def unknown(v: Variable, deps: bool = True) -> str:
+        d = (
+            f' dependencies="{" ".join(str(index[n]) for n in v.depends_on)}"'
+            if deps and v.depends_on
+            else ""
+        )
+        return f'      <Unknown index="{index[v.name]}"{d}/>'
+
+    outputs = [v for v in variables if v.causality == "output"]
+    derivatives = [v for v in variables if v.derivative_of]
+    initial = [v for v in variables if v.causality == "output" and v.initial is None]
+    for tag, group, deps in (
+        ("Outputs", outputs, True),
+        ("Derivatives", derivatives, True),
+        ("InitialUnknowns", initial, False),
+    ):
+        if group:
+            lines += [f"    <{tag}>", *(unknown(v, deps) for v in group), f"    </{tag}>"]
+    lines += ["  </ModelStructure>", "</fmiModelDescription>", ""]
+    return "\n".join(lines)
+
+
+def _fmi3_description(joint: Joint, interface: str, variables: list[Variable]) -> str:
+    vr = {v.name: v.vr for v in variables}
+    caps = 'canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="true"'
+    lines = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f'<fmiModelDescription fmiVersion="3.0" modelName={quoteattr(joint.name)}',
+        f'  instantiationToken="{_TOKEN}"',
+        f"  description={quoteattr(_description(joint, interface))}",
+        f'  generationTool="{GENERATOR}" variableNamingConvention="structured">',
+        f'  <ModelExchange modelIdentifier="{build.MODEL_IDENTIFIER}" {caps} '
+        'needsCompletedIntegratorStep="false"/>',
+        f'  <CoSimulation modelIdentifier="{build.MODEL_IDENTIFIER}" {caps} '
+        'canHandleVariableCommunicationStepSize="true" hasEventMode="false"/>',
+        *_unit_definitions(variables),
+        "  <LogCategories>",
+        '    <Category name="logEvents" description="life-cycle events"/>',
+        '    <Category name="logStatusError" description="errors"/>',
+        "  </LogCategories>",
+        _default_experiment(joint, interface),
+        "  <ModelVariables>",
+    ]
+    for v in variables:
+        attrs = [
+            f"name={quoteattr(v.name)}",
+            f'valueReference="{v.vr}"',
+            f"description={quoteattr(v.description)}",
+            f'causality="{v.causality}"',
+            f'variability="{v.variability}"',
+        ]
+        if v.initial:
+            attrs.append(f'initial="{v.initial}"')
+        if v.start is not None:
+            attrs.append(_start(v).strip())
+        if v.unit:
+            attrs.append(f"unit={quoteattr(v.unit)}")
+        if v.derivative_of:
+            attrs.append(f'derivative="{vr[v.derivative_of]}"')
+        lines.append(f"    <{'Float64' if v.kind == 'Real' else 'Boolean'} {' '.join(attrs)}/>")
+    lines += ["  </ModelVariables>", "  <ModelStructure>"]
+
+    def unknown(tag: str, v: Variable, deps: bool = True) -> str:
+        d = f' dependencies="{" ".join(str(vr[n]) for n in v.depends_on)}"' if deps and v.depends_on else ""
+        return f'    <{tag} valueReference="{v.vr}"{d}/>'
+
+    lines += [unknown("Output", v) for v in variables if v.causality == "output"]
+    lines += [unknown("ContinuousStateDerivative", v) for v in variables if v.derivative_of]
+    lines += [
+        unknown("InitialUnknown", v, False)
+        for v in variables
+        if v.causality == "output" and v.initial is None
+    ]
+    lines += ["  </ModelStructure>", "</fmiModelDescription>", ""]
+    return "\n".join(lines)
+
+
+def _build_description() -> str:
+    files = "\n".join(f'        <SourceFile name="{Path(p).name}"/>' for p in build.c_sources(3))
+    return "\n".join(
+        [
+            '<?xml version="1.0" encoding="UTF-8"?>',
+            '<fmiBuildDescription fmiVersion="3.0">',
+            f'  <BuildConfiguration modelIdentifier="{build.MODEL_IDENTIFIER}">',
+            '    <SourceFileSet language="C99">',
+            files,
+            "    </SourceFileSet>",
+            '    <Library name="m"/>',
+            "  </BuildConfiguration>",
+            "</fmiBuildDescription>",
+            "",
+        ]
+    )
+
+
+def _start_values(joint: Joint, interface: str, variables: list[Variable]) -> str:
+    lines = [
+        "# FlexJoint start values, read by the FMU binary when it is instantiated (SI units)",
+        f"token {_TOKEN}",
+        f"interface {interface}",
+        *(f"axis {a}" for a in units.AXES if a in joint.axes),
+    ]
+    for v in variables:
+        if v.start is None or v.causality == "independent":
+            continue
+        lines.append(f"{v.name} {('true' if v.start else 'false') if v.kind == 'Boolean' else _num(v.start)}")
+    return "\n".join(lines) + "\n"
+
+
+def _check(joint: Joint, fmi_version: int, interface: str) -> None:
+    if fmi_version not in FMI_VERSIONS:
+        raise DesignerError(f"FMI version {fmi_version} is not supported", "use --fmi 2 or --fmi 3")
+    if interface not in INTERFACES:
+        raise DesignerError(f"unknown interface '{interface}'", "use --interface force or --interface body")
+    if interface == "body":
+        missing = [a for a, ac in joint.axes.items() if ac.m is None]
+        if missing:
+            raise DesignerError(
+                f"the body interface needs a mass, and axis {', '.join(missing)} has none",
+                "give --m in kg (kg.m^2 for a rotational axis), or export from a design so the mass "
+                "follows from its geometry",
+            )
+
+
+def archive_entries(
+    joint: Joint, fmi_version: int = 2, interface: str = "force", source_only: bool = False
+) -> dict[str, bytes]:
+    """The files of the FMU archive, by name in the archive."""
+    _check(joint, fmi_version, interface)
+    variables = _variables(joint, interface)
+    describe = _fmi2_description if fmi_version == 2 else _fmi3_description
+    description = describe(joint, interface, variables)
+    start = _start_values(joint, interface, variables)
+    provenance = {
+        "generator": GENERATOR,
+        "fmi_version": f"{fmi_version}.0",
+        "interface": interface,
+        "joint": joint.to_dict(),
+        "value_references": {v.name: v.vr for v in variables},
+    }
+    info = json.dumps(provenance, indent=2, sort_keys=True, default=str) + "\n"
+    digest = hashlib.sha256("\0".join((description, start, info)).encode()).digest()
+    token = "{" + str(uuid.UUID(bytes=digest[:16], version=5)) + "}"
+    entries = {
+        "modelDescription.xml": description.replace(_TOKEN, token).encode(),
+        "resources/start_values.txt": start.replace(_TOKEN, token).encode(),
+        "resources/joint.json": info.encode(),
+    }
+    root = build.source_dir()
+    for rel in build.source_files(fmi_version):
+        entries[f"sources/{Path(rel).name}"] = (root / rel).read_bytes()
+    if fmi_version == 3:
+        entries["sources/buildDescription.xml"] = _build_description().encode()
+    if not source_only:
+        binary = build.build_binary(fmi_version)
+        entries[f"binaries/{build.platform_folder(fmi_version)}/{build.library_name()}"] = binary.read_bytes()
+    return entries
+
+
+def export_fmu(
+    joint: Joint,
+    path: str | Path,
+    fmi_version: int = 2,
+    interface: str = "force",
+    source_only: bool = False,
+    progress: Callable[[float], None] | None = None,
+) -> Path:
+    """Write `joint` as an FMU at `path` (atomically); the same joint always gives the same bytes."""
+    path = Path(path)
+    entries = archive_entries(joint, fmi_version, interface, source_only)
+    if progress:
+        progress(0.5)
+    with atomic_path(path) as tmp, zipfile.ZipFile(tmp, "w") as z:
+        for name in sorted(entries):
+            info = zipfile.ZipInfo(name, date_time=_ZIP_DATE)
+            info.compress_type = zipfile.ZIP_DEFLATED
+            info.external_attr = (0o755 if name.startswith("binaries/") else 0o644) << 16
+            info.create_system = 3
+            z.writestr(info, entries[name])
+    if progress:
+        progress(1.0)
+    return path

@@ -1,0 +1,1 @@
+"""The study's rig pipeline: log schema, identification, the virtual rig, and cleaning."""

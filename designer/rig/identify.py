@@ -1,0 +1,195 @@
+"""Identification: per axis, the least-squares fit of F = m r'' + c r' + k r (the study's Eq 5).
+
+Velocity and acceleration come from Savitzky-Golay differentiation of the coordinate; rows in or
+near a dropout segment are left out. A constant sensor offset is fitted alongside and reported.
+At the study's frequencies a gram-scale specimen's inertial force is about a thousandth of its
+spring force, so m is often not identifiable: the result says so and gives the mass computed
+from the specimen's geometry, walls, infill and TPU density instead.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.ndimage import maximum_filter1d
+from scipy.signal import savgol_filter
+
+from .. import units
+from ..errors import DesignerError
+from ..mass import specimen_mass
+from .logs import LOAD, RigLog, read_log
+
+#: longest Savitzky-Golay window, s: short against the fastest period of the study's chirp (0.54 s)
+WINDOW_S = 0.05
+#: the window spans at most this fraction of the shortest period carrying the coordinate's power
+WINDOW_PERIODS = 0.1
+POLYORDER = 3
+#: m counts as identified when its standard error is at most this fraction of it
+M_REL_SE = 0.1
+
+
+@dataclass(frozen=True)
+class AxisFit:
+    """One axis: m, c, k in rig units (m in kg or kg.m^2) with standard errors and fit quality."""
+
+    axis: str
+    m: float
+    c: float
+    k: float
+    m_se: float
+    c_se: float
+    k_se: float
+    offset: float
+    r2: float
+    #: RMS residual over the range of the load
+    nrmse: float
+    samples: int
+    m_identified: bool
+    #: mass from geometry (kg, translational axes with known factors) when m is not identified
+    m_geometric: float | None
+    #: inertial force against spring force at this excitation (RMS m r'' over RMS k r)
+    inertia_ratio: float
+
+    def mass(self) -> float | None:
+        """The mass to use: the identified one, else the geometric one (None if neither)."""
+        return self.m if self.m_identified else self.m_geometric
+
+    def statement(self) -> str:
+        """One sentence on the mass, for people."""
+        unit = units.rig_unit("m", self.axis)
+        fit = f"m = {self.m:.4g} +/- {self.m_se:.2g} {unit}"
+        if self.m_identified:
+            return f"{fit} (identified)"
+        why = (
+            f"m is not identifiable from this excitation ({fit}; inertial force about "
+            f"{100 * self.inertia_ratio:.2g} % of the spring force)"
+        )
+        if self.m_geometric is not None:
+            return (
+                f"{why}; use the mass from geometry, walls, infill and TPU density: "
+                f"{1e3 * self.m_geometric:.3g} g"
+            )
+        if units.is_rotational(self.axis):
+            return f"{why}; take the inertia from CAD"
+        return f"{why}; give the specimen's factors in the log's sidecar to get the mass from geometry"
+
+
+@dataclass(frozen=True)
+class Identification:
+    """The fits of one log, keyed by axis, with where the log came from and its factors."""
+
+    path: Path | None
+    factors: dict[str, float] | None
+    rate: float
+    axes: dict[str, AxisFit]
+
+    def to_dict(self) -> dict:
+        return {
+            "path": None if self.path is None else str(self.path),
+            "factors": self.factors,
+            "rate_hz": self.rate,
+            "axes": {a: asdict(f) | {"statement": f.statement()} for a, f in self.axes.items()},
+        }
+
+
+def _top_frequency(r: np.ndarray, rate: float) -> float:
+    """Frequency below which 99 % of the coordinate's power lies, Hz."""
+    power = np.abs(np.fft.rfft(r - r.mean())) ** 2
+    cumulative = np.cumsum(power)
+    if cumulative[-1] == 0:
+        return rate / 2
+    return float(np.searchsorted(cumulative, 0.99 * cumulative[-1]) * rate / r.size)
+
+
+def _window(r: np.ndarray, rate: float, window_s: float | None, polyorder: int) -> int:
+    """Odd Savitzky-Golay window length in samples; by default from the excitation's top frequency."""
+    if window_s is None:
+        window_s = min(WINDOW_S, WINDOW_PERIODS / max(_top_frequency(r, rate), 1e-9))
+    return max(int(round(window_s * rate)) | 1, (polyorder + 2) | 1)
+
+
+def fit_axis(log: RigLog, axis: str, window_s: float | None = None, polyorder: int = POLYORDER) -> AxisFit:
+    """Least-squares m, c, k (and offset) of one axis of a validated log."""
+    if axis not in log.axes:
+        raise DesignerError(f"axis {axis} is not in the log", f"the log has {', '.join(log.axes)}")
+    r_filled = np.where(log.dropouts[axis], 0.0, log.data[axis].to_numpy())
+    win = _window(r_filled, log.rate, window_s, polyorder)
+    if win > len(log.data):
+        raise DesignerError(
+            f"the log has {len(log.data)} rows, fewer than the {win}-sample derivative window",
+            "record a longer run",
+        )
+    dt = 1.0 / log.rate
+    force = log.data[LOAD[axis]].to_numpy()
+    bad = maximum_filter1d(log.dropouts[axis].astype(np.uint8), size=2 * win + 1).astype(bool)
+    bad[: win // 2] = bad[-(win // 2) :] = True
+    keep = ~bad
+    if keep.sum() < 10 * win:
+        raise DesignerError(
+            f"axis {axis}: only {int(keep.sum())} samples outside dropouts",
+            "the log has too little valid data to identify; record again",
+        )
+    cols = [savgol_filter(r_filled, win, polyorder, deriv=d, delta=dt)[keep] for d in (2, 1, 0)]
+    y = force[keep]
+    x = np.column_stack(cols + [np.ones_like(y)])
+    scale = np.sqrt(np.mean(x**2, axis=0))
+    scale[scale == 0] = 1.0
+    beta_s, *_ = np.linalg.lstsq(x / scale, y, rcond=None)
+    beta = beta_s / scale
+    resid = y - x @ beta
+    dof = max(len(y) - x.shape[1], 1)
+    sigma2 = float(resid @ resid) / dof
+    xs = x / scale
+    cov = sigma2 * np.linalg.pinv(xs.T @ xs) / np.outer(scale, scale)
+    se = np.sqrt(np.diag(cov))
+    ss_tot = float(np.sum((y - y.mean()) ** 2))
+    r2 = 1.0 - float(resid @ resid) / ss_tot if ss_tot > 0 else float("nan")
+    span = float(y.max() - y.min())
+    nrmse = float(np.sqrt(np.mean(resid**2)) / span) if span > 0 else float("nan")
+    m_log, c, k, offset = (float(v) for v in beta)
+    m = units.to_si("m_log", axis, m_log)
+    m_se = units.to_si("m_log", axis, float(se[0]))
+    identified = m > 0 and m_se <= M_REL_SE * m
+    geometric = (
+        specimen_mass(log.factors) if log.factors is not None and not units.is_rotational(axis) else None
+    )
+    spring = abs(k) * float(np.sqrt(np.mean(cols[2] ** 2)))
+    inertia_ratio = (
+        abs(m_log) * float(np.sqrt(np.mean(cols[0] ** 2))) / spring if spring > 0 else float("inf")
+    )
+    return AxisFit(
+        axis=axis,
+        m=m,
+        c=c,
+        k=k,
+        m_se=m_se,
+        c_se=float(se[1]),
+        k_se=float(se[2]),
+        offset=offset,
+        r2=r2,
+        nrmse=nrmse,
+        samples=int(len(y)),
+        m_identified=bool(identified),
+        m_geometric=None if identified else geometric,
+        inertia_ratio=inertia_ratio,
+    )
+
+
+def identify(
+    log_or_path: RigLog | str | Path,
+    axes: list[str] | None = None,
+    window_s: float | None = None,
+    progress: Callable[[float], None] | None = None,
+) -> Identification:
+    """Identify every axis of a log (or the listed ones): m, c, k with standard errors, R2, NRMSE."""
+    log = log_or_path if isinstance(log_or_path, RigLog) else read_log(log_or_path)
+    chosen = log.axes if axes is None else axes
+    fits = {}
+    for i, axis in enumerate(chosen):
+        fits[axis] = fit_axis(log, axis, window_s)
+        if progress is not None:
+            progress((i + 1) / len(chosen))
+    return Identification(path=log.path, factors=log.factors, rate=log.rate, axes=fits)

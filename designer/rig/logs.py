@@ -1,0 +1,287 @@
+"""Rig logs: the schema, a validating reader and an atomic writer (CSV or Parquet).
+
+A log has a time column `t` [s], per axis its coordinate (`x y z` [mm], `theta phi psi` [rad]) and
+its load (`Fx Fy Fz` [N], `Ttheta Tphi Tpsi` [N.mm]), any subset of axes, and optionally the hub
+angle `hub` [rad]. A column may carry its unit as `x [mm]` or `x_mm`; another unit is rejected.
+The specimen's six factors live in a JSON sidecar beside the log: `run7.csv` -> `run7.json`
+holding `{"factors": {"density": 60, "length": 24, ...}}`.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .. import space, units
+from ..errors import DesignerError
+from ..files import atomic_path, atomic_write
+
+#: the load column of each axis
+LOAD: dict[str, str] = {
+    "x": "Fx",
+    "y": "Fy",
+    "z": "Fz",
+    "theta": "Ttheta",
+    "phi": "Tphi",
+    "psi": "Tpsi",
+}
+#: the unit of every column the schema knows
+UNITS: dict[str, str] = {
+    "t": "s",
+    "hub": "rad",
+    **{a: units.rig_unit("r", a) for a in units.AXES},
+    **{LOAD[a]: units.rig_unit("F", a) for a in units.AXES},
+}
+#: spellings of each unit accepted in a column suffix
+_UNIT_SPELLINGS: dict[str, tuple[str, ...]] = {
+    "s": ("s",),
+    "rad": ("rad",),
+    "mm": ("mm",),
+    "N": ("N",),
+    "N.mm": ("N.mm", "Nmm", "N*mm", "N_mm"),
+}
+#: a sensor reading exactly zero for at least this many samples is taken as stuck
+STUCK_SAMPLES = 5
+#: sampling intervals longer than this multiple of the median mark a gap
+GAP_FACTOR = 1.5
+#: the largest relative spread of sampling intervals (outside gaps) a log may have
+JITTER_LIMIT = 0.05
+_PARQUET = (".parquet", ".pq")
+_SUFFIX_RE = re.compile(r"^(?P<name>[A-Za-z]+)(?:\s*\[(?P<b>[^\]]+)\]|_(?P<u>.+))?$")
+
+
+@dataclass
+class RigLog:
+    """A validated log: canonical columns, sampling rate, factors and flagged dropout rows per axis."""
+
+    data: pd.DataFrame
+    path: Path | None
+    factors: dict[str, float] | None
+    rate: float
+    axes: list[str]
+    #: per axis, True where the coordinate or the load is NaN, stuck at zero, or beside a time gap
+    dropouts: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @property
+    def duration(self) -> float:
+        t = self.data["t"].to_numpy()
+        return float(t[-1] - t[0])
+
+    def dropout_segments(self, axis: str) -> list[tuple[int, int]]:
+        """Flagged (first row, last row) spans of `axis`, 1-based data rows as in the file."""
+        mask = self.dropouts[axis].astype(np.int8)
+        edges = np.flatnonzero(np.diff(np.concatenate(([0], mask, [0]))))
+        return [(int(a) + 1, int(b)) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+
+    def summary(self) -> dict:
+        """Plain-data description for printing and JSON."""
+        return {
+            "path": None if self.path is None else str(self.path),
+            "rows": len(self.data),
+            "rate_hz": self.rate,
+            "duration_s": self.duration,
+            "axes": self.axes,
+            "factors": self.factors,
+            "dropout_fraction": {a: float(self.dropouts[a].mean()) for a in self.axes},
+            "dropout_segments": {a: len(self.dropout_segments(a)) for a in self.axes},
+        }
+
+
+def sidecar_path(path: str | Path) -> Path:
+    """The JSON sidecar holding a log's factors: the log's path with the suffix `.json`."""
+    return Path(path).with_suffix(".json")
+
+
+def _canonical(col: str, source: str) -> str | None:
+    """Canonical name of a log column, checking any unit suffix; None for columns not in the schema."""
+    m = _SUFFIX_RE.match(str(col).strip())
+    if not m or m["name"] not in UNITS:
+        return None
+    name, unit = m["name"], m["b"] or m["u"]
+    if unit is not None and unit.strip() not in _UNIT_SPELLINGS[UNITS[name]]:
+        raise DesignerError(
+            f"{source}: column '{col}' is in unknown or wrong units '{unit}'",
+            f"the rig log gives {name} in {UNITS[name]}: convert it and name the column '{name}'",
+        )
+    return name
+
+
+def _first_bad_row(bad: np.ndarray) -> int:
+    return int(np.flatnonzero(bad)[0]) + 1
+
+
+def _runs(mask: np.ndarray, min_len: int) -> np.ndarray:
+    """Rows inside runs of True at least `min_len` long."""
+    m = mask.astype(np.int8)
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], m, [0]))))
+    starts, ends = edges[::2], edges[1::2]
+    out = np.zeros(mask.shape, dtype=bool)
+    for a, b in zip(starts, ends, strict=True):
+        if b - a >= min_len:
+            out[a:b] = True
+    return out
+
+
+def _check_factors(factors: dict | None, source: str) -> dict[str, float] | None:
+    if factors is None:
+        return None
+    try:
+        return space.validate(factors, allow_extrapolation=True)
+    except DesignerError as exc:
+        raise DesignerError(f"{source}: {exc.problem}", exc.fix) from None
+
+
+def _read_sidecar(path: Path) -> dict[str, float] | None:
+    side = sidecar_path(path)
+    if not side.exists():
+        return None
+    try:
+        doc = json.loads(side.read_text())
+    except (OSError, ValueError) as exc:
+        raise DesignerError(f"cannot read {side}: {exc}", 'write it as {"factors": {...}}') from None
+    if not isinstance(doc, dict) or not isinstance(doc.get("factors"), dict):
+        raise DesignerError(f"{side}: no 'factors' object", 'write it as {"factors": {"density": 60, ...}}')
+    return _check_factors(doc["factors"], side.name)
+
+
+def validate_frame(
+    raw: pd.DataFrame, source: str = "log", factors: dict | None = None, path: Path | None = None
+) -> RigLog:
+    """Check a log's columns, time and units, flag dropouts; raise DesignerError naming column and row."""
+    mapping: dict[str, str] = {}
+    for col in raw.columns:
+        name = _canonical(col, source)
+        if name is None:
+            continue
+        if name in mapping.values():
+            raise DesignerError(f"{source}: two columns give '{name}'", "keep one of them")
+        mapping[col] = name
+    df = raw[list(mapping)].rename(columns=mapping)
+    if "t" not in df.columns:
+        raise DesignerError(f"{source}: missing column 't'", "a rig log needs the time t in s")
+    axes = []
+    for a in units.AXES:
+        have_r, have_f = a in df.columns, LOAD[a] in df.columns
+        if have_r != have_f:
+            missing = LOAD[a] if have_r else a
+            raise DesignerError(
+                f"{source}: missing column '{missing}' ({UNITS[missing]}) for axis {a}",
+                f"give both {a} and {LOAD[a]}, or neither",
+            )
+        if have_r:
+            axes.append(a)
+    if not axes:
+        raise DesignerError(
+            f"{source}: no axis columns",
+            "give at least one coordinate and its load: x/Fx, y/Fy, z/Fz, theta/Ttheta, phi/Tphi, psi/Tpsi",
+        )
+    if len(df) < 3:
+        raise DesignerError(f"{source}: only {len(df)} rows", "a rig log needs a time series")
+    cols = {}
+    for col in df.columns:
+        values = df[col]
+        if values.dtype.kind not in "fiu":
+            numeric = pd.to_numeric(values, errors="coerce")
+            bad = numeric.isna().to_numpy() & values.notna().to_numpy()
+            if bad.any():
+                row = _first_bad_row(bad)
+                raise DesignerError(
+                    f"{source}: column '{col}' row {row} is '{values.iloc[row - 1]}', not a number",
+                    "fix that row or leave it empty (an empty value counts as a dropout)",
+                )
+            values = numeric
+        cols[col] = values.to_numpy(dtype=np.float64)
+    t = cols["t"]
+    if not np.isfinite(t).all():
+        raise DesignerError(
+            f"{source}: column 't' row {_first_bad_row(~np.isfinite(t))} is empty or not finite",
+            "every row needs its time",
+        )
+    dt = np.diff(t)
+    if (dt <= 0).any():
+        row = int(np.flatnonzero(dt <= 0)[0]) + 2
+        raise DesignerError(
+            f"{source}: time not increasing at row {row} (t = {t[row - 1]:g} s after {t[row - 2]:g} s)",
+            "sort the log by t and remove repeated rows",
+        )
+    step = float(np.median(dt))
+    gaps = dt > GAP_FACTOR * step
+    regular = dt[~gaps]
+    jitter = float(np.max(np.abs(regular - step)) / step) if regular.size else 0.0
+    if jitter > JITTER_LIMIT:
+        row = int(np.flatnonzero(~gaps & (np.abs(dt - step) > JITTER_LIMIT * step))[0]) + 2
+        raise DesignerError(
+            f"{source}: irregular sampling in column 't' at row {row} "
+            f"(interval {dt[row - 2]:g} s against {step:g} s)",
+            "resample the log to a constant rate",
+        )
+    gap_rows = np.zeros(len(t), dtype=bool)
+    gap_rows[1:] |= gaps
+    gap_rows[:-1] |= gaps
+    dropouts = {}
+    for a in axes:
+        flagged = gap_rows.copy()
+        for col in (a, LOAD[a]):
+            v = cols[col]
+            nan = ~np.isfinite(v)
+            if nan.all():
+                raise DesignerError(
+                    f"{source}: column '{col}' is all NaN", f"drop axis {a} or fix the sensor"
+                )
+            flagged |= nan | _runs(v == 0.0, STUCK_SAMPLES)
+        if flagged.all():
+            raise DesignerError(
+                f"{source}: axis {a} ('{a}', '{LOAD[a]}') has no valid samples (all NaN or stuck at zero)",
+                f"drop axis {a} or fix the sensor",
+            )
+        dropouts[a] = flagged
+    data = pd.DataFrame(cols)
+    order = ["t"] + [c for a in axes for c in (a, LOAD[a])] + (["hub"] if "hub" in data else [])
+    return RigLog(
+        data=data[order],
+        path=path,
+        factors=_check_factors(factors, source),
+        rate=1.0 / step,
+        axes=axes,
+        dropouts=dropouts,
+    )
+
+
+def read_log(path: str | Path) -> RigLog:
+    """Read and validate a rig log (CSV, or Parquet by suffix) and its factor sidecar."""
+    p = Path(path)
+    if not p.exists():
+        raise DesignerError(f"no such log: {p}", "give the path of a CSV or Parquet rig log")
+    try:
+        if p.suffix.lower() in _PARQUET:
+            raw = pd.read_parquet(p)
+        else:
+            raw = pd.read_csv(p, engine="pyarrow")
+    except (ValueError, OSError, pd.errors.ParserError, UnicodeDecodeError) as exc:
+        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise DesignerError(f"cannot read {p}: {first}", "give a CSV or Parquet rig log") from None
+    return validate_frame(raw, source=p.name, factors=_read_sidecar(p), path=p)
+
+
+def write_log(df: pd.DataFrame, path: str | Path, factors: dict | None = None) -> Path:
+    """Validate and write a log atomically (Parquet for .parquet/.pq, else CSV) and its factor sidecar."""
+    p = Path(path)
+    log = validate_frame(df, source=p.name, factors=factors)
+    if p.suffix.lower() in _PARQUET:
+        with atomic_path(p) as tmp:
+            log.data.to_parquet(tmp, index=False)
+    else:
+        import pyarrow as pa
+        import pyarrow.csv as pacsv
+
+        with atomic_path(p) as tmp:
+            pacsv.write_csv(pa.Table.from_pandas(log.data, preserve_index=False), tmp)
+    if log.factors is not None:
+        with atomic_write(sidecar_path(p)) as fh:
+            json.dump({"factors": log.factors}, fh, indent=2)
+    return p

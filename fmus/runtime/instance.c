@@ -1,0 +1,309 @@
+/* Generic instance handling shared by the FMI 2 and FMI 3 layers. */
+#include "instance.h"
+
+#include <ctype.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "model.h"
+
+#define START_FILE "start_values.txt"
+#define MAX_MESSAGE 1024
+#define MAX_LINE 512
+
+static char *copyString(const char *s) {
+    size_t n = strlen(s) + 1;
+    char *c = malloc(n);
+    if (c) memcpy(c, s, n);
+    return c;
+}
+
+static void vlog(ModelInstance *inst, Status status, const char *category, const char *fmt, va_list args) {
+    char message[MAX_MESSAGE];
+    if (!inst || !inst->log) return;
+    vsnprintf(message, sizeof(message), fmt, args);
+    inst->log(inst, status, category, message);
+}
+
+void logEvent(ModelInstance *inst, const char *fmt, ...) {
+    va_list args;
+    if (!inst || !inst->logEvents) return;
+    va_start(args, fmt);
+    vlog(inst, OK, "logEvents", fmt, args);
+    va_end(args);
+}
+
+void logError(ModelInstance *inst, const char *fmt, ...) {
+    va_list args;
+    if (!inst || !inst->logErrors) return;
+    va_start(args, fmt);
+    vlog(inst, Error, "logStatusError", fmt, args);
+    va_end(args);
+}
+
+static int hexValue(char c) {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+}
+
+/* a file path from an FMI 2 resource URI (file:///a%20b/) or an FMI 3 resource path (/a b/) */
+static char *pathFromLocation(const char *location) {
+    const char *p = location;
+    char *path, *out;
+    bool uri = strncmp(p, "file:", 5) == 0;
+    if (strncmp(p, "file://", 7) == 0) {
+        p += 7;
+        if (strncmp(p, "localhost/", 10) == 0) p += 9;
+    } else if (uri) {
+        p += 5;
+    }
+    path = malloc(strlen(p) + 1);
+    if (!path) return NULL;
+    for (out = path; *p; p++) {
+        if (uri && *p == '%' && hexValue(p[1]) >= 0 && hexValue(p[2]) >= 0) {
+            *out++ = (char)(hexValue(p[1]) * 16 + hexValue(p[2]));
+            p += 2;
+        } else {
+            *out++ = *p;
+        }
+    }
+    *out = '\0';
+    return path;
+}
+
+static char *startFilePath(const char *resourceDir) {
+    char *dir = pathFromLocation(resourceDir);
+    char *file;
+    size_t n;
+    if (!dir) return NULL;
+    n = strlen(dir);
+    file = malloc(n + sizeof(START_FILE) + 1);
+    if (file) {
+        memcpy(file, dir, n);
+        if (n == 0 || dir[n - 1] != '/') file[n++] = '/';
+        memcpy(file + n, START_FILE, sizeof(START_FILE));
+    }
+    free(dir);
+    return file;
+}
+
+static char *trim(char *s) {
+    char *end;
+    while (isspace((unsigned char)*s)) s++;
+    end = s + strlen(s);
+    while (end > s && isspace((unsigned char)end[-1])) *--end = '\0';
+    return s;
+}
+
+/* zero the model data and apply the start-value file from the FMU's resources */
+static Status loadStartValues(ModelInstance *inst) {
+    char line[MAX_LINE];
+    FILE *file = fopen(inst->startFile, "r");
+    bool tokenSeen = false;
+    Status status = OK;
+    int number = 0;
+    if (!file) {
+        logError(inst, "cannot open %s: the FMU's resources folder is missing its start values", inst->startFile);
+        return Error;
+    }
+    memset(&inst->data, 0, sizeof(inst->data));
+    inst->state = StartAndEnd; /* start values go in unchecked, checkModel sees them all at the end */
+    while (status <= Warning && fgets(line, sizeof(line), file)) {
+        char *name = trim(line), *value;
+        number++;
+        if (*name == '\0' || *name == '#') continue;
+        value = name;
+        while (*value && !isspace((unsigned char)*value)) value++;
+        if (*value) *value++ = '\0';
+        value = trim(value);
+        if (strcmp(name, "token") == 0) {
+            tokenSeen = true;
+            if (strcmp(value, inst->token) != 0) {
+                logError(inst, "instantiation token %s does not match %s in the resources", inst->token, value);
+                status = Error;
+            }
+        } else {
+            status = applyStart(inst, name, value);
+            if (status > Warning) logError(inst, "%s line %d: cannot apply '%s %s'", START_FILE, number, name, value);
+        }
+    }
+    fclose(file);
+    inst->state = Instantiated;
+    if (status <= Warning && !tokenSeen) {
+        logError(inst, "%s has no token line", inst->startFile);
+        status = Error;
+    }
+    return status <= Warning ? checkModel(inst) : status;
+}
+
+ModelInstance *createInstance(const char *name, const char *token, const char *resourceDir, InterfaceType type,
+                              bool loggingOn, LogFunction log, void *logger, void *environment) {
+    ModelInstance *inst;
+    if (!name || !token || !resourceDir) return NULL;
+    inst = calloc(1, sizeof(ModelInstance));
+    if (!inst) return NULL;
+    inst->type = type;
+    inst->state = Instantiated;
+    inst->logEvents = loggingOn;
+    inst->logErrors = true;
+    inst->log = log;
+    inst->logger = logger;
+    inst->environment = environment;
+    inst->name = copyString(name);
+    inst->token = copyString(token);
+    inst->startFile = startFilePath(resourceDir);
+    if (!inst->name || !inst->token || !inst->startFile || loadStartValues(inst) > Warning) {
+        freeInstance(inst);
+        return NULL;
+    }
+    logEvent(inst, "instantiated %s from %s", name, inst->startFile);
+    return inst;
+}
+
+void freeInstance(ModelInstance *inst) {
+    if (!inst) return;
+    free(inst->name);
+    free(inst->token);
+    free(inst->startFile);
+    free(inst);
+}
+
+Status resetInstance(ModelInstance *inst) {
+    Status status = loadStartValues(inst);
+    inst->time = 0;
+    inst->state = status <= Warning ? Instantiated : ErrorState;
+    return status;
+}
+
+void saveState(ModelInstance *inst, SavedState *saved) {
+    memset(saved, 0, sizeof(*saved));
+    saved->size = sizeof(*saved);
+    saved->state = inst->state;
+    saved->time = inst->time;
+    saved->data = inst->data;
+}
+
+void restoreState(ModelInstance *inst, const SavedState *saved) {
+    inst->state = saved->state;
+    inst->time = saved->time;
+    inst->data = saved->data;
+}
+
+bool allowedIn(ModelInstance *inst, const char *function, int mask) {
+    if (inst->state & mask) return true;
+    logError(inst, "%s must not be called in the current state (%d)", function, (int)inst->state);
+    inst->state = ErrorState;
+    return false;
+}
+
+Status escalate(ModelInstance *inst, Status status) {
+    if (status == Error) inst->state = ErrorState;
+    if (status == Fatal) inst->state = FatalState;
+    return status;
+}
+
+Status getFloat64s(ModelInstance *inst, const unsigned vr[], size_t n, double value[]) {
+    size_t i;
+    if (n > 0 && (!vr || !value)) {
+        logError(inst, "get: NULL value reference or value array");
+        return Error;
+    }
+    for (i = 0; i < n; i++)
+        if (getFloat64(inst, vr[i], &value[i]) > Warning) return Error;
+    return OK;
+}
+
+Status setFloat64s(ModelInstance *inst, const unsigned vr[], size_t n, const double value[]) {
+    size_t i;
+    if (n > 0 && (!vr || !value)) {
+        logError(inst, "set: NULL value reference or value array");
+        return Error;
+    }
+    for (i = 0; i < n; i++)
+        if (setFloat64(inst, vr[i], value[i]) > Warning) return Error;
+    return OK;
+}
+
+Status noVariables(ModelInstance *inst, const char *type, size_t n) {
+    if (n == 0) return OK;
+    logError(inst, "the model has no %s variables", type);
+    return Error;
+}
+
+Status partialDerivatives(ModelInstance *inst, bool adjoint, const unsigned unknown[], size_t nUnknown,
+                          const unsigned known[], size_t nKnown, const double seed[], double sensitivity[]) {
+    size_t i, j;
+    double d;
+    size_t nSeed = adjoint ? nUnknown : nKnown, nSensitivity = adjoint ? nKnown : nUnknown;
+    if ((nUnknown > 0 && !unknown) || (nKnown > 0 && !known) || (nSeed > 0 && !seed) ||
+        (nSensitivity > 0 && !sensitivity)) {
+        logError(inst, "partial derivatives: NULL array");
+        return Error;
+    }
+    for (i = 0; i < nSensitivity; i++) sensitivity[i] = 0;
+    for (i = 0; i < nUnknown; i++) {
+        for (j = 0; j < nKnown; j++) {
+            if (getPartial(inst, unknown[i], known[j], &d) > Warning) return Error;
+            if (adjoint) sensitivity[j] += d * seed[i];
+            else sensitivity[i] += d * seed[j];
+        }
+    }
+    return OK;
+}
+
+Status checkStateCount(ModelInstance *inst, const char *function, size_t nx) {
+    if (nx == numberOfStates(inst)) return OK;
+    logError(inst, "%s: %zu states passed but the model has %zu", function, nx, numberOfStates(inst));
+    return Error;
+}
+
+Status setContinuousStates(ModelInstance *inst, const double x[], size_t nx) {
+    size_t i;
+    if (checkStateCount(inst, "set continuous states", nx) > Warning || (nx > 0 && !x)) return Error;
+    for (i = 0; i < nx; i++) {
+        if (!isfinite(x[i])) {
+            logError(inst, "set continuous states: x[%zu] = %g is not a finite number", i, x[i]);
+            return Error;
+        }
+    }
+    setStates(inst, x);
+    return OK;
+}
+
+Status stepInstance(ModelInstance *inst, double currentTime, double h) {
+    if (!(h > 0) || !isfinite(h) || !isfinite(currentTime)) {
+        logError(inst, "do step: the step size must be positive and finite (got %g at t = %g)", h, currentTime);
+        return Error;
+    }
+    if (doStep(inst, h) > Warning) return Error;
+    inst->time = currentTime + h;
+    return OK;
+}
+
+Status newSavedState(ModelInstance *inst, void **saved) {
+    if (!saved) {
+        logError(inst, "FMU state: NULL pointer");
+        return Error;
+    }
+    if (!*saved && !(*saved = malloc(sizeof(SavedState)))) {
+        logError(inst, "FMU state: out of memory");
+        return Error;
+    }
+    return OK;
+}
+
+Status deserializeState(ModelInstance *inst, const unsigned char bytes[], size_t size, void **saved) {
+    SavedState s;
+    if (!bytes || size != sizeof(SavedState) || (memcpy(&s, bytes, size), s.size != size)) {
+        logError(inst, "deserialize FMU state: the bytes are not a state of this FMU");
+        return Error;
+    }
+    if (newSavedState(inst, saved) > Warning) return Error;
+    memcpy(*saved, &s, sizeof(s));
+    return OK;
+}

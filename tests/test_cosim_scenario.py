@@ -1,0 +1,148 @@
+"""Scenarios end to end through exported joint FMUs: robot, virtual rig, checks, outputs, CLI."""
+
+import json
+import textwrap
+
+import numpy as np
+import pytest
+import typer
+from typer.testing import CliRunner
+
+from designer.cosim import load, simulate
+from designer.cosim import run as cosim_run
+from designer.errors import DesignerError
+
+ARM = """
+[simulation]
+duration = {duration}
+step = {step}
+[robot]
+model = "arm"
+[joints.j1]
+coefficients = {{ k = 330, c = 0.83 }}
+reference = {{ type = "sine", amplitude = 0.5, frequency = 0.5 }}
+[joints.j2]
+{joint2}
+reference = {{ type = "step", amplitude = 0.3, at = 0.2 }}
+[validation]
+duration = 0.5
+steps = [2e-3, 1e-3, 5e-4, 2.5e-4]
+"""
+J2 = "coefficients = { k = 330, c = 0.83 }\nfmi_version = 3"
+RIG = """
+[simulation]
+duration = 20.0
+step = 1e-3
+[rig]
+sweep = 20.0
+joint = { axis = "theta", coefficients = { k = 330, c = 0.83, m = 2e-6 } }
+factors = { density = 60, length = 24, width = 4.5, height = 9, layer = 0.16, raster = 45 }
+[validation]
+duration = 0.5
+steps = [1e-3, 5e-4, 2.5e-4, 1.25e-4]
+"""
+
+
+def write(tmp_path, text, name="s.toml"):
+    path = tmp_path / name
+    path.write_text(textwrap.dedent(text))
+    return path
+
+
+def arm(tmp_path, duration=10.0, step=1e-3, joint2=J2):
+    return write(tmp_path, ARM.format(duration=duration, step=step, joint2=joint2))
+
+
+def test_two_link_arm_through_fmus_matches_in_engine_reference(tmp_path):
+    sc = load(arm(tmp_path))
+    with cosim_run.joint_fmus(sc) as fmus:
+        laws = {j: cosim_run.law(src, fmus[j]) for j, src in sc.joints.items()}
+        res = cosim_run.robot_run(sc, fmus, sc.step, sc.duration, "gauss-seidel")
+        ref = cosim_run.robot_reference(sc, laws, sc.step, sc.duration, "euler")
+    assert laws["j1"]["k"] == pytest.approx(0.33) and laws["j1"]["c"] == pytest.approx(8.3e-4)
+    for j in sc.joints:
+        assert np.abs(res.column(f"robot.{j}.q") - ref.column(f"robot.{j}.q")).max() <= 1e-6
+    assert np.abs(res.column("robot.j2.s")).max() > 0.05
+
+
+def test_validation_error_falls_with_step_and_outputs(tmp_path):
+    out = tmp_path / "out"
+    summary = simulate(load(arm(tmp_path, duration=1.0)), out, with_validation=True)
+    val = summary["validation"]
+    assert val["max_error"] <= 1e-9
+    rows = val["steps"]
+    for big, small in zip(rows, rows[1:], strict=False):
+        assert small["max_error"] <= big["max_error"] * small["step"] / big["step"] * 1.05
+    assert {p.name for p in out.iterdir()} == {
+        "timeseries.csv",
+        "timeseries.parquet",
+        "metrics.json",
+        "plot.png",
+    }
+    assert json.loads((out / "metrics.json").read_text())["metrics"]["j2"]["overshoot_pct"] >= 0
+
+
+def test_rig_log_identifies_the_fmus_coefficients(tmp_path):
+    from designer.rig.identify import identify
+
+    out = tmp_path / "rig"
+    summary = simulate(load(write(tmp_path, RIG)), out, with_validation=True)
+    fit = identify(out / "rig_log.csv").axes["theta"]
+    assert fit.k == pytest.approx(330, rel=5e-3)
+    assert fit.c == pytest.approx(0.83, rel=5e-3)
+    rows = summary["validation"]["steps"]
+    for big, small in zip(rows, rows[1:], strict=False):
+        assert small["max_error"] <= big["max_error"] * small["step"] / big["step"] * 1.05
+
+
+@pytest.mark.parametrize(
+    "joint2, step, message",
+    [
+        ('fmu = "missing.fmu"', 1e-3, "missing.fmu does not exist"),
+        (J2, -1e-3, "step = -0.001 must be positive"),
+    ],
+)
+def test_bad_scenarios_fail_before_running(tmp_path, joint2, step, message):
+    with pytest.raises(DesignerError, match=message):
+        load(arm(tmp_path, step=step, joint2=joint2))
+
+
+def test_unknown_robot_joint_fails_before_running(tmp_path):
+    path = write(
+        tmp_path, ARM.format(duration=1, step=1e-3, joint2=J2).replace("[joints.j2]", "[joints.elbow]")
+    )
+    with pytest.raises(DesignerError, match="no joint 'elbow'"):
+        load(path)
+
+
+def test_interrupted_run_leaves_complete_files_or_none(tmp_path, monkeypatch):
+    sc = load(arm(tmp_path, duration=0.2))
+    out = tmp_path / "out"
+
+    def interrupt(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cosim_run, "plot", interrupt)
+    with pytest.raises(KeyboardInterrupt):
+        simulate(sc, out)
+    names = sorted(p.name for p in out.iterdir())
+    assert names == ["metrics.json", "timeseries.csv", "timeseries.parquet"]
+    assert len(np.loadtxt(out / "timeseries.csv", delimiter=",", skiprows=1)) == 201
+    monkeypatch.setattr(cosim_run.Master, "run", interrupt)
+    with pytest.raises(KeyboardInterrupt):
+        simulate(sc, tmp_path / "none")
+    assert not (tmp_path / "none").exists()
+
+
+def test_cli_json(tmp_path):
+    from designer_cli import cosim
+
+    app = typer.Typer()
+    app.callback()(lambda: None)
+    cosim.register(app)
+    result = CliRunner().invoke(
+        app, ["cosim", str(arm(tmp_path, duration=0.5)), "-o", str(tmp_path / "o"), "--json"]
+    )
+    assert result.exit_code == 0, result.output
+    doc = json.loads(result.stdout)
+    assert set(doc["metrics"]) == {"j1", "j2"} and "validation" not in doc
