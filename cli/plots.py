@@ -87,6 +87,46 @@ def heatmap_cmd(
         _saved(path)
 
 
+def validate_cmd(
+    output: Annotated[
+        Path, typer.Option("-o", "--output", help="folder for report.html, report.md, figures/")
+    ] = Path("report"),
+    table: Table = None,
+    as_json: Json = False,
+) -> None:
+    """Check the tool against the study and itself; write HTML and Markdown reports; exit 1 if a check fails.
+
+    Example: designer validate -o report/
+    """
+    from designer.report import validate
+
+    from .common import progress
+
+    with progress("validating") as bar:
+        results, page, md, seconds = validate(output, table, progress=bar)
+    failed = [r for r in results if not r.passed]
+    if as_json:
+        print_json(
+            {
+                "passed": not failed,
+                "seconds": seconds,
+                "report": str(page),
+                "checks": [r.to_dict() for r in results],
+            }
+        )
+    else:
+        for r in results:
+            mark = "[green]PASS[/green]" if r.passed else "[red]FAIL[/red]"
+            console.print(f"{mark} {r.name} ({r.seconds:.1f} s): {r.summary}")
+        console.print(
+            f"{len(results) - len(failed)} of {len(results)} checks pass in {seconds:.1f} s; "
+            f"wrote {page} and {md}"
+        )
+    if failed:
+        raise typer.Exit(1)
+
+
 def register(app: typer.Typer) -> None:
     """Add `designer plot` to the main app."""
     app.add_typer(plot_app, name="plot")
+    app.command("validate")(validate_cmd)
