@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from .common import console, print_json
+from .common import progress as progress_bar
 
 plot_app = typer.Typer(
     help="Draw the data, the surrogate and the design space (PNG, SVG or PDF; headless).",
@@ -87,6 +88,126 @@ def heatmap_cmd(
         _saved(path)
 
 
+Surrogate = Annotated[
+    Path | None,
+    typer.Option("--surrogate", help="fitted surrogate JSON (designer fit); default: the bundled one"),
+]
+
+
+def _surrogate(path: Path | None):
+    from designer.surrogate import Surrogate as _S
+
+    return _S.load_default() if path is None else _S.load(path)
+
+
+def _fixed(pairs: list[str]) -> dict[str, float]:
+    """['density=60', 'raster=45'] -> {'density': 60.0, 'raster': 45.0}."""
+    from designer.errors import DesignerError
+
+    out = {}
+    for pair in pairs:
+        name, sep, value = pair.partition("=")
+        if not sep:
+            raise DesignerError(f"--fix '{pair}' is not NAME=VALUE", "write it as --fix density=60")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            raise DesignerError(
+                f"--fix {pair}: '{value}' is not a number", "write it as --fix density=60"
+            ) from None
+    return out
+
+
+@plot_app.command("space")
+def space_cmd(
+    x: Annotated[str, typer.Option("--x", help="continuous factor on the first axis")] = "width",
+    y: Annotated[str, typer.Option("--y", help="continuous factor on the second axis")] = "height",
+    z: Annotated[str | None, typer.Option("--z", help="third factor (with --volume)")] = None,
+    response: Annotated[str, typer.Option("--response", help="quantity: k or c")] = "k",
+    axis: Axis = "x",
+    fix: Annotated[
+        list[str] | None,
+        typer.Option("--fix", help="hold a factor, NAME=VALUE (repeat); others at the centre"),
+    ] = None,
+    target: Annotated[
+        float | None, typer.Option("--target", help="target value in rig units (N/mm, N.s/mm)")
+    ] = None,
+    volume: Annotated[bool, typer.Option("--volume", help="isosurfaces over --x, --y, --z")] = False,
+    output: Output = Path("space.png"),
+    html: Annotated[Path | None, typer.Option("--html", help="also write an interactive HTML scene")] = None,
+    surrogate: Surrogate = None,
+    as_json: Json = False,
+) -> None:
+    """The surrogate's response over two factors (others held) with its 95 % PI, the runs and the target.
+
+    Example: designer plot space --x width --y height --response k --target 0.8 -o space.png --html space.html
+    """
+    from designer.errors import DesignerError
+    from designer.plots import common, space
+
+    common.check_image_path(output)
+    sur = _surrogate(surrogate)
+    resp = f"{response}_{axis}"
+    with progress_bar("rendering") as bar:
+        if volume:
+            if z is None:
+                raise DesignerError("--volume needs a third factor", "add --z, e.g. --z density")
+            view = space.plot_volume(sur, resp, [x, y, z], output, _fixed(fix or []), target, html)
+        else:
+            if z is not None:
+                raise DesignerError("--z draws only with --volume", "add --volume or drop --z")
+            view = space.plot_surface(sur, resp, x, y, output, _fixed(fix or []), target, html)
+        bar(1.0)
+    if as_json:
+        print_json(view.to_dict())
+        return
+    held = ", ".join(f"{k} {v:g}" for k, v in view.held.items())
+    console.print(
+        f"{resp} from {view.value_range[0]:.4g} to {view.value_range[1]:.4g} {view.unit} (held: {held})"
+    )
+    if target is not None:
+        console.print(
+            f"target {target:g} {view.unit} lies inside the 95 % PI over {view.target_in_pi:.0%} of the plot"
+        )
+    for f in view.files:
+        _saved(f)
+
+
+@plot_app.command("loo")
+def loo_cmd(
+    output: Output = Path("loo.png"),
+    axis: Annotated[str | None, typer.Option("--axis", help="only this axis (default: all)")] = None,
+    surrogate: Surrogate = None,
+    as_json: Json = False,
+) -> None:
+    """Leave-one-out predictions against the measurements, with 95 % PIs, per response of the surrogate.
+
+    Example: designer plot loo -o loo.png
+    """
+    from designer.errors import DesignerError
+    from designer.plots import common, loo
+
+    common.check_image_path(output)
+    sur = _surrogate(surrogate)
+    responses = [r for r in sur.responses if axis is None or r.split("_", 1)[1] == axis]
+    if not responses:
+        raise DesignerError(
+            f"the surrogate has no response on axis {axis}", f"it has {', '.join(sur.responses)}"
+        )
+    path = loo.plot_loo(sur, responses, output)
+    metrics = {r: dict(sur.model(r).loo, form=sur.model(r).form) for r in responses}
+    if as_json:
+        print_json({"figure": str(path), "loo": metrics})
+        return
+    for r, m in metrics.items():
+        unit = sur.model(r).unit
+        console.print(
+            f"{r}: {m['form']}, Q2 {m['q2']:.2f}, RMSE {m['rmse']:.3g} {unit}, "
+            f"95 % PI coverage {m['coverage95']:.0%}"
+        )
+    _saved(path)
+
+
 def validate_cmd(
     output: Annotated[
         Path, typer.Option("-o", "--output", help="folder for report.html, report.md, figures/")
@@ -100,9 +221,7 @@ def validate_cmd(
     """
     from designer.report import validate
 
-    from .common import progress
-
-    with progress("validating") as bar:
+    with progress_bar("validating") as bar:
         results, page, md, seconds = validate(output, table, progress=bar)
     failed = [r for r in results if not r.passed]
     if as_json:
