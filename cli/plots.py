@@ -208,6 +208,45 @@ def loo_cmd(
     _saved(path)
 
 
+@plot_app.command("timeseries")
+def timeseries_cmd(
+    series: Annotated[
+        Path, typer.Argument(help="time series CSV or Parquet with a 't' column (designer cosim)")
+    ],
+    output: Output = Path("timeseries.png"),
+    columns: Annotated[
+        str | None, typer.Option("--columns", help="signals, comma-separated (default: all)")
+    ] = None,
+    reference: Annotated[Path | None, typer.Option("--reference", help="reference series to overlay")] = None,
+) -> None:
+    """Co-simulation signals against time, one panel each, a reference dashed.
+
+    Example: designer plot timeseries results/timeseries.csv --columns joint.x.s,joint.x.f -o ts.png
+    """
+    from designer.plots import common, timeseries
+
+    common.check_image_path(output)
+    frame = _read_series(series)
+    ref = None if reference is None else _read_series(reference)
+    cols = None if columns is None else [c.strip() for c in columns.split(",") if c.strip()]
+    _saved(timeseries.plot_timeseries(frame, output, cols, reference=ref))
+
+
+def _read_series(path: Path):
+    import pandas as pd
+
+    from designer.errors import DesignerError
+
+    if not path.is_file():
+        raise DesignerError(f"no such file: {path}", "give a CSV or Parquet time series")
+    try:
+        return pd.read_parquet(path) if path.suffix.lower() in (".parquet", ".pq") else pd.read_csv(path)
+    except (ValueError, OSError, pd.errors.ParserError, UnicodeDecodeError) as exc:
+        raise DesignerError(
+            f"cannot read {path}: {str(exc).splitlines()[0]}", "give a CSV or Parquet file"
+        ) from None
+
+
 def validate_cmd(
     output: Annotated[
         Path, typer.Option("-o", "--output", help="folder for report.html, report.md, figures/")

@@ -88,3 +88,19 @@ def test_cli_bad_input_is_one_line(tmp_path):
     assert run.returncode == 2
     assert run.stderr.startswith("error: unknown axis") and "Traceback" not in run.stderr
     assert not (tmp_path / "effects.png").exists()
+
+
+def test_timeseries_png_with_reference(tmp_path):
+    import pandas as pd
+
+    from designer.plots.timeseries import plot_timeseries
+
+    t = np.linspace(0, 2, 400)
+    frame = pd.DataFrame({"t": t, "joint.x.s": np.exp(-t) * np.sin(9 * t), "joint.x.f": np.cos(9 * t)})
+    assert_picture(
+        plot_timeseries(frame, tmp_path / "ts.png", reference=frame.iloc[::4]), min_size=(800, 300)
+    )
+    with pytest.raises(DesignerError, match="no column q"):
+        plot_timeseries(frame, tmp_path / "ts.png", ["q"])
+    with pytest.raises(DesignerError, match="no 'time' column"):
+        plot_timeseries(frame, tmp_path / "ts.png", time="time")
