@@ -8,7 +8,7 @@ import typer
 
 from designer.errors import DesignerError
 
-from . import cosim, design, export
+from . import cosim, design, export, plots
 
 app = typer.Typer(
     help="Design 3D-printed TPU flexible joints: predict and choose stiffness and damping, export FMUs.",
@@ -20,6 +20,7 @@ app = typer.Typer(
 design.register(app)
 export.register(app)
 cosim.register(app)
+plots.register(app)
 
 
 def main() -> None:

@@ -1,0 +1,290 @@
+"""`designer plot ...` and `designer validate`: figures of the data, the surrogate and the design space."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from .common import console, print_json
+from .common import progress as progress_bar
+
+plot_app = typer.Typer(
+    help="Draw the data, the surrogate and the design space (PNG, SVG or PDF; headless).",
+    no_args_is_help=True,
+)
+
+Output = Annotated[Path, typer.Option("-o", "--output", help="image file (.png .svg .pdf)")]
+Table = Annotated[
+    Path | None,
+    typer.Option("--table", help="coefficient table (CSV/Parquet); default: the bundled 44 runs"),
+]
+Axis = Annotated[str, typer.Option("--axis", help="axis: x y z theta phi psi")]
+Json = Annotated[bool, typer.Option("--json", help="print the plotted numbers as JSON")]
+
+
+def _quantities(response: str | None) -> list[str] | None:
+    """'c,k' -> ['c', 'k']; None -> every quantity the table has."""
+    return None if response is None else [q.strip() for q in response.split(",") if q.strip()]
+
+
+def _saved(path: Path) -> None:
+    console.print(f"wrote {path} ({path.stat().st_size / 1024:.0f} KiB)")
+
+
+@plot_app.command("effects")
+def effects_cmd(
+    output: Output = Path("effects.png"),
+    response: Annotated[
+        str | None,
+        typer.Option("--response", help="quantities, comma-separated: c,k (default: all)"),
+    ] = None,
+    axis: Axis = "x",
+    table: Table = None,
+    as_json: Json = False,
+) -> None:
+    """Main-effect boxplots of each response against each factor's levels, medians in red.
+
+    Example: designer plot effects --response k --axis x -o effects.png
+    """
+    from designer.data import load_table
+    from designer.plots import common, effects
+
+    common.check_image_path(output)
+    t = load_table(table)
+    responses = common.responses_for(t, _quantities(response), axis)
+    path = effects.plot_effects(t, responses, output)
+    if as_json:
+        print_json({"figure": str(path), "medians": effects.main_effects(t, responses).to_dict("records")})
+    else:
+        _saved(path)
+
+
+@plot_app.command("heatmap")
+def heatmap_cmd(
+    output: Output = Path("heatmap.png"),
+    axis: Annotated[
+        str | None,
+        typer.Option("--axis", help="only this axis' responses (default: all in the table)"),
+    ] = None,
+    table: Table = None,
+    as_json: Json = False,
+) -> None:
+    """Heat map of the Pearson correlations between the six factors and the responses.
+
+    Example: designer plot heatmap -o heatmap.png
+    """
+    from designer.data import load_table
+    from designer.plots import common, heatmap
+
+    common.check_image_path(output)
+    t = load_table(table)
+    responses = common.responses_for(t, None, axis)
+    path = heatmap.plot_heatmap(t, responses, output)
+    if as_json:
+        print_json({"figure": str(path), "correlations": heatmap.correlations(t, responses).to_dict()})
+    else:
+        _saved(path)
+
+
+Surrogate = Annotated[
+    Path | None,
+    typer.Option("--surrogate", help="fitted surrogate JSON (designer fit); default: the bundled one"),
+]
+
+
+def _surrogate(path: Path | None):
+    from designer.surrogate import Surrogate as _S
+
+    return _S.load_default() if path is None else _S.load(path)
+
+
+def _fixed(pairs: list[str]) -> dict[str, float]:
+    """['density=60', 'raster=45'] -> {'density': 60.0, 'raster': 45.0}."""
+    from designer.errors import DesignerError
+
+    out = {}
+    for pair in pairs:
+        name, sep, value = pair.partition("=")
+        if not sep:
+            raise DesignerError(f"--fix '{pair}' is not NAME=VALUE", "write it as --fix density=60")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            raise DesignerError(
+                f"--fix {pair}: '{value}' is not a number", "write it as --fix density=60"
+            ) from None
+    return out
+
+
+@plot_app.command("space")
+def space_cmd(
+    x: Annotated[str, typer.Option("--x", help="continuous factor on the first axis")] = "width",
+    y: Annotated[str, typer.Option("--y", help="continuous factor on the second axis")] = "height",
+    z: Annotated[str | None, typer.Option("--z", help="third factor (with --volume)")] = None,
+    response: Annotated[str, typer.Option("--response", help="quantity: k or c")] = "k",
+    axis: Axis = "x",
+    fix: Annotated[
+        list[str] | None,
+        typer.Option("--fix", help="hold a factor, NAME=VALUE (repeat); others at the centre"),
+    ] = None,
+    target: Annotated[
+        float | None, typer.Option("--target", help="target value in rig units (N/mm, N.s/mm)")
+    ] = None,
+    volume: Annotated[bool, typer.Option("--volume", help="isosurfaces over --x, --y, --z")] = False,
+    output: Output = Path("space.png"),
+    html: Annotated[Path | None, typer.Option("--html", help="also write an interactive HTML scene")] = None,
+    surrogate: Surrogate = None,
+    as_json: Json = False,
+) -> None:
+    """The surrogate's response over two factors (others held) with its 95 % PI, the runs and the target.
+
+    Example: designer plot space --x width --y height --response k --target 0.8 -o space.png --html space.html
+    """
+    from designer.errors import DesignerError
+    from designer.plots import common, space
+
+    common.check_image_path(output)
+    sur = _surrogate(surrogate)
+    resp = f"{response}_{axis}"
+    with progress_bar("rendering") as bar:
+        if volume:
+            if z is None:
+                raise DesignerError("--volume needs a third factor", "add --z, e.g. --z density")
+            view = space.plot_volume(sur, resp, [x, y, z], output, _fixed(fix or []), target, html)
+        else:
+            if z is not None:
+                raise DesignerError("--z draws only with --volume", "add --volume or drop --z")
+            view = space.plot_surface(sur, resp, x, y, output, _fixed(fix or []), target, html)
+        bar(1.0)
+    if as_json:
+        print_json(view.to_dict())
+        return
+    held = ", ".join(f"{k} {v:g}" for k, v in view.held.items())
+    console.print(
+        f"{resp} from {view.value_range[0]:.4g} to {view.value_range[1]:.4g} {view.unit} (held: {held})"
+    )
+    if target is not None:
+        console.print(
+            f"target {target:g} {view.unit} lies inside the 95 % PI over {view.target_in_pi:.0%} of the plot"
+        )
+    for f in view.files:
+        _saved(f)
+
+
+@plot_app.command("loo")
+def loo_cmd(
+    output: Output = Path("loo.png"),
+    axis: Annotated[str | None, typer.Option("--axis", help="only this axis (default: all)")] = None,
+    surrogate: Surrogate = None,
+    as_json: Json = False,
+) -> None:
+    """Leave-one-out predictions against the measurements, with 95 % PIs, per response of the surrogate.
+
+    Example: designer plot loo -o loo.png
+    """
+    from designer.errors import DesignerError
+    from designer.plots import common, loo
+
+    common.check_image_path(output)
+    sur = _surrogate(surrogate)
+    responses = [r for r in sur.responses if axis is None or r.split("_", 1)[1] == axis]
+    if not responses:
+        raise DesignerError(
+            f"the surrogate has no response on axis {axis}", f"it has {', '.join(sur.responses)}"
+        )
+    path = loo.plot_loo(sur, responses, output)
+    metrics = {r: dict(sur.model(r).loo, form=sur.model(r).form) for r in responses}
+    if as_json:
+        print_json({"figure": str(path), "loo": metrics})
+        return
+    for r, m in metrics.items():
+        unit = sur.model(r).unit
+        console.print(
+            f"{r}: {m['form']}, Q2 {m['q2']:.2f}, RMSE {m['rmse']:.3g} {unit}, "
+            f"95 % PI coverage {m['coverage95']:.0%}"
+        )
+    _saved(path)
+
+
+@plot_app.command("timeseries")
+def timeseries_cmd(
+    series: Annotated[
+        Path, typer.Argument(help="time series CSV or Parquet with a 't' column (designer cosim)")
+    ],
+    output: Output = Path("timeseries.png"),
+    columns: Annotated[
+        str | None, typer.Option("--columns", help="signals, comma-separated (default: all)")
+    ] = None,
+    reference: Annotated[Path | None, typer.Option("--reference", help="reference series to overlay")] = None,
+) -> None:
+    """Co-simulation signals against time, one panel each, a reference dashed.
+
+    Example: designer plot timeseries results/timeseries.csv --columns joint.x.s,joint.x.f -o ts.png
+    """
+    from designer.plots import common, timeseries
+
+    common.check_image_path(output)
+    frame = _read_series(series)
+    ref = None if reference is None else _read_series(reference)
+    cols = None if columns is None else [c.strip() for c in columns.split(",") if c.strip()]
+    _saved(timeseries.plot_timeseries(frame, output, cols, reference=ref))
+
+
+def _read_series(path: Path):
+    import pandas as pd
+
+    from designer.errors import DesignerError
+
+    if not path.is_file():
+        raise DesignerError(f"no such file: {path}", "give a CSV or Parquet time series")
+    try:
+        return pd.read_parquet(path) if path.suffix.lower() in (".parquet", ".pq") else pd.read_csv(path)
+    except (ValueError, OSError, pd.errors.ParserError, UnicodeDecodeError) as exc:
+        raise DesignerError(
+            f"cannot read {path}: {str(exc).splitlines()[0]}", "give a CSV or Parquet file"
+        ) from None
+
+
+def validate_cmd(
+    output: Annotated[
+        Path, typer.Option("-o", "--output", help="folder for report.html, report.md, figures/")
+    ] = Path("report"),
+    table: Table = None,
+    as_json: Json = False,
+) -> None:
+    """Check the tool against the study and itself; write HTML and Markdown reports; exit 1 if a check fails.
+
+    Example: designer validate -o report/
+    """
+    from designer.report import validate
+
+    with progress_bar("validating") as bar:
+        results, page, md, seconds = validate(output, table, progress=bar)
+    failed = [r for r in results if not r.passed]
+    if as_json:
+        print_json(
+            {
+                "passed": not failed,
+                "seconds": seconds,
+                "report": str(page),
+                "checks": [r.to_dict() for r in results],
+            }
+        )
+    else:
+        for r in results:
+            mark = "[green]PASS[/green]" if r.passed else "[red]FAIL[/red]"
+            console.print(f"{mark} {r.name} ({r.seconds:.1f} s): {r.summary}")
+        console.print(
+            f"{len(results) - len(failed)} of {len(results)} checks pass in {seconds:.1f} s; "
+            f"wrote {page} and {md}"
+        )
+    if failed:
+        raise typer.Exit(1)
+
+
+def register(app: typer.Typer) -> None:
+    """Add `designer plot` to the main app."""
+    app.add_typer(plot_app, name="plot")
+    app.command("validate")(validate_cmd)

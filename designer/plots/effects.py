@@ -1,0 +1,62 @@
+"""Main-effect boxplots: each response against each factor's levels, medians marked (study Figs 5-12)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .. import space
+from .common import response_label, save_figure
+
+
+def main_effects(table: pd.DataFrame, responses: list[str]) -> pd.DataFrame:
+    """Per response, factor and level: run count and median (rig units), the numbers the boxes show."""
+    rows = []
+    for resp in responses:
+        for f in space.FACTORS:
+            for level, group in table.groupby(f.name)[resp]:
+                rows.append(
+                    {
+                        "response": resp,
+                        "factor": f.name,
+                        "level": float(level),
+                        "n": int(group.size),
+                        "median": float(group.median()),
+                    }
+                )
+    return pd.DataFrame(rows)
+
+
+def plot_effects(table: pd.DataFrame, responses: list[str], path: str | Path) -> Path:
+    """One row of boxplots per response, one panel per factor; red lines are the medians."""
+    import matplotlib.pyplot as plt
+
+    ncol = len(space.FACTORS)
+    fig, axes = plt.subplots(
+        len(responses), ncol, figsize=(2.4 * ncol, 2.8 * len(responses)), squeeze=False, sharey="row"
+    )
+    rng = np.random.default_rng(0)  # fixed jitter: the same table gives the same picture
+    for i, resp in enumerate(responses):
+        for j, f in enumerate(space.FACTORS):
+            ax = axes[i, j]
+            groups = [(level, g[resp].to_numpy()) for level, g in table.groupby(f.name)]
+            ax.boxplot(
+                [g for _, g in groups],
+                positions=range(len(groups)),
+                widths=0.55,
+                medianprops={"color": "red", "linewidth": 2},
+                flierprops={"marker": ""},
+            )
+            for k, (_, g) in enumerate(groups):
+                ax.plot(k + rng.uniform(-0.12, 0.12, g.size), g, ".", color="0.35", ms=3, alpha=0.7)
+            ax.plot(range(len(groups)), [np.median(g) for _, g in groups], "r--", lw=0.8)
+            ax.set_xticks(range(len(groups)), [f"{level:g}" for level, _ in groups])
+            ax.set_xlabel(f"{f.name} ({f.unit})")
+            if j == 0:
+                ax.set_ylabel(response_label(resp))
+            ax.grid(axis="y", alpha=0.3)
+    fig.suptitle(f"Main effects on {', '.join(responses)} ({len(table)} runs; red: medians)")
+    fig.tight_layout()
+    return save_figure(fig, path)

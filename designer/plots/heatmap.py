@@ -1,0 +1,38 @@
+"""Correlation heat map between the factors and the responses (study Fig 13)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .. import space
+from .common import save_figure
+
+
+def correlations(table: pd.DataFrame, responses: list[str]) -> pd.DataFrame:
+    """Pearson correlation matrix of the six factors and the responses, as the study's Fig 13."""
+    cols = list(space.FACTOR_NAMES) + list(responses)
+    return table[cols].corr(method="pearson")
+
+
+def plot_heatmap(table: pd.DataFrame, responses: list[str], path: str | Path) -> Path:
+    """Annotated heat map of the correlations, -1 (blue) to 1 (red)."""
+    import matplotlib.pyplot as plt
+
+    corr = correlations(table, responses)
+    n = len(corr)
+    fig, ax = plt.subplots(figsize=(0.75 * n + 2.5, 0.75 * n + 1.5))
+    im = ax.imshow(corr.to_numpy(), cmap="coolwarm", vmin=-1, vmax=1)
+    ax.set_xticks(range(n), corr.columns, rotation=45, ha="right")
+    ax.set_yticks(range(n), corr.index)
+    for (i, j), v in np.ndenumerate(corr.to_numpy()):
+        if np.isfinite(v):
+            ax.text(
+                j, i, f"{v:.2f}", ha="center", va="center", fontsize=8, color="white" if abs(v) > 0.6 else "k"
+            )
+    fig.colorbar(im, ax=ax, label="Pearson correlation")
+    ax.set_title(f"Factor and response correlations ({len(table)} runs)")
+    fig.tight_layout()
+    return save_figure(fig, path)

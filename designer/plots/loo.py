@@ -1,0 +1,66 @@
+"""Predicted against observed under leave-one-out, with each prediction's 95 % interval."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .common import response_label, save_figure
+
+
+def loo_table(surrogate, response: str) -> pd.DataFrame:
+    """Per training run: observed, LOO prediction and its 95 % PI, and whether the PI covers the run."""
+    model = surrogate.model(response)
+    pred = model.loo_predictions
+    observed = surrogate.table[response].to_numpy(float)
+    return pd.DataFrame(
+        {
+            "observed": observed,
+            "predicted": np.asarray(pred["value"], float),
+            "lo": np.asarray(pred["lo"], float),
+            "hi": np.asarray(pred["hi"], float),
+        }
+    ).assign(covered=lambda d: (d.observed >= d.lo) & (d.observed <= d.hi))
+
+
+def plot_loo(surrogate, responses: list[str], path: str | Path) -> Path:
+    """One panel per response: LOO predictions with PI bars against the measurements, 1:1 line."""
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(responses), figsize=(5.2 * len(responses), 4.8), squeeze=False)
+    for ax, resp in zip(axes[0], responses, strict=True):
+        model = surrogate.model(resp)
+        d = loo_table(surrogate, resp)
+        for covered, color, label in (
+            (True, "tab:blue", "PI covers the run"),
+            (False, "tab:red", "PI misses it"),
+        ):
+            s = d[d.covered == covered]
+            ax.errorbar(
+                s.observed,
+                s.predicted,
+                yerr=[s.predicted - s.lo, s.hi - s.predicted],
+                fmt="o",
+                ms=4,
+                color=color,
+                ecolor=color,
+                elinewidth=0.8,
+                alpha=0.8,
+                label=f"{label} ({len(s)})",
+            )
+        lim = [min(d.observed.min(), d.lo.min()), max(d.observed.max(), d.hi.max())]
+        ax.plot(lim, lim, "k--", lw=0.8, label="predicted = observed")
+        ax.set_xlabel(f"observed {response_label(resp)}")
+        ax.set_ylabel(f"leave-one-out prediction {response_label(resp)}")
+        loo = model.loo
+        ax.set_title(
+            f"{resp}: {model.form}, Q2 {loo['q2']:.2f}, RMSE {loo['rmse']:.3g} {model.unit}\n"
+            f"95 % PI coverage {loo['coverage95']:.0%} of {len(d)} runs",
+            fontsize=10,
+        )
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="upper left")
+    fig.tight_layout()
+    return save_figure(fig, path)

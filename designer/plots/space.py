@@ -1,0 +1,357 @@
+"""The design space in 3D (pyvista, off-screen): the surrogate over two or three factors, others held.
+
+`plot_surface` draws the predicted response over two continuous factors with the 95 % prediction
+interval as translucent surfaces, the measured runs as points and the target as a contour line.
+`plot_volume` draws the response over three continuous factors as isosurfaces, the target's in red.
+Both draw in the unit cube (each axis scaled to its tested range) and can also write the scene as an
+interactive HTML page (`designer.plots.html3d`).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from .. import space
+from ..errors import DesignerError
+from ..files import atomic_path
+from .common import check_image_path, response_label
+from .html3d import Layer, Scene, write_scene
+
+#: the picture's size in pixels (width, height)
+WINDOW = (1200, 900)
+CMAP = "viridis"
+PI_COLOR = (0.35, 0.45, 0.85)
+TARGET_COLOR = (0.9, 0.05, 0.05)
+
+
+@dataclass
+class SpaceView:
+    """What a design-space figure shows, as numbers: the held factors and the response's range."""
+
+    response: str
+    unit: str
+    factors: list[str]
+    held: dict[str, float]
+    value_range: tuple[float, float]
+    target: float | None
+    #: share of the drawn grid where the target lies inside the 95 % PI
+    target_in_pi: float | None
+    files: list[Path] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        d = dict(self.__dict__)
+        d["files"] = [str(p) for p in self.files]
+        return d
+
+
+def held_values(table: pd.DataFrame, free: list[str], fixed: Mapping[str, float] | None) -> dict[str, float]:
+    """The values of the factors not drawn: given ones checked, the rest at the level nearest the median."""
+    fixed = dict(fixed or {})
+    for name in fixed:
+        if name in free:
+            raise DesignerError(f"{name} is drawn on an axis and also held fixed", f"drop --fix {name}=...")
+    held = {}
+    for f in space.FACTORS:
+        if f.name in free:
+            continue
+        if f.name in fixed:
+            held[f.name] = space.check_value(f.name, fixed[f.name])
+        else:
+            median = float(table[f.name].median()) if f.name in table else (f.low + f.high) / 2
+            held[f.name] = float(min(f.levels, key=lambda v: abs(v - median)))
+    return held
+
+
+def _free_factors(names: list[str]) -> list[space.Factor]:
+    factors = [space.factor(n) for n in names]
+    for f in factors:
+        if f.categorical:
+            raise DesignerError(
+                f"{f.name} is categorical ({f.describe_range()})",
+                "draw continuous factors (density, length, width, height) and hold it with --fix",
+            )
+    if len(set(names)) != len(names):
+        raise DesignerError(f"a factor is repeated in {', '.join(names)}", "draw distinct factors")
+    return factors
+
+
+def _unit(v: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    return (np.asarray(v, float) - lo) / (hi - lo)
+
+
+def _runs_near(table: pd.DataFrame, held: Mapping[str, float]) -> np.ndarray:
+    """Which measured runs were printed at the held values (within 1 % of each factor's range)."""
+    mask = np.ones(len(table), bool)
+    for name, v in held.items():
+        f = space.factor(name)
+        mask &= np.abs(table[name].to_numpy(float) - v) <= 0.01 * (f.high - f.low) + 1e-9
+    return mask
+
+
+def _rgb(values: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    from matplotlib import colormaps
+
+    return colormaps[CMAP](np.clip((values - lo) / (hi - lo), 0, 1))[:, :3]
+
+
+def _plotter():
+    """An off-screen pyvista plotter that renders without a display (EGL when there is no X server)."""
+    if not os.environ.get("DISPLAY"):
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    import pyvista as pv
+
+    pv.OFF_SCREEN = True
+    plotter = pv.Plotter(off_screen=True, window_size=list(WINDOW))
+    plotter.set_background("white")
+    return pv, plotter
+
+
+def _finish(plotter, scene: Scene, path: Path, title: str) -> None:
+    """Axes with the factors' real ranges, the title, camera, and the screenshot written atomically."""
+    ranges = [v for r in scene.axis_ranges for v in r]
+    plotter.show_bounds(
+        bounds=[0, 1, 0, 1, 0, 1],
+        axes_ranges=ranges,
+        xtitle=scene.axis_labels[0],
+        ytitle=scene.axis_labels[1],
+        ztitle=scene.axis_labels[2],
+        color="black",
+        font_size=10,
+        location="outer",
+    )
+    plotter.add_text(title, font_size=10, color="black")
+    plotter.camera_position = [(2.6, -1.9, 1.9), (0.5, 0.5, 0.45), (0, 0, 1)]
+    with atomic_path(path) as tmp:
+        plotter.screenshot(str(tmp))
+    plotter.close()
+
+
+def _colorbar(plotter, response: str, lo: float, hi: float) -> None:
+    """The colour scale of the response (an invisible mesh carrying its range)."""
+    import pyvista as pv
+
+    bar = pv.PolyData(np.zeros((2, 3)))
+    bar.point_data[response] = [lo, hi]
+    plotter.add_mesh(
+        bar,
+        scalars=response,
+        cmap=CMAP,
+        opacity=0.0,
+        show_scalar_bar=True,
+        scalar_bar_args={"title": response_label(response), "color": "black", "vertical": True},
+    )
+
+
+def _write(
+    plotter_layers: list[Layer],
+    scene: Scene,
+    path: Path,
+    html: Path | None,
+    title: str,
+    scale: tuple[str, float, float],
+) -> None:
+    """Render the layers to the PNG and, when asked, the same scene to HTML."""
+    pv, plotter = _plotter()
+    for layer in plotter_layers:
+        kwargs: dict[str, Any] = {"opacity": layer.opacity}
+        if layer.rgb is not None:
+            kwargs |= {"scalars": (layer.rgb * 255).astype(np.uint8), "rgb": True}
+        else:
+            kwargs["color"] = layer.color
+        if layer.mesh.n_cells and layer.mesh.verts.size == layer.mesh.n_cells * 2:
+            kwargs |= {"point_size": layer.size * 4, "render_points_as_spheres": True}
+        elif layer.mesh.lines.size:
+            kwargs["line_width"] = layer.size * 2
+        plotter.add_mesh(layer.mesh, **kwargs)
+    _colorbar(plotter, *scale)
+    plotter.add_legend(
+        labels=[(layer.name, layer.color) for layer in plotter_layers],
+        bcolor="white",
+        size=(0.32, 0.03 * len(plotter_layers)),
+        loc="upper right",
+        face="rectangle",
+    )
+    _finish(plotter, scene, path, title)
+    if html is not None:
+        write_scene(scene, html)
+
+
+def _check_html(html: str | Path | None) -> Path | None:
+    if html is None:
+        return None
+    p = Path(html)
+    if p.suffix.lower() not in (".html", ".htm"):
+        raise DesignerError(f"cannot write an HTML scene to '{p.name}'", "end the file name in .html")
+    return p
+
+
+def plot_surface(
+    surrogate,
+    response: str,
+    x: str,
+    y: str,
+    path: str | Path,
+    fixed: Mapping[str, float] | None = None,
+    target: float | None = None,
+    html: str | Path | None = None,
+    resolution: int = 41,
+) -> SpaceView:
+    """The response over factors x and y (others held), its 95 % PI, the measured runs and the target."""
+    import pyvista as pv
+
+    path, html = check_image_path(path), _check_html(html)
+    model = surrogate.model(response)
+    fx, fy = _free_factors([x, y])
+    table = surrogate.table
+    held = held_values(table, [x, y], fixed)
+    gx, gy = np.meshgrid(np.linspace(fx.low, fx.high, resolution), np.linspace(fy.low, fy.high, resolution))
+    X = pd.DataFrame({n: np.full(gx.size, held.get(n, 0.0)) for n in space.FACTOR_NAMES})
+    X[x], X[y] = gx.ravel(), gy.ravel()
+    pred = model.predict(X)
+    observed = table[response].to_numpy(float)
+    zlo = float(min(pred.lo.min(), observed.min(), target if target is not None else np.inf))
+    zhi = float(max(pred.hi.max(), observed.max(), target if target is not None else -np.inf))
+    zlo, zhi = zlo - 0.02 * (zhi - zlo), zhi + 0.02 * (zhi - zlo)
+
+    def grid(z: np.ndarray) -> pv.PolyData:
+        g = pv.StructuredGrid(
+            _unit(gx, fx.low, fx.high), _unit(gy, fy.low, fy.high), _unit(z.reshape(gx.shape), zlo, zhi)
+        )
+        return g.extract_surface(algorithm="dataset_surface")
+
+    mid = grid(pred.value)
+    vlo, vhi = float(pred.value.min()), float(pred.value.max())
+    layers = [
+        Layer(
+            f"{response} predicted",
+            mid,
+            rgb=_rgb(pred.value, vlo, vhi),
+            color=tuple(_rgb(np.array([0.5]), 0, 1)[0]),
+        ),
+        Layer("95 % PI lower", grid(pred.lo), color=PI_COLOR, opacity=0.25),
+        Layer("95 % PI upper", grid(pred.hi), color=PI_COLOR, opacity=0.25),
+    ]
+    near = _runs_near(table, held)
+    runs = np.c_[
+        _unit(table[x], fx.low, fx.high), _unit(table[y], fy.low, fy.high), _unit(observed, zlo, zhi)
+    ]
+    if near.any():
+        layers.append(
+            Layer(
+                f"runs at the held values ({int(near.sum())})",
+                pv.PolyData(runs[near]),
+                color=(0, 0, 0),
+                size=4,
+            )
+        )
+    if (~near).any():
+        layers.append(
+            Layer(
+                f"other runs ({int((~near).sum())})",
+                pv.PolyData(runs[~near]),
+                color=(0.55, 0.55, 0.55),
+                size=2.5,
+            )
+        )
+    share = None
+    if target is not None:
+        mid.point_data["value"] = pred.value
+        line = mid.contour([target], scalars="value")
+        if line.n_points:
+            layers.append(Layer(f"target {target:g} {model.unit}", line, color=TARGET_COLOR, size=2.5))
+            floor = line.copy()
+            floor.points[:, 2] = 0.0
+            layers.append(Layer("target, projected", floor, color=TARGET_COLOR, size=1.5, opacity=0.6))
+        share = float(np.mean((pred.lo <= target) & (target <= pred.hi)))
+    held_txt = ", ".join(f"{k} {v:g} {space.factor(k).unit}" for k, v in held.items())
+    title = f"{response_label(response)} over {x} and {y}; held: {held_txt}"
+    scene = Scene(
+        title,
+        (f"{x} ({fx.unit})", f"{y} ({fy.unit})", response_label(response)),
+        ((fx.low, fx.high), (fy.low, fy.high), (zlo, zhi)),
+        layers,
+    )
+
+    _write(layers, scene, path, html, title, (response, vlo, vhi))
+    return SpaceView(
+        response, model.unit, [x, y], held, (vlo, vhi), target, share, [path] + ([html] if html else [])
+    )
+
+
+def plot_volume(
+    surrogate,
+    response: str,
+    factors: list[str],
+    path: str | Path,
+    fixed: Mapping[str, float] | None = None,
+    target: float | None = None,
+    html: str | Path | None = None,
+    resolution: int = 25,
+    levels: int = 4,
+) -> SpaceView:
+    """The response over three factors as isosurfaces (translucent), the target's in red, runs as points."""
+    import pyvista as pv
+
+    path, html = check_image_path(path), _check_html(html)
+    if len(factors) != 3:
+        raise DesignerError(f"a volume needs three factors, got {len(factors)}", "give --x, --y and --z")
+    model = surrogate.model(response)
+    fs = _free_factors(factors)
+    table = surrogate.table
+    held = held_values(table, factors, fixed)
+    axes = [np.linspace(f.low, f.high, resolution) for f in fs]
+    mesh = np.meshgrid(*axes, indexing="ij")
+    X = pd.DataFrame({n: np.full(mesh[0].size, held.get(n, 0.0)) for n in space.FACTOR_NAMES})
+    for f, m in zip(fs, mesh, strict=True):
+        X[f.name] = m.ravel(order="F")
+    pred = model.predict(X)
+    vol = pv.ImageData(dimensions=(resolution,) * 3, spacing=(1 / (resolution - 1),) * 3)
+    vol.point_data["value"] = pred.value
+    vlo, vhi = float(pred.value.min()), float(pred.value.max())
+    layers = []
+    for v in np.linspace(vlo, vhi, levels + 2)[1:-1]:
+        iso = vol.contour([v], scalars="value")
+        if iso.n_points:
+            color = tuple(_rgb(np.array([v]), vlo, vhi)[0])
+            layers.append(Layer(f"{response} = {v:.3g} {model.unit}", iso, color=color, opacity=0.5))
+    share = None
+    if target is not None:
+        iso = vol.contour([target], scalars="value")
+        if iso.n_points:
+            layers.append(Layer(f"target {target:g} {model.unit}", iso, color=TARGET_COLOR, opacity=0.85))
+        share = float(np.mean((pred.lo <= target) & (target <= pred.hi)))
+    pts = np.c_[[_unit(table[f.name], f.low, f.high) for f in fs]].T
+    observed = table[response].to_numpy(float)
+    layers.append(
+        Layer(
+            f"measured runs ({len(table)}), coloured by {response}",
+            pv.PolyData(pts),
+            rgb=_rgb(observed, vlo, vhi),
+            color=(0.4, 0.4, 0.4),
+            size=3,
+        )
+    )
+    held_txt = ", ".join(f"{k} {v:g} {space.factor(k).unit}" for k, v in held.items()) or "none"
+    title = f"{response_label(response)} isosurfaces over {', '.join(factors)}; held: {held_txt}"
+    scene = Scene(
+        title, tuple(f"{f.name} ({f.unit})" for f in fs), tuple((f.low, f.high) for f in fs), layers
+    )
+
+    _write(layers, scene, path, html, title, (response, vlo, vhi))
+    return SpaceView(
+        response,
+        model.unit,
+        list(factors),
+        held,
+        (vlo, vhi),
+        target,
+        share,
+        [path] + ([html] if html else []),
+    )

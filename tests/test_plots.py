@@ -1,0 +1,106 @@
+"""The 2D plots of the data: effects boxplots and the correlation heat map, library and CLI."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from imagecheck import assert_picture
+
+from designer import space
+from designer.data import load_table
+from designer.errors import DesignerError
+from designer.plots import common, effects, heatmap
+
+
+@pytest.fixture(scope="module")
+def table():
+    return load_table()
+
+
+def test_main_effects_match_the_table(table):
+    med = effects.main_effects(table, ["k_x"])
+    width = med[med.factor == "width"].set_index("level")
+    assert list(width.index) == [2.0, 4.5, 7.0]
+    assert width["n"].sum() == len(table)
+    assert width.loc[7.0, "median"] == pytest.approx(table.loc[table.width == 7, "k_x"].median())
+    # the study: wider specimens are less stiff along x
+    assert width.loc[2.0, "median"] > width.loc[7.0, "median"]
+    assert set(med.factor) == set(space.FACTOR_NAMES)
+
+
+def test_effects_png(table, tmp_path):
+    path = effects.plot_effects(table, ["c_x", "k_x"], tmp_path / "effects.png")
+    rgb = assert_picture(path, min_size=(1200, 500))
+    # medians are drawn in pure red
+    red = (rgb[..., 0] > 0.9) & (rgb[..., 1] < 0.15) & (rgb[..., 2] < 0.15)
+    assert red.sum() > 200
+
+
+def test_correlations_are_pearson(table):
+    corr = heatmap.correlations(table, ["c_x", "k_x"])
+    assert corr.loc["width", "k_x"] == pytest.approx(np.corrcoef(table.width, table.k_x)[0, 1])
+    assert corr.loc["width", "k_x"] < -0.3  # the study's Fig 13: width lowers stiffness
+    assert np.allclose(np.diag(corr), 1.0)
+
+
+def test_heatmap_png_and_svg(table, tmp_path):
+    assert_picture(heatmap.plot_heatmap(table, ["c_x", "k_x"], tmp_path / "hm.png"))
+    svg = heatmap.plot_heatmap(table, ["c_x", "k_x"], tmp_path / "hm.svg")
+    assert svg.read_text().lstrip().startswith("<?xml")
+
+
+def test_bad_names_are_designer_errors(table, tmp_path):
+    with pytest.raises(DesignerError, match="end the file name"):
+        common.check_image_path(tmp_path / "x.jpg")
+    with pytest.raises(DesignerError, match="no column m_x"):
+        common.responses_for(table, ["m"], "x")
+    with pytest.raises(DesignerError, match="unknown axis"):
+        common.responses_for(table, None, "w")
+    with pytest.raises(DesignerError, match="does not exist"):
+        effects.plot_effects(table, ["k_x"], tmp_path / "missing" / "e.png")
+
+
+def designer(*args: str, cwd) -> subprocess.CompletedProcess:
+    """Run the installed `designer` command."""
+    exe = Path(sys.executable).with_name("designer")
+    return subprocess.run([str(exe), *args], capture_output=True, text=True, cwd=cwd)
+
+
+def test_cli_effects_and_heatmap(tmp_path):
+    run = designer("plot", "effects", "--response", "k", "-o", "e.png", cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    assert "e.png" in run.stdout
+    assert_picture(tmp_path / "e.png")
+    run = designer("plot", "heatmap", "--json", "-o", "h.png", cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    data = json.loads(run.stdout)
+    assert data["correlations"]["k_x"]["k_x"] == pytest.approx(1.0)
+    assert_picture(tmp_path / "h.png")
+
+
+def test_cli_bad_input_is_one_line(tmp_path):
+    run = designer("plot", "effects", "--axis", "q", cwd=tmp_path)
+    assert run.returncode == 2
+    assert run.stderr.startswith("error: unknown axis") and "Traceback" not in run.stderr
+    assert not (tmp_path / "effects.png").exists()
+
+
+def test_timeseries_png_with_reference(tmp_path):
+    import pandas as pd
+
+    from designer.plots.timeseries import plot_timeseries
+
+    t = np.linspace(0, 2, 400)
+    frame = pd.DataFrame({"t": t, "joint.x.s": np.exp(-t) * np.sin(9 * t), "joint.x.f": np.cos(9 * t)})
+    assert_picture(
+        plot_timeseries(frame, tmp_path / "ts.png", reference=frame.iloc[::4]), min_size=(800, 300)
+    )
+    with pytest.raises(DesignerError, match="no column q"):
+        plot_timeseries(frame, tmp_path / "ts.png", ["q"])
+    with pytest.raises(DesignerError, match="no 'time' column"):
+        plot_timeseries(frame, tmp_path / "ts.png", time="time")

@@ -1,0 +1,59 @@
+"""`designer validate`: the checks, the HTML and Markdown report, the exit code."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from imagecheck import assert_picture, chromium, dump_dom
+
+from designer import report
+from designer.data import load_table
+
+
+def test_validate_writes_a_passing_report(tmp_path):
+    exe = Path(sys.executable).with_name("designer")
+    run = subprocess.run([str(exe), "validate", "-o", "rep"], capture_output=True, text=True, cwd=tmp_path)
+    assert run.returncode == 0, run.stdout + run.stderr
+    out = tmp_path / "rep"
+    md = (out / "report.md").read_text()
+    names = [c(report.Context(load_table(), tmp_path)).name for c in report.CHECKS[:1]]
+    assert names[0] in md and "FAIL" not in md
+    for png in sorted((out / "figures").glob("*.png")):
+        assert_picture(png)
+    assert len(list((out / "figures").glob("*.png"))) == len(report.CHECKS)
+    exe = chromium()
+    if exe is None:
+        pytest.skip("no headless Chromium on this machine")
+    dom = dump_dom(exe, out / "report.html")
+    assert f'data-checks="{len(report.CHECKS)}"' in dom
+    assert f'data-passed="{len(report.CHECKS)}"' in dom
+    assert dom.count('class="check"') == len(report.CHECKS)
+
+
+def test_a_failing_check_fails_the_report(tmp_path):
+    table = load_table()
+    # triple the stiffness of the widest runs: k_x now rises with width, against the study
+    wide = table.width == 7
+    table.loc[wide, "k_x"] *= 3
+    ctx = report.Context(table, tmp_path)
+    result = report.check_main_effects(ctx)
+    assert not result.passed
+    rows = result.table.set_index(["response", "factor"])
+    assert not rows.loc[("k_x", "width"), "agrees"]
+    assert rows.loc[("k_x", "height"), "agrees"]
+    results = report.run_checks(ctx, (report.check_dataset, report.check_main_effects))
+    page, md = report.write_report(results, tmp_path, 1.0)
+    assert "1 of 2 checks pass" in md.read_text() and "FAIL" in page.read_text()
+
+
+def test_bad_table_fails_in_one_line(tmp_path):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("density,length\n1,2\n")
+    exe = Path(sys.executable).with_name("designer")
+    run = subprocess.run(
+        [str(exe), "validate", "--table", str(bad), "-o", "rep"], capture_output=True, text=True, cwd=tmp_path
+    )
+    assert run.returncode == 2 and run.stderr.startswith("error:") and "Traceback" not in run.stderr
