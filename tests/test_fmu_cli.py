@@ -1,0 +1,183 @@
+"""`designer export`: joint sources, bad-input messages, and the Modelica, MJCF and URDF outputs."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+from designer.export import sources
+from designer.export.modelica import modelica_text
+from designer.export.robot import mjcf_text, urdf_text
+from designer.joint import PRB_GAMMA, from_coefficients
+
+DESIGN = {"density": 60, "length": 24, "width": 4.5, "height": 9, "layer": 0.16, "raster": 0}
+
+
+def run(*args, env=None):
+    import os
+
+    e = dict(os.environ, **(env or {}))
+    return subprocess.run(
+        [sys.executable, "-c", "from designer_cli.main import main; main()", *args],
+        capture_output=True,
+        text=True,
+        env=e,
+    )
+
+
+@pytest.fixture()
+def cache_env(tmp_path):
+    return {"XDG_CACHE_HOME": str(tmp_path / "cache")}
+
+
+class FakeSurrogate:
+    """A surrogate with the documented interface and known numbers."""
+
+    id = "fake-1"
+    responses = ["c_x", "k_x"]
+
+    def predict(self, X):
+        from types import SimpleNamespace
+
+        one = lambda v: SimpleNamespace(value=np.array([v]), lo=np.array([v / 2]), hi=np.array([v * 2]))  # noqa: E731
+        return {"k_x": one(0.8), "c_x": one(2e-3)}
+
+
+def test_joint_from_design_carries_pis_settings_mass_and_prb():
+    j = sources.from_design(DESIGN, ["x", "theta"], surrogate=FakeSurrogate())
+    assert j.axes["x"].k == 0.8 and j.axes["x"].k_pi95 == (0.4, 1.6)
+    assert j.provenance["params"]["width"] == 4.5 and j.provenance["surrogate"] == "fake-1"
+    assert j.axes["x"].m > 0
+    arm = PRB_GAMMA * 24
+    assert j.axes["theta"].k == pytest.approx(0.8 * arm**2)
+    assert "derived, not measured" in j.axes["theta"].origin
+
+
+def test_joint_from_suggestion(tmp_path):
+    s = {
+        "axis": "x",
+        "targets": {"k": 0.8},
+        "reachable": True,
+        "candidates": [
+            {
+                "params": DESIGN,
+                "predicted": {
+                    "k": {"value": 0.7, "pi95": [0.5, 0.9]},
+                    "c": {"value": 1e-3, "pi95": [0, 3e-3]},
+                },
+                "desirability": 0.9,
+            },
+            {
+                "params": DESIGN,
+                "predicted": {"k": {"value": 0.6, "pi95": None}, "c": {"value": 1e-3, "pi95": None}},
+                "desirability": 0.5,
+            },
+        ],
+    }
+    p = tmp_path / "s.json"
+    p.write_text(json.dumps(s))
+    j = sources.from_suggestion(p, 2)
+    assert j.axes["x"].k == 0.6 and j.provenance["desirability"] == 0.5 and j.axes["x"].m > 0
+    r = run("export", "fmu", "--from", str(p), "--candidate", "3", "-o", str(tmp_path / "j.fmu"))
+    assert r.returncode == 2 and "candidate 3 does not exist" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_cli_exports_fmu_with_json(tmp_path, cache_env):
+    out = tmp_path / "j.fmu"
+    r = run(
+        "export",
+        "fmu",
+        "--k",
+        "0.8",
+        "--c",
+        "2e-3",
+        "--m",
+        "0.01",
+        "--interface",
+        "body",
+        "--fmi",
+        "3",
+        "-o",
+        str(out),
+        "--json",
+        env=cache_env,
+    )
+    assert r.returncode == 0, r.stderr
+    data = json.loads(r.stdout)
+    assert data["path"] == str(out) and data["joint"]["axes"]["x"]["si"]["k"] == 800.0
+    assert out.is_file()
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        ([], "give the joint one way"),
+        (["--k", "0.8", "--c", "2e-3", "--density", "60"], "give the joint one way"),
+        (["--k", "0.8", "--c", "2e-3", "--interface", "body"], "needs a mass"),
+        (["--k", "0.8"], "one --k and one --c per --axis"),
+        (["--k", "-1", "--c", "2e-3"], "not a valid value"),
+        (["--k", "0.8", "--c", "2e-3", "--axis", "w"], "unknown axis"),
+        (["--k", "0.8", "--c", "2e-3", "--fmi", "4"], "FMI version 4"),
+        (["--k", "0.8", "--c", "2e-3", "--interface", "spring"], "unknown interface"),
+        (["--density", "60"], "missing factor"),
+    ],
+)
+def test_cli_bad_input_is_one_line(tmp_path, cache_env, args, message):
+    r = run("export", "fmu", *args, "-o", str(tmp_path / "j.fmu"), env=cache_env)
+    assert r.returncode == 2
+    assert r.stderr.startswith("error: ") and message in r.stderr and "Traceback" not in r.stderr
+    assert not (tmp_path / "j.fmu").exists()
+
+
+def test_cli_without_compiler_says_how_and_source_only_works(tmp_path, cache_env):
+    env = dict(cache_env, CC="no-such-cc-xyz")
+    r = run("export", "fmu", "--k", "0.8", "--c", "2e-3", "-o", str(tmp_path / "j.fmu"), env=env)
+    assert r.returncode == 2 and "no-such-cc-xyz" in r.stderr and "--source-only" in r.stderr
+    r = run(
+        "export", "fmu", "--k", "0.8", "--c", "2e-3", "--source-only", "-o", str(tmp_path / "j.fmu"), env=env
+    )
+    assert r.returncode == 0 and "build it from sources/" in r.stdout
+
+
+def test_modelica_package_uses_msl_with_si_values():
+    j = from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}, "theta": {"k": 50.0, "c": 0.1}})
+    text = modelica_text(j)
+    assert "Modelica.Mechanics.Translational.Components.SpringDamper springDamper_x(c = k_x, d = c_x)" in text
+    assert "TranslationalSpringConstant k_x = 800.0" in text and "Mass m_x = 0.01" in text
+    assert "Rotational.Components.SpringDamper" in text and "RotationalSpringConstant k_theta = 0.05" in text
+    assert "Inertia" not in text.split("k_theta")[1].split("end Joint")[0].replace("Documentation", "")
+    assert 'uses(Modelica(version = "4.0.0"))' in text and "entered by hand" in text
+    assert text.count("package FlexJoint") == 1 and text.rstrip().endswith("end FlexJoint;")
+
+
+def test_mjcf_loads_in_mujoco_with_the_joint_numbers():
+    import mujoco
+
+    j = from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}, "theta": {"k": 50.0, "c": 0.1, "m": 1e-5}})
+    model = mujoco.MjModel.from_xml_string(mjcf_text(j))
+    assert list(model.jnt_stiffness) == [800.0, 0.05]
+    assert list(model.dof_damping) == [2.0, 1e-4] and list(model.dof_armature) == [0.01, 1e-5]
+    assert list(model.jnt_type) == [mujoco.mjtJoint.mjJNT_SLIDE, mujoco.mjtJoint.mjJNT_HINGE]
+
+
+def test_urdf_declares_damping_and_says_it_has_no_stiffness():
+    j = from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}})
+    text = urdf_text(j)
+    root = ET.fromstring(text)
+    joint = root.find("joint")
+    assert joint.get("type") == "prismatic" and float(joint.find("dynamics").get("damping")) == 2.0
+    assert float(root.find("link[@name='FlexJoint_x_link']/inertial/mass").get("value")) == 0.01
+    assert "URDF has no joint stiffness" in text and "800.0 N/m" in text
+
+
+@pytest.mark.parametrize("fmt, suffix", [("modelica", ".mo"), ("mjcf", ".xml"), ("urdf", ".urdf")])
+def test_cli_writes_snippets(tmp_path, fmt, suffix):
+    out = tmp_path / f"j{suffix}"
+    r = run("export", fmt, "--k", "0.8", "--c", "2e-3", "--m", "0.01", "-o", str(out))
+    assert r.returncode == 0, r.stderr
+    assert "800" in out.read_text() and "N/m" in r.stdout
