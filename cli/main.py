@@ -8,6 +8,8 @@ import typer
 
 from designer.errors import DesignerError
 
+from . import rig
+
 app = typer.Typer(
     help="Design 3D-printed TPU flexible joints: predict and choose stiffness and damping, export FMUs.",
     no_args_is_help=True,
@@ -15,6 +17,7 @@ app = typer.Typer(
     add_completion=False,
     rich_markup_mode="rich",
 )
+rig.register(app)
 
 
 def main() -> None:

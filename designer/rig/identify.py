@@ -14,10 +14,11 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 from scipy.ndimage import maximum_filter1d
 from scipy.signal import savgol_filter
 
-from .. import units
+from .. import space, units
 from ..errors import DesignerError
 from ..mass import specimen_mass
 from .logs import LOAD, RigLog, read_log
@@ -26,7 +27,7 @@ from .logs import LOAD, RigLog, read_log
 WINDOW_S = 0.05
 #: the window spans at most this fraction of the shortest period carrying the coordinate's power
 WINDOW_PERIODS = 0.1
-POLYORDER = 3
+POLYORDER = 5
 #: m counts as identified when its standard error is at most this fraction of it
 M_REL_SE = 0.1
 
@@ -193,3 +194,34 @@ def identify(
         if progress is not None:
             progress((i + 1) / len(chosen))
     return Identification(path=log.path, factors=log.factors, rate=log.rate, axes=fits)
+
+
+def results_table(results: list[Identification]) -> pd.DataFrame:
+    """The coefficient table `designer fit` reads: factors, c and k per axis, m where identified.
+
+    An axis's m column appears only when m was identified in every log; fit quality (`r2_<axis>`,
+    `nrmse_<axis>`) and the log's path ride along as extra columns.
+    """
+    rows = []
+    for res in results:
+        if res.factors is None:
+            raise DesignerError(
+                f"{res.path}: no factors", "write them to the log's JSON sidecar to build a coefficient table"
+            )
+        rows.append(dict(res.factors))
+    axes = [a for a in units.AXES if all(a in r.axes for r in results)]
+    if not axes:
+        raise DesignerError("the logs share no axis", "identify logs of the same axes together")
+    for row, res in zip(rows, results, strict=True):
+        for a in axes:
+            f = res.axes[a]
+            row[f"c_{a}"], row[f"k_{a}"] = f.c, f.k
+            if all(r.axes[a].m_identified for r in results):
+                row[f"m_{a}"] = f.m
+            row[f"r2_{a}"], row[f"nrmse_{a}"] = f.r2, f.nrmse
+        row["log"] = str(res.path)
+    table = pd.DataFrame(rows)
+    front = list(space.FACTOR_NAMES) + [
+        f"{q}_{a}" for a in axes for q in units.QUANTITIES if f"{q}_{a}" in table
+    ]
+    return table[front + [col for col in table.columns if col not in front]]
