@@ -60,7 +60,7 @@ def test_chirp_derivatives_are_exact():
     assert np.abs(np.gradient(dq, t) - ddq)[10:-10].max() < 1e-3
     # the instantaneous frequency sweeps 0.2 -> 1.85 Hz
     assert dq[0] == pytest.approx(2 * np.pi * 0.2)
-    assert np.abs(dq[t > 49]).max() == pytest.approx(2 * np.pi * 1.85, rel=1e-3)
+    assert np.abs(dq[t > 49]).max() == pytest.approx(2 * np.pi * 1.85, rel=5e-3)
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])
