@@ -98,11 +98,14 @@ class Identification:
 
 def _top_frequency(r: np.ndarray, rate: float) -> float:
     """Frequency below which 99 % of the coordinate's power lies, Hz."""
-    power = np.abs(np.fft.rfft(r - r.mean())) ** 2
+    from scipy.fft import next_fast_len, rfft
+
+    n = next_fast_len(r.size, real=True)
+    power = np.abs(rfft(r - r.mean(), n=n)) ** 2
     cumulative = np.cumsum(power)
     if cumulative[-1] == 0:
         return rate / 2
-    return float(np.searchsorted(cumulative, 0.99 * cumulative[-1]) * rate / r.size)
+    return float(np.searchsorted(cumulative, 0.99 * cumulative[-1]) * rate / n)
 
 
 def _window(r: np.ndarray, rate: float, window_s: float | None, polyorder: int) -> int:
