@@ -136,19 +136,22 @@ def fit_axis(log: RigLog, axis: str, window_s: float | None = None, polyorder: i
             f"axis {axis}: only {int(keep.sum())} samples outside dropouts",
             "the log has too little valid data to identify; record again",
         )
-    cols = [savgol_filter(r_filled, win, polyorder, deriv=d, delta=dt)[keep] for d in (2, 1, 0)]
     y = force[keep]
-    x = np.column_stack(cols + [np.ones_like(y)])
-    scale = np.sqrt(np.mean(x**2, axis=0))
+    x = np.empty((y.size, 4))
+    for j, d in enumerate((2, 1, 0)):
+        x[:, j] = savgol_filter(r_filled, win, polyorder, deriv=d, delta=dt)[keep]
+    x[:, 3] = 1.0
+    scale = np.sqrt(np.einsum("ij,ij->j", x, x) / y.size)
     scale[scale == 0] = 1.0
-    beta_s, *_ = np.linalg.lstsq(x / scale, y, rcond=None)
+    x /= scale
+    # normal equations of the column-scaled problem: four well-scaled columns, one pass over the rows
+    gram_inv = np.linalg.pinv(x.T @ x)
+    beta_s = gram_inv @ (x.T @ y)
+    resid = y - x @ beta_s
     beta = beta_s / scale
-    resid = y - x @ beta
-    dof = max(len(y) - x.shape[1], 1)
+    dof = max(y.size - x.shape[1], 1)
     sigma2 = float(resid @ resid) / dof
-    xs = x / scale
-    cov = sigma2 * np.linalg.pinv(xs.T @ xs) / np.outer(scale, scale)
-    se = np.sqrt(np.diag(cov))
+    se = np.sqrt(np.diag(sigma2 * gram_inv)) / scale
     ss_tot = float(np.sum((y - y.mean()) ** 2))
     r2 = 1.0 - float(resid @ resid) / ss_tot if ss_tot > 0 else float("nan")
     span = float(y.max() - y.min())
@@ -160,10 +163,8 @@ def fit_axis(log: RigLog, axis: str, window_s: float | None = None, polyorder: i
     geometric = (
         specimen_mass(log.factors) if log.factors is not None and not units.is_rotational(axis) else None
     )
-    spring = abs(k) * float(np.sqrt(np.mean(cols[2] ** 2)))
-    inertia_ratio = (
-        abs(m_log) * float(np.sqrt(np.mean(cols[0] ** 2))) / spring if spring > 0 else float("inf")
-    )
+    spring = abs(k) * float(scale[2])
+    inertia_ratio = abs(m_log) * float(scale[0]) / spring if spring > 0 else float("inf")
     return AxisFit(
         axis=axis,
         m=m,
