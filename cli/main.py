@@ -8,7 +8,7 @@ import typer
 
 from designer.errors import DesignerError
 
-from . import cosim, design, export, plots
+from . import cosim, design, export, plots, rig
 
 app = typer.Typer(
     help="Design 3D-printed TPU flexible joints: predict and choose stiffness and damping, export FMUs.",
@@ -18,6 +18,7 @@ app = typer.Typer(
     rich_markup_mode="rich",
 )
 design.register(app)
+rig.register(app)
 export.register(app)
 cosim.register(app)
 plots.register(app)

@@ -14,10 +14,11 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 from scipy.ndimage import maximum_filter1d
 from scipy.signal import savgol_filter
 
-from .. import units
+from .. import space, units
 from ..errors import DesignerError
 from ..mass import specimen_mass
 from .logs import LOAD, RigLog, read_log
@@ -26,7 +27,7 @@ from .logs import LOAD, RigLog, read_log
 WINDOW_S = 0.05
 #: the window spans at most this fraction of the shortest period carrying the coordinate's power
 WINDOW_PERIODS = 0.1
-POLYORDER = 3
+POLYORDER = 5
 #: m counts as identified when its standard error is at most this fraction of it
 M_REL_SE = 0.1
 
@@ -97,11 +98,14 @@ class Identification:
 
 def _top_frequency(r: np.ndarray, rate: float) -> float:
     """Frequency below which 99 % of the coordinate's power lies, Hz."""
-    power = np.abs(np.fft.rfft(r - r.mean())) ** 2
+    from scipy.fft import next_fast_len, rfft
+
+    n = next_fast_len(r.size, real=True)
+    power = np.abs(rfft(r - r.mean(), n=n)) ** 2
     cumulative = np.cumsum(power)
     if cumulative[-1] == 0:
         return rate / 2
-    return float(np.searchsorted(cumulative, 0.99 * cumulative[-1]) * rate / r.size)
+    return float(np.searchsorted(cumulative, 0.99 * cumulative[-1]) * rate / n)
 
 
 def _window(r: np.ndarray, rate: float, window_s: float | None, polyorder: int) -> int:
@@ -132,19 +136,22 @@ def fit_axis(log: RigLog, axis: str, window_s: float | None = None, polyorder: i
             f"axis {axis}: only {int(keep.sum())} samples outside dropouts",
             "the log has too little valid data to identify; record again",
         )
-    cols = [savgol_filter(r_filled, win, polyorder, deriv=d, delta=dt)[keep] for d in (2, 1, 0)]
     y = force[keep]
-    x = np.column_stack(cols + [np.ones_like(y)])
-    scale = np.sqrt(np.mean(x**2, axis=0))
+    x = np.empty((y.size, 4))
+    for j, d in enumerate((2, 1, 0)):
+        x[:, j] = savgol_filter(r_filled, win, polyorder, deriv=d, delta=dt)[keep]
+    x[:, 3] = 1.0
+    scale = np.sqrt(np.einsum("ij,ij->j", x, x) / y.size)
     scale[scale == 0] = 1.0
-    beta_s, *_ = np.linalg.lstsq(x / scale, y, rcond=None)
+    x /= scale
+    # normal equations of the column-scaled problem: four well-scaled columns, one pass over the rows
+    gram_inv = np.linalg.pinv(x.T @ x)
+    beta_s = gram_inv @ (x.T @ y)
+    resid = y - x @ beta_s
     beta = beta_s / scale
-    resid = y - x @ beta
-    dof = max(len(y) - x.shape[1], 1)
+    dof = max(y.size - x.shape[1], 1)
     sigma2 = float(resid @ resid) / dof
-    xs = x / scale
-    cov = sigma2 * np.linalg.pinv(xs.T @ xs) / np.outer(scale, scale)
-    se = np.sqrt(np.diag(cov))
+    se = np.sqrt(np.diag(sigma2 * gram_inv)) / scale
     ss_tot = float(np.sum((y - y.mean()) ** 2))
     r2 = 1.0 - float(resid @ resid) / ss_tot if ss_tot > 0 else float("nan")
     span = float(y.max() - y.min())
@@ -156,10 +163,8 @@ def fit_axis(log: RigLog, axis: str, window_s: float | None = None, polyorder: i
     geometric = (
         specimen_mass(log.factors) if log.factors is not None and not units.is_rotational(axis) else None
     )
-    spring = abs(k) * float(np.sqrt(np.mean(cols[2] ** 2)))
-    inertia_ratio = (
-        abs(m_log) * float(np.sqrt(np.mean(cols[0] ** 2))) / spring if spring > 0 else float("inf")
-    )
+    spring = abs(k) * float(scale[2])
+    inertia_ratio = abs(m_log) * float(scale[0]) / spring if spring > 0 else float("inf")
     return AxisFit(
         axis=axis,
         m=m,
@@ -193,3 +198,34 @@ def identify(
         if progress is not None:
             progress((i + 1) / len(chosen))
     return Identification(path=log.path, factors=log.factors, rate=log.rate, axes=fits)
+
+
+def results_table(results: list[Identification]) -> pd.DataFrame:
+    """The coefficient table `designer fit` reads: factors, c and k per axis, m where identified.
+
+    An axis's m column appears only when m was identified in every log; fit quality (`r2_<axis>`,
+    `nrmse_<axis>`) and the log's path ride along as extra columns.
+    """
+    rows = []
+    for res in results:
+        if res.factors is None:
+            raise DesignerError(
+                f"{res.path}: no factors", "write them to the log's JSON sidecar to build a coefficient table"
+            )
+        rows.append(dict(res.factors))
+    axes = [a for a in units.AXES if all(a in r.axes for r in results)]
+    if not axes:
+        raise DesignerError("the logs share no axis", "identify logs of the same axes together")
+    for row, res in zip(rows, results, strict=True):
+        for a in axes:
+            f = res.axes[a]
+            row[f"c_{a}"], row[f"k_{a}"] = f.c, f.k
+            if all(r.axes[a].m_identified for r in results):
+                row[f"m_{a}"] = f.m
+            row[f"r2_{a}"], row[f"nrmse_{a}"] = f.r2, f.nrmse
+        row["log"] = str(res.path)
+    table = pd.DataFrame(rows)
+    front = list(space.FACTOR_NAMES) + [
+        f"{q}_{a}" for a in axes for q in units.QUANTITIES if f"{q}_{a}" in table
+    ]
+    return table[front + [col for col in table.columns if col not in front]]

@@ -1,0 +1,333 @@
+"""Commands of the study's pipeline: identify, rig simulate, clean, doe, analyze."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from designer.errors import DesignerError
+
+from .common import console, print_json, progress
+
+rig_app = typer.Typer(help="The virtual rig: simulate the study's experiment.", no_args_is_help=True)
+
+_FACTOR_HELP = "specimen factor written to the log's sidecar (give all six, or none)"
+
+
+def identify(
+    logs: Annotated[
+        list[Path], typer.Argument(help="rig logs (CSV or Parquet), each with its factor sidecar")
+    ],
+    output: Annotated[
+        Path | None, typer.Option("-o", "--output", help="write the coefficient table (CSV)")
+    ] = None,
+    window: Annotated[
+        float | None, typer.Option(help="Savitzky-Golay window, s (default: from the excitation)")
+    ] = None,
+    json_out: Annotated[bool, typer.Option("--json", help="print JSON")] = False,
+) -> None:
+    """Identify m, c, k per axis from rig logs (least squares of F = m r'' + c r' + k r).
+
+    Example: designer identify run1.csv run2.parquet -o table.csv
+    """
+    from designer.rig.identify import identify as run
+    from designer.rig.identify import results_table
+
+    results = []
+    with progress("identifying") as bar:
+        for i, path in enumerate(logs):
+            results.append(run(path, window_s=window, progress=lambda f, i=i: bar((i + f) / len(logs))))
+    if output is not None:
+        results_table(results).pipe(_write_csv, output)
+    if json_out:
+        print_json({"logs": [r.to_dict() for r in results], "table": None if output is None else str(output)})
+        return
+    from rich.table import Table
+
+    from designer import units
+
+    for res in results:
+        table = Table(title=f"{res.path}  ({res.rate:g} Hz)")
+        for col in ("axis", "k", "c", "m", "R2", "NRMSE"):
+            table.add_column(col)
+        for a, f in res.axes.items():
+            table.add_row(
+                a,
+                f"{f.k:.4g} +/- {f.k_se:.2g} {units.rig_unit('k', a)}",
+                f"{f.c:.4g} +/- {f.c_se:.2g} {units.rig_unit('c', a)}",
+                f"{f.m:.3g} +/- {f.m_se:.2g} {units.rig_unit('m', a)}",
+                f"{f.r2:.5f}",
+                f"{100 * f.nrmse:.3g} %",
+            )
+        console.print(table)
+        for f in res.axes.values():
+            console.print(f"  {f.axis}: {f.statement()}")
+    if output is not None:
+        console.print(f"wrote {output}")
+
+
+def _write_csv(df, path: Path) -> None:
+    from designer.files import atomic_write
+
+    with atomic_write(path, newline="") as fh:
+        df.to_csv(fh, index=False)
+
+
+@rig_app.command("simulate")
+def simulate(
+    output: Annotated[Path, typer.Option("-o", "--output", help="log to write (.csv, or .parquet)")],
+    k: Annotated[float, typer.Option(help="stiffness, N/mm (N.mm/rad for rotational axes)")],
+    c: Annotated[float, typer.Option(help="damping, N.s/mm (N.mm.s/rad for rotational axes)")],
+    m: Annotated[float, typer.Option(help="mass, kg (inertia kg.m^2 for rotational axes)")] = 0.001,
+    axis: Annotated[list[str], typer.Option(help="axis to simulate; repeat for several")] = ("x",),
+    duration: Annotated[float, typer.Option(help="run length T, s (the study: 2200)")] = 2200.0,
+    rate: Annotated[float, typer.Option(help="sampling rate, Hz")] = 1000.0,
+    amplitude: Annotated[float, typer.Option(help="motion of each axis per rad of hub, mm or rad")] = 1.0,
+    noise: Annotated[float, typer.Option(help="force noise, fraction of the RMS load")] = 0.01,
+    dropouts: Annotated[
+        float, typer.Option(help="fraction of samples in dropout segments (NaN or zero)")
+    ] = 0.0,
+    seed: Annotated[int | None, typer.Option(help="random seed")] = None,
+    f0: Annotated[float, typer.Option(help="chirp start frequency, Hz")] = 0.2,
+    f1: Annotated[float, typer.Option(help="chirp end frequency, Hz")] = 1.85,
+    density: Annotated[float | None, typer.Option(help=_FACTOR_HELP)] = None,
+    length: Annotated[float | None, typer.Option(help=_FACTOR_HELP)] = None,
+    width: Annotated[float | None, typer.Option(help=_FACTOR_HELP)] = None,
+    height: Annotated[float | None, typer.Option(help=_FACTOR_HELP)] = None,
+    layer: Annotated[float | None, typer.Option(help=_FACTOR_HELP)] = None,
+    raster: Annotated[float | None, typer.Option(help=_FACTOR_HELP)] = None,
+) -> None:
+    """Drive a joint with the study's chirp (0.2 to 1.85 Hz) and write the rig log.
+
+    Example: designer rig simulate --k 0.8 --c 2e-3 --m 0.001 --duration 200 --dropouts 0.001 -o log.csv
+    """
+    from designer.rig.logs import write_log
+    from designer.rig.simulate import simulate as run
+
+    given = {"density": density, "length": length, "width": width, "height": height}
+    given |= {"layer": layer, "raster": raster}
+    factors = {n: v for n, v in given.items() if v is not None}
+    if factors and len(factors) < 6:
+        missing = ", ".join(f"--{n}" for n, v in given.items() if v is None)
+        raise DesignerError(f"missing factor(s) {missing}", "give all six factors, or none")
+    with progress("simulating") as bar:
+        df = run(
+            {a: {"m": m, "c": c, "k": k} for a in axis},
+            duration=duration,
+            rate=rate,
+            amplitude=amplitude,
+            noise=noise,
+            dropouts=dropouts,
+            seed=seed,
+            f0=f0,
+            f1=f1,
+        )
+        bar(0.5)
+        write_log(df, output, factors or None)
+        bar(1.0)
+    console.print(f"wrote {output}: {len(df)} rows, {duration:g} s at {rate:g} Hz, axes {', '.join(axis)}")
+
+
+def clean(
+    table: Annotated[
+        Path, typer.Argument(help="coefficient table (CSV or Parquet), e.g. from designer identify")
+    ],
+    output: Annotated[Path | None, typer.Option("-o", "--output", help="write the kept runs (CSV)")] = None,
+    eps: Annotated[float, typer.Option(help="DBSCAN radius in standard deviations (the study: 0.5)")] = 0.5,
+    min_samples: Annotated[int, typer.Option(help="DBSCAN core size (the study: 5)")] = 5,
+    json_out: Annotated[bool, typer.Option("--json", help="print JSON")] = False,
+) -> None:
+    """Drop runs with NaN or zero coefficients, then DBSCAN outliers; say why for each.
+
+    Example: designer clean table.csv -o clean.csv
+    """
+    import pandas as pd
+
+    from designer.rig.clean import clean as run
+
+    if not table.exists():
+        raise DesignerError(f"no such table: {table}", "give the path of a CSV or Parquet table")
+    raw = pd.read_parquet(table) if table.suffix.lower() in (".parquet", ".pq") else pd.read_csv(table)
+    res = run(raw, eps=eps, min_samples=min_samples, source=table.name)
+    if output is not None:
+        _write_csv(res.table, output)
+    if json_out:
+        print_json(res.summary())
+        return
+    console.print(f"kept {len(res.table)} of {len(raw)} runs")
+    for row in res.dropped.itertuples():
+        console.print(f"  dropped row {row.row}: {row.reason}")
+    if output is not None:
+        console.print(f"wrote {output}")
+
+
+def doe(
+    output: Annotated[Path | None, typer.Option("-o", "--output", help="write the run sheet (CSV)")] = None,
+    center: Annotated[
+        int | None, typer.Option(help="centre runs (default 3 per layer x raster; 6 all-continuous)")
+    ] = None,
+    seed: Annotated[int | None, typer.Option(help="random seed of the run order")] = None,
+    all_continuous: Annotated[
+        bool, typer.Option(help="Box and Behnken's 1960 six-factor design instead")
+    ] = False,
+    augment: Annotated[
+        int | None, typer.Option(help="pick N specimens that most narrow the surrogate's PIs")
+    ] = None,
+    k: Annotated[float | None, typer.Option(help="with --augment: target stiffness, N/mm")] = None,
+    c: Annotated[float | None, typer.Option(help="with --augment: target damping, N.s/mm")] = None,
+    axis: Annotated[str, typer.Option(help="with --augment and a target: its axis")] = "x",
+    data: Annotated[
+        Path | None, typer.Option(help="with --augment: table to fit (default: bundled surrogate)")
+    ] = None,
+    json_out: Annotated[bool, typer.Option("--json", help="print JSON")] = False,
+) -> None:
+    """Plan specimens: the study's Box-Behnken run sheet, or the next N that most narrow the 95 % PIs.
+
+    Example: designer doe --seed 1 -o plan.csv
+    Example: designer doe --augment 8 --k 0.8 --c 2e-3 -o next.csv
+    """
+    from designer import doe as plans
+
+    if augment is None:
+        if k is not None or c is not None or data is not None:
+            raise DesignerError("--k, --c and --data go with --augment", "add --augment N")
+        if all_continuous:
+            plan = plans.all_continuous_plan(plans.CENTER_BB6 if center is None else center, seed)
+        else:
+            plan = plans.study_plan(plans.CENTER if center is None else center, seed)
+        _finish_plan(plan, output, json_out, {})
+        return
+    plan, narrowing = _augment(plans, augment, k, c, axis, data)
+    _finish_plan(plan, output, json_out, narrowing)
+
+
+def _augment(plans, n: int, k: float | None, c: float | None, axis: str, data: Path | None):
+    from designer.surrogate import Surrogate
+
+    from designer.data import load_table
+
+    sur = Surrogate().fit(load_table(data)) if data is not None else Surrogate.load_default()
+    target = {r: v for r, v in ((f"k_{axis}", k), (f"c_{axis}", c)) if v is not None}
+    unknown = [r for r in target if r not in sur.responses]
+    if unknown:
+        raise DesignerError(f"the surrogate has no {unknown[0]}", f"it predicts {', '.join(sur.responses)}")
+    near = None
+    if target:
+        near = plans.near_target(lambda X: {r: p.value for r, p in sur.predict(X).items()}, target)
+    with progress("choosing specimens") as bar:
+        return plans.augment(n, sur.models, sur.table, target=near, progress=bar)
+
+
+def _finish_plan(plan, output: Path | None, json_out: bool, narrowing: dict) -> None:
+    import math
+
+    from designer import units
+
+    if output is not None:
+        _write_csv(plan, output)
+    if json_out:
+        print_json({"runs": plan.to_dict(orient="records"), "pi_narrowing": narrowing})
+        return
+    from rich.table import Table
+
+    table = Table()
+    for col in plan.columns:
+        table.add_column(col)
+    for row in plan.itertuples(index=False):
+        table.add_row(*(f"{v:g}" if isinstance(v, float) else str(v) for v in row))
+    console.print(table)
+    console.print(f"{len(plan)} runs")
+    for resp, nar in narrowing.items():
+        before, after = nar["half_width_before"], nar["half_width_after"]
+        if nar["transform"] == "log":
+            text = f"x/ {math.exp(before):.3g} -> x/ {math.exp(after):.3g}"
+        else:
+            q, a = resp.split("_", 1)
+            text = f"+/- {before:.3g} -> +/- {after:.3g} {units.rig_unit(q, a)}"
+        console.print(f"{resp}: mean 95 % PI half-width {text} ({100 * (1 - after / before):.1f} % narrower)")
+    if output is not None:
+        console.print(f"wrote {output}")
+
+
+def analyze(
+    data: Annotated[
+        Path | None, typer.Option(help="coefficient table (default: the bundled study table)")
+    ] = None,
+    json_out: Annotated[bool, typer.Option("--json", help="print JSON")] = False,
+) -> None:
+    """MANOVA over the responses, ANOVA per response with contribution %, correlations, Table 4.
+
+    Example: designer analyze --json
+    """
+    from designer.data import load_table
+    from designer.stats import analyze as run
+
+    res = run(load_table(data))
+    if json_out:
+        print_json(res)
+        return
+    from rich.table import Table
+
+    for resp, rows in res["anova"].items():
+        table = Table(title=f"ANOVA of {resp} (type III, first-order, {res['runs']} runs)")
+        for col in ("source", "DF", "SS", "F", "p", "contribution"):
+            table.add_column(col)
+        for r in rows:
+            table.add_row(
+                r["source"],
+                f"{r['df']:g}",
+                f"{r['sum_sq']:.3g}",
+                "" if r["F"] != r["F"] else f"{r['F']:.3f}",
+                "" if r["p"] != r["p"] else f"{r['p']:.3g}",
+                "" if r["contribution_pct"] != r["contribution_pct"] else f"{r['contribution_pct']:.1f} %",
+            )
+        console.print(table)
+    if res["manova"]:
+        table = Table(title="MANOVA")
+        for col in ("source", "statistic", "value", "F", "DF", "p"):
+            table.add_column(col)
+        for r in res["manova"]:
+            table.add_row(
+                r["source"],
+                r["statistic"],
+                f"{r['value']:.4g}",
+                f"{r['F']:.3f}",
+                f"{r['df1']:g}, {r['df2']:g}",
+                f"{r['p']:.3g}",
+            )
+        console.print(table)
+    corr = Table(title="Correlation")
+    names = list(res["correlation"])
+    corr.add_column("")
+    for n in names:
+        corr.add_column(n)
+    for n in names:
+        corr.add_row(n, *(f"{res['correlation'][m][n]:+.2f}" for m in names))
+    console.print(corr)
+    if "table4" in res:
+        table = Table(title="k_x against the paper's Table 4")
+        for col in ("source", "F paper", "F", "diff", "p paper", "p", "agrees"):
+            table.add_column(col)
+        for r in res["table4"]["rows"]:
+            table.add_row(
+                r["source"],
+                f"{r['F_paper']:.3f}",
+                f"{r['F']:.3f}",
+                f"{r['F_diff_pct']:+.1f} %",
+                f"{r['p_paper']:.3g}",
+                f"{r['p']:.3g}",
+                "yes" if r["agrees"] else "NO",
+            )
+        console.print(table)
+        console.print(res["table4"]["note"])
+
+
+def register(app: typer.Typer) -> None:
+    """Add identify, rig simulate, clean, doe and analyze to the `designer` command."""
+    app.command()(identify)
+    app.add_typer(rig_app, name="rig")
+    app.command()(clean)
+    app.command()(doe)
+    app.command()(analyze)
