@@ -11,7 +11,8 @@ from typing import Any
 
 from rich.console import Console
 
-console = Console(highlight=False)
+# piped output is not cut at rich's 80-column default: numbers must never be truncated
+console = Console(highlight=False, width=None if sys.stdout.isatty() else 120)
 err_console = Console(stderr=True, highlight=False)
 
 

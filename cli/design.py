@@ -223,24 +223,24 @@ def suggest(
 
 
 def _print_suggestion(data: dict) -> None:
+    from rich import box
     from rich.table import Table
 
     u = data["units"]
     goals = ", ".join(f"{q} = {v:g} {u[q]}" for q, v in data["targets"].items() if v is not None)
-    tab = Table(title=f"Designs for {goals} on axis {data['axis']}")
-    for col in (
-        "#",
-        "density %",
-        "length mm",
-        "width mm",
-        "height mm",
-        "layer mm",
-        "raster deg",
-        f"k {u['k']} [95 % PI]",
-        f"c {u['c']} [95 % PI]",
-        "desirability",
-    ):
-        tab.add_column(col, justify="right")
+    # an unpredictable response has the same prediction everywhere: stated below, not repeated per row
+    shown = [q for q in ("k", "c") if data["predictability"][q]["predictable"]] or ["k", "c"]
+    tab = Table(
+        title=f"Designs for {goals} on axis {data['axis']}",
+        box=box.SIMPLE_HEAD,
+        pad_edge=False,
+        collapse_padding=True,
+    )
+    for col in ("#", "infill\n%", "l\nmm", "b\nmm", "h\nmm", "layer\nmm", "raster\ndeg"):
+        tab.add_column(col, justify="right", no_wrap=True)
+    for q in shown:
+        tab.add_column(f"{q} {u[q]}\n[95 % PI]", justify="right", no_wrap=True)
+    tab.add_column("D", justify="right", no_wrap=True)
     for i, cand in enumerate(data["candidates"], 1):
         p, pr = cand["params"], cand["predicted"]
         tab.add_row(
@@ -251,11 +251,11 @@ def _print_suggestion(data: dict) -> None:
             f"{p['height']:g}",
             f"{p['layer']:g}",
             f"{p['raster']:g}",
-            _pi(pr["k"]["value"], pr["k"]["pi95"]),
-            _pi(pr["c"]["value"], pr["c"]["pi95"]),
+            *[_pi(pr[q]["value"], pr[q]["pi95"]) for q in shown],
             f"{cand['desirability']:.3f}",
         )
     console.print(tab)
+    console.print("l, b, h: length, width, height; D: composite desirability (1 = every target met)")
     style = "green" if data["reachable"] else "bold red"
     for s in data["statements"]:
         console.print(f"[{style}]-[/{style}] {s}")

@@ -204,9 +204,8 @@ def doe(
 
 
 def _augment(plans, n: int, k: float | None, c: float | None, axis: str, data: Path | None):
-    from designer.surrogate import Surrogate
-
     from designer.data import load_table
+    from designer.surrogate import Surrogate
 
     sur = Surrogate().fit(load_table(data)) if data is not None else Surrogate.load_default()
     target = {r: v for r, v in ((f"k_{axis}", k), (f"c_{axis}", c)) if v is not None}
