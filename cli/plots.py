@@ -77,13 +77,14 @@ def heatmap_cmd(
     """
     from designer.data import load_table
     from designer.plots import common, heatmap
+    from designer.stats import correlation
 
     common.check_image_path(output)
     t = load_table(table)
     responses = common.responses_for(t, None, axis)
     path = heatmap.plot_heatmap(t, responses, output)
     if as_json:
-        print_json({"figure": str(path), "correlations": heatmap.correlations(t, responses).to_dict()})
+        print_json({"figure": str(path), "correlations": correlation(t, responses).to_dict()})
     else:
         _saved(path)
 

@@ -42,7 +42,9 @@ def test_effects_png(table, tmp_path):
 
 
 def test_correlations_are_pearson(table):
-    corr = heatmap.correlations(table, ["c_x", "k_x"])
+    from designer.stats import correlation
+
+    corr = correlation(table, ["c_x", "k_x"])
     assert corr.loc["width", "k_x"] == pytest.approx(np.corrcoef(table.width, table.k_x)[0, 1])
     assert corr.loc["width", "k_x"] < -0.3  # the study's Fig 13: width lowers stiffness
     assert np.allclose(np.diag(corr), 1.0)

@@ -245,29 +245,12 @@ def write_outputs(sc: Scenario, out: Path, frame: pd.DataFrame, summary: dict) -
 
 def plot(frame: pd.DataFrame, path: Path) -> Path:
     """Angles (or coordinate and hub) and loads against time, one panel each."""
-    import matplotlib
+    from ..plots.timeseries import plot_timeseries
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    angles = [c for c in frame.columns if c.endswith((".q", ".motor", ".s")) and not c.endswith(".v")]
+    angles = [c for c in frame.columns if c.endswith((".q", ".motor", ".s"))]
     loads = [c for c in frame.columns if c.endswith((".f", ".tau"))]
-    fig, (ax1, ax2) = plt.subplots(2, 1, sharex=True, figsize=(8, 6))
-    for c in angles:
-        ax1.plot(frame["t"], frame[c], label=c, lw=0.8)
-    for c in loads:
-        ax2.plot(frame["t"], frame[c], label=c, lw=0.8)
-    ax1.set_ylabel("angle [rad] / coordinate [SI]")
-    ax2.set_ylabel("torque [N.m] / force [N]")
-    ax2.set_xlabel("t [s]")
-    for ax in (ax1, ax2):
-        ax.legend(fontsize=7, loc="upper right")
-        ax.grid(alpha=0.3)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=120)
-    plt.close(fig)
-    return path
+    panels = {"angle [rad] / coordinate [SI]": angles, "torque [N.m] / force [N]": loads}
+    return plot_timeseries(frame, path, panels={label: cols for label, cols in panels.items() if cols})
 
 
 def simulate(sc: Scenario, out: Path, with_validation: bool = False, progress: Progress = None) -> dict:

@@ -7,21 +7,15 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import space
+from ..stats import correlation
 from .common import save_figure
-
-
-def correlations(table: pd.DataFrame, responses: list[str]) -> pd.DataFrame:
-    """Pearson correlation matrix of the six factors and the responses, as the study's Fig 13."""
-    cols = list(space.FACTOR_NAMES) + list(responses)
-    return table[cols].corr(method="pearson")
 
 
 def plot_heatmap(table: pd.DataFrame, responses: list[str], path: str | Path) -> Path:
     """Annotated heat map of the correlations, -1 (blue) to 1 (red)."""
     import matplotlib.pyplot as plt
 
-    corr = correlations(table, responses)
+    corr = correlation(table, responses)
     n = len(corr)
     fig, ax = plt.subplots(figsize=(0.75 * n + 2.5, 0.75 * n + 1.5))
     im = ax.imshow(corr.to_numpy(), cmap="coolwarm", vmin=-1, vmax=1)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 
 import pandas as pd
@@ -19,33 +20,37 @@ def plot_timeseries(
     columns: list[str] | None = None,
     time: str = "t",
     reference: pd.DataFrame | None = None,
+    panels: Mapping[str, list[str]] | None = None,
 ) -> Path:
-    """Each column of `frame` against `time` (s); the same column of `reference` dashed, where it has one."""
+    """Columns of `frame` against `time` (s), one panel each (or grouped: `panels` maps a label to its
+    columns); the same column of `reference` dashed, where it has one."""
     import matplotlib.pyplot as plt
 
     if time not in frame.columns:
         raise DesignerError(
             f"the time series has no '{time}' column", f"it has {', '.join(map(str, frame.columns))}"
         )
-    columns = columns or [c for c in frame.columns if c != time]
-    missing = [c for c in columns if c not in frame.columns]
-    if missing or not columns:
+    if panels is None:
+        panels = {c: [c] for c in columns or [c for c in frame.columns if c != time]}
+    wanted = [c for cols in panels.values() for c in cols]
+    missing = [c for c in wanted if c not in frame.columns]
+    if missing or not wanted:
         raise DesignerError(
             f"no column {missing[0] if missing else 'to plot'}", f"choose from {', '.join(frame.columns)}"
         )
-    if len(columns) > MAX_PANELS:
+    if len(panels) > MAX_PANELS:
         raise DesignerError(
-            f"{len(columns)} signals is too many for one figure", f"pick at most {MAX_PANELS} with --columns"
+            f"{len(panels)} signals is too many for one figure", f"pick at most {MAX_PANELS} with --columns"
         )
-    fig, axes = plt.subplots(
-        len(columns), 1, sharex=True, figsize=(9, 1.9 * len(columns) + 0.8), squeeze=False
-    )
-    for ax, col in zip(axes[:, 0], columns, strict=True):
-        ax.plot(frame[time], frame[col], lw=0.9, label="co-simulation")
-        if reference is not None and col in reference.columns:
-            ax.plot(reference[time], reference[col], "k--", lw=0.8, label="reference")
+    fig, axes = plt.subplots(len(panels), 1, sharex=True, figsize=(9, 1.9 * len(panels) + 0.8), squeeze=False)
+    for ax, (label, cols) in zip(axes[:, 0], panels.items(), strict=True):
+        for col in cols:
+            ax.plot(frame[time], frame[col], lw=0.9, label=col if len(cols) > 1 else "co-simulation")
+            if reference is not None and col in reference.columns:
+                ax.plot(reference[time], reference[col], "k--", lw=0.8, label=f"{col} reference")
+        if len(cols) > 1 or reference is not None:
             ax.legend(fontsize=7, loc="upper right")
-        ax.set_ylabel(col, fontsize=8)
+        ax.set_ylabel(label, fontsize=8)
         ax.grid(alpha=0.3)
     axes[-1, 0].set_xlabel(f"{time} (s)")
     fig.tight_layout()

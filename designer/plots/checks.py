@@ -1,0 +1,67 @@
+"""Figures of the validation checks: Table 4 side by side, identified against true, error against step."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .common import save_figure
+
+
+def plot_table4(compare: pd.DataFrame, path: str | Path) -> Path:
+    """F of each source, the paper's Table 4 beside ours (`stats.compare_table4`), log scale."""
+    import matplotlib.pyplot as plt
+
+    x = np.arange(len(compare))
+    fig, ax = plt.subplots(figsize=(8, 4))
+    ax.bar(x - 0.2, compare["F_paper"], 0.4, label="paper's Table 4", color="0.6")
+    ax.bar(x + 0.2, compare["F"], 0.4, label="ours (bundled Table 3)", color="tab:blue")
+    ax.axhline(1.0, color="k", lw=0.6, ls=":")
+    ax.set_yscale("log")
+    ax.set_xticks(x, compare["source"])
+    ax.set_ylabel("F of k_x (type III)")
+    for i, ok in enumerate(compare["agrees"]):
+        ax.annotate("" if ok else "differs", (i, max(compare["F"].iloc[i], compare["F_paper"].iloc[i])))
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, axis="y")
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def plot_identification(rows: pd.DataFrame, tolerance_pct: float, path: str | Path) -> Path:
+    """Relative error of identified k and c per coefficient set, with the tolerance band."""
+    import matplotlib.pyplot as plt
+
+    x = np.arange(len(rows))
+    fig, ax = plt.subplots(figsize=(8, 3.8))
+    ax.axhspan(-tolerance_pct, tolerance_pct, color="tab:green", alpha=0.12, label=f"+/- {tolerance_pct:g} %")
+    ax.plot(x - 0.1, rows["k error %"], "o", label="k")
+    ax.plot(x + 0.1, rows["c error %"], "s", label="c")
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set_xticks(x, rows["set"], fontsize=8)
+    ax.set_ylabel("identified / true - 1 (%)")
+    ax.set_title("Virtual rig -> identification, closed loop")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def plot_convergence(steps: pd.DataFrame, path: str | Path, unit: str) -> Path:
+    """Error against macro step, log-log, every column of `steps` but "step" as one line."""
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 4.2))
+    h = steps["step"].to_numpy()
+    for col in steps.columns.drop("step"):
+        ax.loglog(h, np.maximum(steps[col].to_numpy(), 1e-18), "o-", label=col)
+    first = steps.columns.drop("step")[0]
+    ax.loglog(h, steps[first].iloc[-1] * h / h[-1], "k:", lw=0.8, label="first order")
+    ax.set_xlabel("macro step (s)")
+    ax.set_ylabel(f"max error ({unit})")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, which="both")
+    fig.tight_layout()
+    return save_figure(fig, path)
