@@ -8,7 +8,7 @@ import pytest
 
 
 def designer(*args, check=False):
-    cmd = [sys.executable, "-c", "from designer_cli.main import main; main()", *args]
+    cmd = [sys.executable, "-I", "-c", "from designer_cli.main import main; main()", *args]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=300, check=check)
 
 

@@ -12,7 +12,7 @@ import pytest
 from designer import space
 from designer.doe import all_continuous_plan, augment, box_behnken_6, near_target, printable_grid, study_plan
 
-CLI = [sys.executable, "-c", "from designer_cli.main import main; main()"]
+CLI = [sys.executable, "-I", "-c", "from designer_cli.main import main; main()"]
 
 
 def test_study_plan_is_bbdesign4_for_every_layer_and_raster():

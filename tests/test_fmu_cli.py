@@ -23,7 +23,7 @@ def run(*args, env=None):
 
     e = dict(os.environ, **(env or {}))
     return subprocess.run(
-        [sys.executable, "-c", "from designer_cli.main import main; main()", *args],
+        [sys.executable, "-I", "-c", "from designer_cli.main import main; main()", *args],
         capture_output=True,
         text=True,
         env=e,

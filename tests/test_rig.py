@@ -17,7 +17,7 @@ from designer.rig.logs import read_log, sidecar_path, validate_frame, write_log
 from designer.rig.simulate import Chirp, simulate
 
 FACTORS = {"density": 60, "length": 24, "width": 4.5, "height": 9, "layer": 0.16, "raster": 0}
-CLI = [sys.executable, "-c", "from designer_cli.main import main; main()"]
+CLI = [sys.executable, "-I", "-c", "from designer_cli.main import main; main()"]
 
 
 def _cli(*args, **kw):

@@ -10,7 +10,7 @@ import pytest
 from designer.data import load_table
 from designer.stats import anova, compare_table4, correlation, manova, paper_table4
 
-CLI = [sys.executable, "-c", "from designer_cli.main import main; main()"]
+CLI = [sys.executable, "-I", "-c", "from designer_cli.main import main; main()"]
 
 
 def test_table4_reproduced():
