@@ -2,6 +2,7 @@
 
 import json
 import textwrap
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -146,3 +147,76 @@ def test_cli_json(tmp_path):
     assert result.exit_code == 0, result.output
     doc = json.loads(result.stdout)
     assert set(doc["metrics"]) == {"j1", "j2"} and "validation" not in doc
+
+
+DESIGN = {"density": 60, "length": 24, "width": 4.5, "height": 9, "layer": 0.16, "raster": 45}
+DESIGN_TOML = "design = { density = 60, length = 24, width = 4.5, height = 9, layer = 0.16, raster = 45 }"
+
+
+def _suggestion(tmp_path):
+    from designer.suggest import suggest
+    from designer.surrogate import Surrogate
+
+    doc = suggest(Surrogate.load_default(), k=0.8, fixed={"length": 24}, top=2).to_dict()
+    (tmp_path / "s.json").write_text(json.dumps(doc))
+    return doc
+
+
+def test_joints_from_a_design_and_a_suggestion_run_through_the_surrogate(tmp_path):
+    from designer.export import sources
+
+    doc = _suggestion(tmp_path)
+    text = ARM.format(duration=0.3, step=1e-3, joint2='suggestion = "s.json"\ncandidate = 2')
+    sc = load(write(tmp_path, text.replace("coefficients = { k = 330, c = 0.83 }", DESIGN_TOML)))
+    expect = {
+        "j1": sources.from_design(DESIGN, ["theta"]).axes["theta"],
+        "j2": sources.from_suggestion(tmp_path / "s.json", 2, ["theta"]).axes["theta"],
+    }
+    # the suggestion's k on x (N/mm) taken to theta with the PRB model: K = k (0.85 L)^2
+    k2 = doc["candidates"][1]["predicted"]["k"]["value"] * (0.85 * 24) ** 2
+    assert expect["j2"].k == pytest.approx(k2, rel=1e-9) and 250 < k2 < 420
+    with cosim_run.joint_fmus(sc) as fmus:
+        for j, src in sc.joints.items():
+            law = cosim_run.law(src, fmus[j])
+            assert law["k"] == pytest.approx(expect[j].k * 1e-3, rel=1e-9)  # N.mm/rad -> N.m/rad
+            assert law["c"] == pytest.approx(expect[j].c * 1e-3, rel=1e-9)
+        res = cosim_run.robot_run(sc, fmus, sc.step, sc.duration, "gauss-seidel")
+    assert np.abs(res.column("robot.j2.s")).max() > 0.01
+    assert sc.joints["j2"].joint.provenance["source"] == "suggestion s.json, candidate 2"
+
+
+def test_rig_joint_from_a_design_has_the_predicted_mass(tmp_path):
+    text = RIG.replace("coefficients = { k = 330, c = 0.83, m = 2e-6 }", DESIGN_TOML)
+    src = load(write(tmp_path, text)).rig_joint
+    theta = src.joint.axes["theta"]
+    assert theta.m is not None and theta.m > 0 and theta.k > 0
+
+
+@pytest.mark.parametrize(
+    "joint2, message",
+    [
+        ('suggestion = "nothing.json"', "cannot read a suggestion"),
+        ('suggestion = "s.json"\ncandidate = 9', "candidate 9 does not exist"),
+        ('suggestion = "s.json"\ncandidate = "best"', "is not a whole number"),
+        ("coefficients = { k = 1, c = 1 }\ncandidate = 1", "candidate needs a suggestion"),
+        ('suggestion = "s.json"\n' + DESIGN_TOML, "it has: design, suggestion"),
+        ("design = { density = 60 }", "missing factor"),
+        ('design = "good"', "design must be a table"),
+        (DESIGN_TOML.replace("density = 60", "density = 300"), "outside the tested range"),
+    ],
+)
+def test_bad_design_and_suggestion_joints_fail_before_running(tmp_path, joint2, message):
+    _suggestion(tmp_path)
+    with pytest.raises(DesignerError, match=message):
+        load(arm(tmp_path, joint2=joint2))
+
+
+def test_the_arm_example_takes_its_joints_from_a_suggestion():
+    examples = Path(__file__).resolve().parent.parent / "examples"
+    sc = load(examples / "two_link_arm.toml")
+    for name, candidate in (("j1", 1), ("j2", 2)):
+        assert (
+            sc.joints[name].joint.provenance["source"] == f"suggestion suggestion.json, candidate {candidate}"
+        )
+        assert 250 < sc.joints[name].joint.axes["theta"].k < 420  # N.mm/rad
+    assert "designer suggest --k 0.8 --fix length=24" in (examples / "two_link_arm.sh").read_text()

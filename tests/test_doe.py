@@ -7,10 +7,10 @@ import sys
 
 import numpy as np
 import pandas as pd
-import pytest
 
 from designer import space
 from designer.doe import all_continuous_plan, augment, box_behnken_6, near_target, printable_grid, study_plan
+from designer.surrogate import Surrogate
 
 CLI = [sys.executable, "-I", "-c", "from designer_cli.main import main; main()"]
 
@@ -111,11 +111,26 @@ def test_cli_doe_writes_plan(tmp_path):
 
 
 def test_augment_with_the_surrogate():
-    surrogate = pytest.importorskip("designer.surrogate")
-    sur = surrogate.Surrogate.load_default()
+    sur = Surrogate.load_default()
     near = near_target(lambda X: {r: p.value for r, p in sur.predict(X).items()}, {"k_x": 0.8, "c_x": 2e-3})
     plan, narrowing = augment(6, sur.models, sur.table, target=near)
     assert len(plan) == 6
     space.validate(plan.iloc[0][list(space.FACTOR_NAMES)].to_dict())
     for resp in sur.responses:
         assert narrowing[resp]["half_width_after"] < narrowing[resp]["half_width_before"]
+
+
+def test_cli_augment_with_the_shipped_surrogate(tmp_path):
+    out = subprocess.run(
+        CLI + ["doe", "--augment", "4", "--k", "0.8", "-o", str(tmp_path / "next.csv"), "--json"],
+        capture_output=True,
+        text=True,
+    )
+    assert out.returncode == 0, out.stderr
+    doc = json.loads(out.stdout)
+    assert len(doc["runs"]) == 4 and len(pd.read_csv(tmp_path / "next.csv")) == 4
+    for run in doc["runs"]:
+        space.validate({f: run[f] for f in space.FACTOR_NAMES})
+    assert set(doc["pi_narrowing"]) == set(Surrogate.load_default().responses)
+    k = doc["pi_narrowing"]["k_x"]
+    assert k["half_width_after"] < k["half_width_before"]

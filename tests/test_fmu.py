@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import shutil
 import subprocess
+import sys
 import zipfile
 
 import numpy as np
@@ -66,6 +67,31 @@ def test_validate_fmu_reports_no_problem(fmus, version, interface):
     assert expected <= names and ("x.a" in names) == (interface == "body")
     k = next(v for v in md.modelVariables if v.name == "x.k")
     assert float(k.start) == K_SI and k.unit == "N/m" and k.causality == "parameter"
+
+
+@pytest.mark.parametrize("interface", ["force", "body"])
+def test_fmi2_start_values_follow_the_spec_and_the_fmi_library_parses_quietly(fmus, interface):
+    path = fmus[(2, interface)]
+    for v in read_model_description(str(path)).modelVariables:
+        # FMI 2 section 2.2.7: a start is required for parameters, inputs and initial exact/approx,
+        # forbidden otherwise and on the independent variable (left implicit, see export/fmu.py)
+        assert v.causality != "independent"
+        needs = v.causality in ("parameter", "input") or v.initial in ("exact", "approx")
+        assert (v.start is not None) == needs, v.name
+    script = (
+        "import sys\n"
+        "from libcosimpy.CosimExecution import CosimExecution\n"
+        "from libcosimpy.CosimLogging import CosimLogLevel, log_output_level\n"
+        "from libcosimpy.CosimSlave import CosimLocalSlave\n"
+        "log_output_level(CosimLogLevel.WARNING)\n"
+        "ex = CosimExecution.from_step_size(step_size=1_000_000)\n"
+        "slave = CosimLocalSlave(fmu_path=sys.argv[1], instance_name='j')\n"
+        "print('index', ex.add_local_slave(local_slave=slave))\n"
+    )
+    r = subprocess.run([sys.executable, "-c", script, str(path)], capture_output=True, text=True)
+    assert r.returncode == 0 and "index 0" in r.stdout, r.stderr
+    assert "Start attribute is required" not in r.stdout + r.stderr
+    assert "[error]" not in r.stdout + r.stderr and "[warning]" not in r.stdout + r.stderr
 
 
 @pytest.mark.parametrize("version", [2, 3])

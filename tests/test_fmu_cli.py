@@ -181,3 +181,50 @@ def test_cli_writes_snippets(tmp_path, fmt, suffix):
     r = run("export", fmt, "--k", "0.8", "--c", "2e-3", "--m", "0.01", "-o", str(out))
     assert r.returncode == 0, r.stderr
     assert "800" in out.read_text() and "N/m" in r.stdout
+
+
+def _starts(fmu) -> dict[str, float]:
+    from fmpy import read_model_description
+
+    md = read_model_description(str(fmu))
+    return {
+        v.name: float(v.start)
+        for v in md.modelVariables
+        if v.causality == "parameter" and not v.name.endswith(".enabled")
+    }
+
+
+def test_cli_exports_a_design_through_the_shipped_surrogate(tmp_path, cache_env):
+    import pandas as pd
+
+    from designer.surrogate import Surrogate
+
+    flags = [x for f, v in DESIGN.items() for x in (f"--{f}", str(v))]
+    out = tmp_path / "design.fmu"
+    args = ["export", "fmu", *flags, "--axis", "x", "--axis", "theta", "--interface", "body", "-o", str(out)]
+    r = run(*args, "--json", env=cache_env)
+    assert r.returncode == 0, r.stderr
+    axes = json.loads(r.stdout)["joint"]["axes"]
+    pred = Surrogate.load_default().predict(pd.DataFrame([DESIGN]))
+    k, c = float(pred["k_x"].value[0]), float(pred["c_x"].value[0])
+    assert axes["x"]["rig"]["k"] == pytest.approx(k) and axes["x"]["rig"]["c"] == pytest.approx(c)
+    assert axes["theta"]["rig"]["k"] == pytest.approx(k * (PRB_GAMMA * 24) ** 2)
+    starts = _starts(out)
+    assert starts["x.k"] == pytest.approx(k * 1e3) and starts["x.c"] == pytest.approx(c * 1e3)  # N/m, N.s/m
+    assert starts["theta.k"] == pytest.approx(axes["theta"]["si"]["k"]) and starts["x.m"] > 0
+
+
+def test_cli_exports_a_suggestion_from_designer_suggest(tmp_path, cache_env):
+    r = run("suggest", "--k", "0.8", "--fix", "length=24", "--top", "2", "--json", env=cache_env)
+    assert r.returncode == 0, r.stderr
+    (tmp_path / "s.json").write_text(r.stdout)
+    cand = json.loads(r.stdout)["candidates"][1]
+    out = tmp_path / "s.fmu"
+    r = run(
+        "export", "fmu", "--from", str(tmp_path / "s.json"), "--candidate", "2", "--axis", "theta",
+        "--fmi", "3", "-o", str(out), "--json", env=cache_env,
+    )  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    theta = json.loads(r.stdout)["joint"]["axes"]["theta"]
+    k = cand["predicted"]["k"]["value"] * (PRB_GAMMA * 24) ** 2  # N.mm/rad
+    assert theta["rig"]["k"] == pytest.approx(k) and _starts(out)["theta.k"] == pytest.approx(k * 1e-3)

@@ -25,7 +25,7 @@ Progress = Callable[[float], None] | None
 
 @contextlib.contextmanager
 def joint_fmus(sc: Scenario) -> Iterator[dict[str, Path]]:
-    """The FMU file of every joint (key "rig" for the rig), exporting coefficients into a temporary folder."""
+    """The FMU file of every joint (key "rig" for the rig), exporting the others into a temporary folder."""
     sources = {"rig": sc.rig_joint} if sc.kind == "rig" else sc.joints
     with tempfile.TemporaryDirectory(prefix="designer-cosim-") as tmp:
         paths = {}
@@ -34,12 +34,10 @@ def joint_fmus(sc: Scenario) -> Iterator[dict[str, Path]]:
                 paths[name] = src.fmu
                 continue
             from ..export.fmu import export_fmu
-            from ..joint import from_coefficients
 
-            joint = from_coefficients({src.axis: src.coefficients}, name=f"joint_{name}")
             interface = "body" if sc.kind == "rig" else "force"
             paths[name] = export_fmu(
-                joint, Path(tmp) / f"{name}.fmu", fmi_version=src.fmi_version, interface=interface
+                src.joint, Path(tmp) / f"{name}.fmu", fmi_version=src.fmi_version, interface=interface
             )
         yield paths
 

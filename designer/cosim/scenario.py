@@ -7,14 +7,19 @@ take `[simulation]`, `[outputs]` and `[validation]`. The README documents every 
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import tomllib
+if sys.version_info >= (3, 11):
+    import tomllib
+else:
+    import tomli as tomllib
 
 from .. import units
 from ..errors import DesignerError
+from ..joint import Joint, from_coefficients
 from .master import ALGORITHMS
 from .references import Chirp, Reference, Sine, Step, Trajectory
 from .robot import ARM_LENGTHS, ARM_MASSES, INTEGRATORS
@@ -24,11 +29,11 @@ FMI_VERSIONS = (2, 3)
 
 @dataclass(frozen=True)
 class JointSource:
-    """Where a joint FMU comes from: a file, or coefficients (rig units) exported on the fly."""
+    """Where a joint FMU comes from: a file, or a joint (coefficients, design, suggestion) to export."""
 
     axis: str
     fmu: Path | None = None
-    coefficients: dict[str, float] | None = None
+    joint: Joint | None = None
     fmi_version: int = 2
     parameters: dict[str, float] = field(default_factory=dict)
 
@@ -139,7 +144,10 @@ def _chirp(spec: dict, path: Path) -> Chirp:
     )
 
 
-def _joint_source(spec: Any, key: str, path: Path, default_axis: str) -> JointSource:
+SOURCES = ("fmu", "coefficients", "design", "suggestion")
+
+
+def _joint_source(spec: Any, key: str, path: Path, default_axis: str, name: str) -> JointSource:
     if not isinstance(spec, dict):
         raise DesignerError(f"{_where(path, key)} must be a table", "see the scenario format in the README")
     axis = units.check_axis(spec.get("axis", default_axis))
@@ -147,25 +155,52 @@ def _joint_source(spec: Any, key: str, path: Path, default_axis: str) -> JointSo
     params = spec.get("parameters", {})
     if not isinstance(params, dict):
         raise DesignerError(f"{_where(path, key)}.parameters must be a table", 'e.g. {"theta.k" = 0.3}')
-    has = [k for k in ("fmu", "coefficients") if k in spec]
+    has = [k for k in SOURCES if k in spec]
     if len(has) != 1:
         raise DesignerError(
-            f"{_where(path, key)} needs exactly one of fmu or coefficients",
-            f"it has: {', '.join(has) or 'neither'}",
+            f"{_where(path, key)} needs exactly one of {', '.join(SOURCES)}",
+            f"it has: {', '.join(has) or 'none'}",
         )
+    if "candidate" in spec and "suggestion" not in spec:
+        raise DesignerError(f"{_where(path, key)}.candidate needs a suggestion", 'add suggestion = "s.json"')
     if "fmu" in spec:
         fmu = _file(spec["fmu"], f"{key}.fmu", path)
         from .fmu import check_fmu
 
         check_fmu(fmu, [axis])
         return JointSource(axis=axis, fmu=fmu, fmi_version=version, parameters=params)
+    joint = _joint(spec, key, path, axis, name)
+    return JointSource(axis=axis, joint=joint, fmi_version=version, parameters=params)
+
+
+def _joint(spec: dict, key: str, path: Path, axis: str, name: str) -> Joint:
+    """The joint of a coefficients, design (through the default surrogate) or suggestion source."""
+    from ..export import sources
+
+    if "suggestion" in spec:
+        candidate = spec.get("candidate", 1)
+        if isinstance(candidate, bool) or not isinstance(candidate, int):
+            raise DesignerError(
+                f"{_where(path, key)}.candidate = {candidate!r} is not a whole number", "1 = best"
+            )
+        return sources.from_suggestion(
+            _file(spec["suggestion"], f"{key}.suggestion", path), candidate, [axis], name
+        )
+    if "design" in spec:
+        design = spec["design"]
+        if not isinstance(design, dict):
+            raise DesignerError(
+                f"{_where(path, key)}.design must be a table of the six print settings",
+                "e.g. {density = 60, length = 24, width = 4.5, height = 9, layer = 0.16, raster = 45}",
+            )
+        return sources.from_design(design, [axis], name)
     coef = spec["coefficients"]
     if not isinstance(coef, dict) or not {"k", "c"} <= set(coef):
         raise DesignerError(
             f"{_where(path, key)}.coefficients needs k and c (rig units)", "e.g. {k = 300, c = 0.8, m = 2e-6}"
         )
     coef = {q: _number(coef, q, path, positive=q != "c") for q in coef}
-    return JointSource(axis=axis, coefficients=coef, fmi_version=version, parameters=params)
+    return from_coefficients({axis: coef}, name=name)
 
 
 def load(path: str | Path) -> Scenario:
@@ -218,7 +253,7 @@ def load(path: str | Path) -> Scenario:
             factors = space.validate(factors)
         return Scenario(
             kind="rig",
-            rig_joint=_joint_source(rig.get("joint"), "rig.joint", path, "theta"),
+            rig_joint=_joint_source(rig.get("joint"), "rig.joint", path, "theta", "joint_rig"),
             hub=_chirp(rig, path),
             factors=factors,
             **common,
@@ -241,7 +276,7 @@ def _robot(doc: dict, path: Path, common: dict) -> Scenario:
     check_joints(spec, list(joints_doc))
     joints, motors = {}, {}
     for name, spec_j in joints_doc.items():
-        joints[name] = _joint_source(spec_j, f"joints.{name}", path, "theta")
+        joints[name] = _joint_source(spec_j, f"joints.{name}", path, "theta", f"joint_{name}")
         motors[name] = _reference(
             spec_j.get("reference", {"type": "step", "amplitude": 0.0}), f"joints.{name}.reference", path
         )

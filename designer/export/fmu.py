@@ -248,6 +248,9 @@ def _description(joint: Joint, interface: str) -> str:
 
 
 def _fmi2_description(joint: Joint, interface: str, variables: list[Variable]) -> str:
+    # FMI 2 makes "time" implicit and forbids a start on an explicit independent variable, which the
+    # FMI Library in libcosim then reports as a missing start (its issue #21): leave it out
+    variables = [v for v in variables if v.causality != "independent"]
     index = {v.name: i + 1 for i, v in enumerate(variables)}
     sources = "\n".join(f'      <File name="{Path(p).name}"/>' for p in build.c_sources(2))
     caps = (
