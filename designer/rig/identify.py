@@ -219,24 +219,32 @@ def fit_axis(log: RigLog, axis: str, window_s: float | None = None, polyorder: i
             "the log has too little valid data to identify; record again",
         )
     y = force[keep]
-    # columns as rows: r'', r', r and the constant, each contiguous
-    x = np.ones((4, y.size))
-    x[:3] = _derivatives(r_filled, win, polyorder, dt)[:, keep]
-    scale = np.sqrt(np.einsum("ij,ij->i", x, x) / y.size)
+    # columns r'', r', r (rows here) and the constant; left-out rows zeroed instead of copied out
+    bad_rows = np.flatnonzero(bad)
+    d = _derivatives(r_filled, win, polyorder, dt)
+    d[:, bad_rows] = 0.0
+    y0 = np.where(keep, force, 0.0)
+    gram = np.empty((4, 4))
+    gram[:3, :3] = d @ d.T
+    gram[:3, 3] = gram[3, :3] = d.sum(axis=1)
+    gram[3, 3] = y.size
+    moment = np.append(d @ y0, y.sum())
+    scale = np.sqrt(np.diag(gram) / y.size)
     scale[scale == 0] = 1.0
-    x /= scale[:, None]
-    # normal equations of the column-scaled problem: four well-scaled columns, one pass over the rows
-    gram_inv = np.linalg.pinv(x @ x.T)
-    beta_s = gram_inv @ (x @ y)
-    resid = y - beta_s @ x
+    # normal equations of the column-scaled problem: four well-scaled columns
+    gram_inv = np.linalg.pinv(gram / np.outer(scale, scale))
+    beta_s = gram_inv @ (moment / scale)
     beta = beta_s / scale
-    dof = max(y.size - x.shape[0], 1)
-    sigma2 = float(resid @ resid) / dof
+    resid = y0 - beta[:3] @ d - beta[3]
+    resid[bad_rows] = 0.0
+    rss = float(resid @ resid)
+    dof = max(y.size - gram.shape[0], 1)
+    sigma2 = rss / dof
     se = np.sqrt(np.diag(sigma2 * gram_inv)) / scale
     ss_tot = float(np.sum((y - y.mean()) ** 2))
-    r2 = 1.0 - float(resid @ resid) / ss_tot if ss_tot > 0 else float("nan")
+    r2 = 1.0 - rss / ss_tot if ss_tot > 0 else float("nan")
     span = float(y.max() - y.min())
-    nrmse = float(np.sqrt(np.mean(resid**2)) / span) if span > 0 else float("nan")
+    nrmse = float(np.sqrt(rss / y.size) / span) if span > 0 else float("nan")
     m_log, c, k, offset = (float(v) for v in beta)
     m = units.to_si("m_log", axis, m_log)
     m_se = units.to_si("m_log", axis, float(se[0]))
