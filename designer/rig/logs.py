@@ -116,11 +116,14 @@ def _first_bad_row(bad: np.ndarray) -> int:
 
 
 def _runs(mask: np.ndarray, min_len: int) -> np.ndarray:
-    """Rows inside runs of True at least `min_len` long."""
-    m = mask.astype(np.int8)
-    edges = np.flatnonzero(np.diff(np.concatenate(([0], m, [0]))))
-    starts, ends = edges[::2], edges[1::2]
+    """Rows inside runs of True at least `min_len` long (work in proportion to the True rows)."""
+    rows = np.flatnonzero(mask)
     out = np.zeros(mask.shape, dtype=bool)
+    if rows.size < min_len:
+        return out
+    breaks = np.flatnonzero(np.diff(rows) > 1)
+    starts = rows[np.concatenate(([0], breaks + 1))]
+    ends = rows[np.concatenate((breaks, [rows.size - 1]))] + 1
     for a, b in zip(starts, ends, strict=True):
         if b - a >= min_len:
             out[a:b] = True
@@ -240,10 +243,10 @@ def validate_frame(
                 f"drop axis {a} or fix the sensor",
             )
         dropouts[a] = flagged
-    data = pd.DataFrame(cols)
-    order = ["t"] + [c for a in axes for c in (a, LOAD[a])] + (["hub"] if "hub" in data else [])
+    order = ["t"] + [c for a in axes for c in (a, LOAD[a])] + (["hub"] if "hub" in cols else [])
     return RigLog(
-        data=data[order],
+        # one block per column, sharing the arrays: no consolidating copy of a long log
+        data=pd.DataFrame({c: cols[c] for c in order}, copy=False),
         path=path,
         factors=_check_factors(factors, source),
         rate=1.0 / step,
