@@ -9,13 +9,12 @@ from the specimen's geometry, walls, infill and TPU density instead.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import asdict, dataclass
-from pathlib import Path
-
 import os
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import asdict, dataclass
 from functools import cache
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -112,6 +111,12 @@ def _top_frequency(r: np.ndarray, rate: float) -> float:
     return float(np.searchsorted(cumulative, 0.99 * cumulative[-1]) * rate / n)
 
 
+@cache
+def _twiddles(n: int, cols: int, top: int) -> np.ndarray:
+    """exp(-2 pi i j k / n) for the columns j < cols and the bins k <= top of the four-step FFT."""
+    return np.exp(-2j * np.pi * (np.arange(cols)[:, None] * np.arange(top + 1) % n) / n)
+
+
 def _below_99(r: np.ndarray, rate: float, f_cap: float) -> bool:
     """Whether 99 % of the coordinate's power lies at or below f_cap: `_top_frequency <= f_cap`.
 
@@ -133,9 +138,8 @@ def _below_99(r: np.ndarray, rate: float, f_cap: float) -> bool:
     x = np.zeros(n)
     np.subtract(r, r.mean(), out=x[: r.size])
     # X[k] = sum_j exp(-2 pi i j k / n) * FFT_{n/cols}(x[j::cols])[k], for k < n / cols
-    inner = rfft(x.reshape(n // cols, cols), axis=0)[: top + 1]
-    k = np.arange(top + 1)[:, None]
-    low = np.einsum("kj,kj->k", inner, np.exp(-2j * np.pi * (k * np.arange(cols) % n) / n))
+    inner = rfft(x.reshape(n // cols, cols).T, axis=1)[:, : top + 1]
+    low = np.einsum("jk,jk->k", inner, _twiddles(n, cols, top))
     spectrum0, nyquist = x.sum(), x[::2].sum() - x[1::2].sum()
     total = (n * float(x @ x) + spectrum0**2 + nyquist**2) / 2
     return total == 0 or float(np.sum(low.real**2 + low.imag**2)) >= 0.99 * total
@@ -161,7 +165,9 @@ def _kernel_spectra(win: int, polyorder: int, dt: float, block: int) -> np.ndarr
     half = win // 2
     g = np.zeros((3, block))
     for i, d in enumerate((2, 1, 0)):
-        g[i, -np.arange(-half, half + 1) % block] = savgol_coeffs(win, polyorder, deriv=d, delta=dt, use="dot")
+        g[i, -np.arange(-half, half + 1) % block] = savgol_coeffs(
+            win, polyorder, deriv=d, delta=dt, use="dot"
+        )
     return rfft(g, axis=1)
 
 
