@@ -255,16 +255,25 @@ def validate_frame(
     )
 
 
+def _read_frame(p: Path) -> pd.DataFrame:
+    """The file's columns read by pyarrow, as a frame sharing its arrays (no consolidating copy)."""
+    import pyarrow.csv as pacsv
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(p) if p.suffix.lower() in _PARQUET else pacsv.read_csv(p)
+    if len(set(table.column_names)) < table.num_columns:
+        return table.to_pandas()
+    columns = (col.to_numpy(zero_copy_only=False) for col in table.columns)
+    return pd.DataFrame(dict(zip(table.column_names, columns, strict=True)), copy=False)
+
+
 def read_log(path: str | Path) -> RigLog:
     """Read and validate a rig log (CSV, or Parquet by suffix) and its factor sidecar."""
     p = Path(path)
     if not p.exists():
         raise DesignerError(f"no such log: {p}", "give the path of a CSV or Parquet rig log")
     try:
-        if p.suffix.lower() in _PARQUET:
-            raw = pd.read_parquet(p)
-        else:
-            raw = pd.read_csv(p, engine="pyarrow")
+        raw = _read_frame(p)
     except (ValueError, OSError, pd.errors.ParserError, UnicodeDecodeError) as exc:
         first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise DesignerError(f"cannot read {p}: {first}", "give a CSV or Parquet rig log") from None
