@@ -116,11 +116,14 @@ def _first_bad_row(bad: np.ndarray) -> int:
 
 
 def _runs(mask: np.ndarray, min_len: int) -> np.ndarray:
-    """Rows inside runs of True at least `min_len` long."""
-    m = mask.astype(np.int8)
-    edges = np.flatnonzero(np.diff(np.concatenate(([0], m, [0]))))
-    starts, ends = edges[::2], edges[1::2]
+    """Rows inside runs of True at least `min_len` long (work in proportion to the True rows)."""
+    rows = np.flatnonzero(mask)
     out = np.zeros(mask.shape, dtype=bool)
+    if rows.size < min_len:
+        return out
+    breaks = np.flatnonzero(np.diff(rows) > 1)
+    starts = rows[np.concatenate(([0], breaks + 1))]
+    ends = rows[np.concatenate((breaks, [rows.size - 1]))] + 1
     for a, b in zip(starts, ends, strict=True):
         if b - a >= min_len:
             out[a:b] = True
@@ -240,10 +243,10 @@ def validate_frame(
                 f"drop axis {a} or fix the sensor",
             )
         dropouts[a] = flagged
-    data = pd.DataFrame(cols)
-    order = ["t"] + [c for a in axes for c in (a, LOAD[a])] + (["hub"] if "hub" in data else [])
+    order = ["t"] + [c for a in axes for c in (a, LOAD[a])] + (["hub"] if "hub" in cols else [])
     return RigLog(
-        data=data[order],
+        # one block per column, sharing the arrays: no consolidating copy of a long log
+        data=pd.DataFrame({c: cols[c] for c in order}, copy=False),
         path=path,
         factors=_check_factors(factors, source),
         rate=1.0 / step,
@@ -252,16 +255,25 @@ def validate_frame(
     )
 
 
+def _read_frame(p: Path) -> pd.DataFrame:
+    """The file's columns read by pyarrow, as a frame sharing its arrays (no consolidating copy)."""
+    import pyarrow.csv as pacsv
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(p) if p.suffix.lower() in _PARQUET else pacsv.read_csv(p)
+    if len(set(table.column_names)) < table.num_columns:
+        return table.to_pandas()
+    columns = (col.to_numpy(zero_copy_only=False) for col in table.columns)
+    return pd.DataFrame(dict(zip(table.column_names, columns, strict=True)), copy=False)
+
+
 def read_log(path: str | Path) -> RigLog:
     """Read and validate a rig log (CSV, or Parquet by suffix) and its factor sidecar."""
     p = Path(path)
     if not p.exists():
         raise DesignerError(f"no such log: {p}", "give the path of a CSV or Parquet rig log")
     try:
-        if p.suffix.lower() in _PARQUET:
-            raw = pd.read_parquet(p)
-        else:
-            raw = pd.read_csv(p, engine="pyarrow")
+        raw = _read_frame(p)
     except (ValueError, OSError, pd.errors.ParserError, UnicodeDecodeError) as exc:
         first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise DesignerError(f"cannot read {p}: {first}", "give a CSV or Parquet rig log") from None
