@@ -426,10 +426,11 @@ def check_cosim(ctx: Context) -> CheckResult:
     from .cosim import run
     from .cosim.references import Sine, Step
     from .cosim.scenario import JointSource, Scenario
+    from .joint import from_coefficients
     from .plots.checks import plot_convergence
     from .plots.timeseries import plot_timeseries
 
-    joint = JointSource(axis="theta", coefficients={"k": 330.0, "c": 0.83})
+    joint = JointSource(axis="theta", joint=from_coefficients({"theta": {"k": 330.0, "c": 0.83}}))
     sc = Scenario(
         path=Path("two-link arm (report)"),
         kind="robot",
