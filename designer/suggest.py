@@ -35,7 +35,7 @@ _IPOPT = {
     "ipopt.print_level": 0,
     "print_time": False,
     "ipopt.sb": "yes",
-    "ipopt.tol": 1e-12,
+    "ipopt.tol": 1e-9,
     "ipopt.max_iter": 300,
     "error_on_fail": False,
 }
