@@ -283,10 +283,10 @@ def suggest(
             design.update({n: v for n, v in fixed.items() if n in design})
             raw.append(space.round_printable(design))
 
-    candidates = _rank(surrogate, axis, raw, targets, allow_extrapolation, spans_by_name(spans))
+    span_of = {f.name: float(s) for f, s in zip(space.CONTINUOUS, spans, strict=True)}
     picked: list[Candidate] = []
-    for cand in candidates:
-        if all(_distance(cand.params, other.params, spans_by_name(spans)) > DISTINCT for other in picked):
+    for cand in _rank(surrogate, axis, raw, targets):
+        if all(_distance(cand.params, other.params, span_of) > DISTINCT for other in picked):
             picked.append(cand)
         if len(picked) == top:
             break
@@ -305,17 +305,11 @@ def suggest(
     return Suggestion(axis, targets, picked, reachable, statements, pred_info, surrogate.id, fixed)
 
 
-def spans_by_name(spans: np.ndarray) -> dict[str, float]:
-    return {f.name: float(s) for f, s in zip(space.CONTINUOUS, spans, strict=True)}
-
-
 def _rank(
     surrogate: Surrogate,
     axis: str,
     designs: list[dict[str, float]],
     targets: Mapping[str, Target],
-    allow_extrapolation: bool,
-    spans: Mapping[str, float],
 ) -> list[Candidate]:
     """Predict each design, score it, and sort by desirability, then by the narrower k interval."""
     cols = {n: np.array([d[n] for d in designs]) for n in space.FACTOR_NAMES}
@@ -337,8 +331,12 @@ def _rank(
         if extrapolated:
             notes.append("outside the tested ranges: the prediction is an extrapolation")
         out.append(Candidate(design, predicted, desirability, rel_error, extrapolated, notes))
-    k_width = {id(c): np.log(c.predicted["k"]["pi95"][1] / c.predicted["k"]["pi95"][0]) for c in out}
-    return sorted(out, key=lambda c: (-round(c.desirability, 6), k_width[id(c)]))
+
+    def k_width(c: Candidate) -> float:
+        lo, hi = c.predicted["k"]["pi95"]
+        return float(np.log(hi / lo))
+
+    return sorted(out, key=lambda c: (-round(c.desirability, 6), k_width(c)))
 
 
 def _statements(
