@@ -1,14 +1,36 @@
-"""Entry point of the `designer` command: registers the sub-commands and turns errors into one line."""
+"""Entry point of the `designer` command: registers the sub-commands and owns the one error path.
+
+Every failure ends as one line on stderr naming the problem and the fix, never a traceback:
+
+| exit | meaning |
+| --- | --- |
+| 0 | success |
+| 1 | a negative answer: a check failed, no design meets the target, a log failed identification |
+| 2 | bad input or environment (a file, a flag, a full disk, too little memory) |
+| 3 | internal error (a bug: the line says so; `--debug` shows the traceback) |
+| 129, 130, 143 | stopped by SIGHUP, Ctrl-C (SIGINT) or SIGTERM; part files are removed |
+"""
 
 from __future__ import annotations
 
+import errno
+import signal
 import sys
+import traceback
+from typing import Annotated
 
 import typer
 
 from designer.errors import DesignerError
 
 from . import cosim, design, export, plots, rig
+
+try:  # typer 0.28 vendors click
+    from typer._click import exceptions as _click_errors
+except ImportError:  # pragma: no cover - older typer on click
+    from click import exceptions as _click_errors
+
+REPORT_HINT = "this is a bug in designer: rerun with --debug and report the traceback"
 
 app = typer.Typer(
     help="Design 3D-printed TPU flexible joints: predict and choose stiffness and damping, export FMUs.",
@@ -17,6 +39,29 @@ app = typer.Typer(
     add_completion=False,
     rich_markup_mode="rich",
 )
+
+
+def _version(value: bool) -> None:
+    if value:
+        from designer import __version__
+
+        print(f"designer {__version__}")
+        raise typer.Exit(0)
+
+
+@app.callback()
+def _options(
+    version: Annotated[
+        bool, typer.Option("--version", callback=_version, is_eager=True, help="Print the version and exit.")
+    ] = False,
+    debug: Annotated[
+        bool, typer.Option("--debug", help="On an internal error, show the traceback (any position).")
+    ] = False,
+) -> None:
+    """Exit codes: 0 success, 1 negative answer (a check failed, no design meets the target), 2 bad input
+    or environment, 3 internal error; 130/143/129 when stopped by Ctrl-C, SIGTERM or SIGHUP."""
+
+
 design.register(app)
 rig.register(app)
 export.register(app)
@@ -24,13 +69,98 @@ cosim.register(app)
 plots.register(app)
 
 
-def main() -> None:
-    """Run the command; bad input ends with one line on stderr and exit code 2, no traceback."""
+class Stopped(BaseException):
+    """Raised in the main thread by SIGINT, SIGTERM or SIGHUP: unwinds through every `finally` and
+    `except BaseException` (which remove part files) and is not caught as an `Exception`."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _stop(signum: int, frame) -> None:
+    # later signals are ignored so that the cleanup they interrupt runs to its end
+    for s in _signals():
+        signal.signal(s, signal.SIG_IGN)
+    raise Stopped(signum)
+
+
+def _signals() -> list[int]:
+    return [getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n)]
+
+
+def _os_message(exc: OSError) -> tuple[str, str]:
+    """An operating-system error as (problem, fix)."""
+    where = f" ({exc.filename})" if exc.filename else ""
+    if exc.errno in (errno.ENOSPC, errno.EDQUOT):
+        return f"the disk is full{where}", "free some space or write to another disk"
+    if exc.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
+        return f"permission denied{where}", "choose a path you can read or write"
+    if exc.errno == errno.ENOENT:
+        return f"no such file or folder{where}", "check the path"
+    if exc.errno == errno.EISDIR:
+        return f"a folder where a file is expected{where}", "give a file"
+    return f"{exc.strerror or exc}{where}", "check the path and the disk"
+
+
+def _fail(problem: str, fix: str | None, code: int) -> int:
+    line = f"error: {problem}" + (f" ({fix})" if fix else "")
+    # one line: control characters and non-printable bytes of user input are not echoed raw
+    line = "".join(ch if ch.isprintable() else "?" for ch in line.replace("\n", " "))
+    print(line, file=sys.stderr)
+    return code
+
+
+def run(argv: list[str] | None = None) -> int:
+    """Run the command line `argv` (default sys.argv[1:]) and return its exit code; never raises."""
+    args = list(sys.argv[1:] if argv is None else argv)
+    debug = "--debug" in args[: args.index("--")] if "--" in args else "--debug" in args
+    if debug:
+        args.remove("--debug")
     try:
-        app()
+        code = app(args=args, prog_name="designer", standalone_mode=False)
+        return code if isinstance(code, int) else 0
+    except Stopped as exc:
+        print(f"stopped by {signal.Signals(exc.signum).name}; partial files removed", file=sys.stderr)
+        return 128 + exc.signum
+    except (KeyboardInterrupt, typer.Abort):
+        print("stopped by SIGINT; partial files removed", file=sys.stderr)
+        return 130
+    except typer.Exit as exc:
+        return exc.exit_code
+    except _click_errors.ClickException as exc:
+        if type(exc).__name__ == "NoArgsIsHelpError":
+            return 2  # the help is already printed
+        ctx = getattr(exc, "ctx", None)
+        where = f"{ctx.command_path} --help" if ctx is not None else "designer --help"
+        return _fail(exc.format_message(), f"see {where}", 2)
     except DesignerError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        sys.exit(2)
-    except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
-        sys.exit(130)
+        return _fail(exc.problem, exc.fix, 2)
+    except MemoryError:
+        return _fail("out of memory", "ask for a smaller run (shorter, coarser, fewer cases)", 2)
+    except OSError as exc:
+        if exc.errno is None:
+            return _internal(exc, debug)
+        return _fail(*_os_message(exc), 2)
+    except Exception as exc:  # noqa: BLE001 - the one place that turns any bug into exit 3
+        return _internal(exc, debug)
+
+
+def _internal(exc: BaseException, debug: bool) -> int:
+    if debug:
+        traceback.print_exception(exc)
+    first = (str(exc).splitlines() or [""])[0][:200]
+    return _fail(f"internal error: {type(exc).__name__}: {first}", REPORT_HINT, 3)
+
+
+def main() -> None:
+    """The console script: SIGTERM and SIGHUP stop the command like Ctrl-C; exit with run()'s code."""
+    for s in _signals():
+        signal.signal(s, _stop)
+    code = run()
+    sys.stdout.flush()
+    sys.exit(code)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

@@ -1,32 +1,147 @@
-"""Writing files so that a failure or an interrupt leaves the old file or none, never half of one."""
+"""Writing files so that a failure or an interrupt leaves the old file or none, never half of one.
+
+Output paths are probed before any work (`check_output`): a folder where a file is expected (or the
+reverse), a folder that does not exist or cannot be written (read-only, /proc), and too little free
+space for the estimated size are reported up front instead of after a long computation. Files are
+written to a temporary name beside the target and renamed over it (`atomic_write`, `atomic_path`); a
+folder of results is staged beside its target and moved in at the end (`atomic_dir`).
+"""
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
+import shutil
+import signal
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import IO
 
 from .errors import DesignerError
 
+# head room kept free on the target's disk beyond the estimated size (file system metadata, temp files)
+_SPARE_BYTES = 1 << 20
+_SIGNALS = {getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n)}
+
+
+def format_bytes(n: float) -> str:
+    """1536 -> '1.5 KiB': sizes in messages, binary units, two significant figures at most."""
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB"):
+        if abs(n) < 1024 or unit == "TiB":
+            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.2g} {unit}"
+        n /= 1024
+    raise AssertionError("unreachable")
+
+
+def _existing_ancestor(path: Path) -> Path:
+    """The nearest folder above `path` (absolute) that exists."""
+    for parent in path.parents:
+        if parent.exists():
+            return parent
+    return Path(path.anchor)
+
+
+def _probe(folder: Path, path: Path) -> None:
+    """Create and remove a file in `folder`: os.access cannot see read-only mounts or /proc as root."""
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".probe.", dir=folder)
+    except OSError as exc:
+        raise DesignerError(
+            f"cannot write {path}: folder {folder} is not writable ({exc.strerror or exc})",
+            "choose a path in a folder you can write to",
+        ) from None
+    os.close(fd)
+    os.unlink(tmp)
+
+
+def check_output(
+    path: str | Path,
+    *,
+    kind: str = "file",
+    suffixes: Iterable[str] | None = None,
+    estimate_bytes: float = 0,
+) -> Path:
+    """Check before any work that `path` can be written; returns it resolved.
+
+    Args:
+        path: the file (or folder, when kind="folder") to be written.
+        kind: "file" (its folder must exist) or "folder" (made with its parents when missing).
+        suffixes: accepted file suffixes, lower case with the dot (None: any).
+        estimate_bytes: expected size; the target's disk must have this much free plus 1 MiB.
+
+    Raises:
+        DesignerError: a folder where a file is expected or the reverse, a wrong suffix, a folder that
+            is missing or cannot be written, or too little free space (with the estimate).
+    """
+    if kind not in ("file", "folder"):
+        raise ValueError(f"kind={kind!r}: use 'file' or 'folder'")
+    p = Path(path).expanduser().absolute()
+    if kind == "file" and p.is_dir():
+        raise DesignerError(
+            f"cannot write {path}: it is a folder", f"give a file name, e.g. {Path(path) / 'out'}"
+        )
+    if kind == "folder" and p.exists() and not p.is_dir():
+        raise DesignerError(f"cannot write into {path}: it is a file", "give a folder (new or existing)")
+    if suffixes is not None and kind == "file":
+        allowed = sorted(suffixes)
+        if p.suffix.lower() not in allowed:
+            raise DesignerError(
+                f"cannot write {path}: the suffix '{p.suffix}' is not {' or '.join(allowed)}",
+                f"name the file with {' or '.join(allowed)}",
+            )
+    folder = p if (kind == "folder" and p.is_dir()) else p.parent
+    if not folder.is_dir():
+        if kind == "file":
+            raise DesignerError(f"cannot write {path}: folder {folder} does not exist", "create it first")
+        folder = _existing_ancestor(p)
+        if not folder.is_dir():
+            raise DesignerError(f"cannot create {path}: {folder} is not a folder", "choose another path")
+    _probe(folder, Path(path))
+    free = shutil.disk_usage(folder).free
+    if estimate_bytes + _SPARE_BYTES > free:
+        raise DesignerError(
+            f"not enough space for {path}: about {format_bytes(estimate_bytes)} needed, "
+            f"{format_bytes(free)} free on its disk",
+            "free some space or write to another disk",
+        )
+    return p
+
 
 def _check_dir(path: Path) -> Path:
-    parent = path.resolve().parent
+    parent = path.absolute().parent
     if not parent.is_dir():
         raise DesignerError(f"cannot write {path}: folder {parent} does not exist", "create it first")
-    if not os.access(parent, os.W_OK):
-        raise DesignerError(f"cannot write {path}: folder {parent} is not writable", "choose another path")
+    if path.is_dir():
+        raise DesignerError(f"cannot write {path}: it is a folder", f"give a file name, e.g. {path / 'out'}")
     return parent
+
+
+def _space_error(path: Path, exc: OSError) -> OSError | DesignerError:
+    """ENOSPC/EDQUOT while writing `path` as a DesignerError; any other OSError unchanged."""
+    if exc.errno in (errno.ENOSPC, errno.EDQUOT):
+        return DesignerError(
+            f"the disk filled up while writing {path}", "free some space or write to another disk"
+        )
+    if exc.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
+        return DesignerError(f"cannot write {path}: {exc.strerror}", "choose a path you can write to")
+    return exc
 
 
 @contextlib.contextmanager
 def atomic_write(path: str | Path, mode: str = "w", **kwargs) -> Iterator[IO]:
-    """Open a temporary file beside `path`; rename it over `path` only when the block succeeds."""
+    """Open a temporary file beside `path`; rename it over `path` only when the block succeeds.
+
+    Raises:
+        DesignerError: the folder is missing or not writable, `path` is a folder, or the disk is full.
+    """
     path = Path(path)
     parent = _check_dir(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=parent)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=parent)
+    except OSError as exc:
+        raise _space_error(path, exc) from None
     try:
         with os.fdopen(fd, mode, **kwargs) as fh:
             yield fh
@@ -34,6 +149,10 @@ def atomic_write(path: str | Path, mode: str = "w", **kwargs) -> Iterator[IO]:
             os.fsync(fh.fileno())
         os.chmod(tmp, 0o644)
         os.replace(tmp, path)
+    except OSError as exc:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise _space_error(path, exc) from None
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
@@ -42,16 +161,71 @@ def atomic_write(path: str | Path, mode: str = "w", **kwargs) -> Iterator[IO]:
 
 @contextlib.contextmanager
 def atomic_path(path: str | Path) -> Iterator[Path]:
-    """A temporary path beside `path` for writers that want a file name (zip, parquet, savefig)."""
+    """A temporary path beside `path` for writers that want a file name (zip, parquet, savefig).
+
+    Raises:
+        DesignerError: the folder is missing or not writable, `path` is a folder, or the disk is full.
+    """
     path = Path(path)
     parent = _check_dir(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part" + path.suffix, dir=parent)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part" + path.suffix, dir=parent)
+    except OSError as exc:
+        raise _space_error(path, exc) from None
     os.close(fd)
     try:
         yield Path(tmp)
         os.chmod(tmp, 0o644)
         os.replace(tmp, path)
+    except OSError as exc:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise _space_error(path, exc) from None
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         raise
+
+
+def _move_in(stage: Path, target: Path) -> None:
+    """Move every entry of `stage` into the existing folder `target`, replacing same-named entries."""
+    trash = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".old", dir=target.parent))
+    try:
+        for entry in stage.iterdir():
+            dest = target / entry.name
+            if dest.exists() or dest.is_symlink():
+                os.replace(dest, trash / entry.name)
+            os.replace(entry, dest)
+    finally:
+        shutil.rmtree(trash, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def atomic_dir(path: str | Path) -> Iterator[Path]:
+    """A staging folder beside `path`, moved into place when the block succeeds (removed when not).
+
+    A missing or empty target is replaced by the staged folder in one rename; into an existing folder
+    the staged entries replace their namesakes (other files there stay), with SIGINT/SIGTERM/SIGHUP
+    held back during the moves so an interrupt never leaves old and new outputs mixed.
+
+    Raises:
+        DesignerError: `path` is a file, or its folder cannot be created or written.
+    """
+    target = check_output(path, kind="folder")
+    target.parent.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent))
+    try:
+        yield stage
+        os.chmod(stage, 0o755)
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
+        try:
+            if target.is_dir() and any(target.iterdir()):
+                _move_in(stage, target)
+            else:
+                os.replace(stage, target)
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+    except OSError as exc:
+        raise _space_error(target, exc) from None
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
