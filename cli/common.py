@@ -1,4 +1,5 @@
-"""What every command shares: JSON output, rich console, progress bars shown only on a terminal."""
+"""What every command shares: its common options (one spelling each), --fix parsing, JSON output, the
+rich console, and progress bars shown only on a terminal."""
 
 from __future__ import annotations
 
@@ -7,9 +8,73 @@ import json
 import math
 import sys
 from collections.abc import Callable, Iterator
-from typing import Any
+from pathlib import Path
+from typing import Annotated, Any
 
+import typer
 from rich.console import Console
+
+from designer.errors import DesignerError
+
+# the options many commands share, spelled once: -o/--output, --data, --json, --surrogate, --fix
+JsonOpt = Annotated[bool, typer.Option("--json", help="Print machine-readable JSON only.")]
+DataOpt = Annotated[
+    Path | None,
+    typer.Option("--data", help="Coefficient table (CSV or Parquet); default: the bundled 44 study runs."),
+]
+SurrogateOpt = Annotated[
+    Path | None,
+    typer.Option("--surrogate", help="Surrogate JSON from `designer fit` (default: the shipped one)."),
+]
+FixOpt = Annotated[
+    list[str] | None,
+    typer.Option("--fix", help="Hold a factor, NAME=VALUE in rig units, e.g. --fix width=4.5 (repeatable)."),
+]
+
+
+def output_option(help: str) -> Any:
+    """The `-o/--output` option with a command's own help text."""
+    return typer.Option("-o", "--output", help=help)
+
+
+def parse_fix(items: list[str] | None) -> dict[str, float]:
+    """['width=4.5', 'raster=0'] -> {'width': 4.5, 'raster': 0.0}; names checked, each factor once.
+
+    Raises:
+        DesignerError: not NAME=VALUE, an unknown factor (with the closest name), a factor given twice,
+            or a value that is not a number (with the factor's unit).
+    """
+    import difflib
+
+    from designer import space
+
+    fixed: dict[str, float] = {}
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise DesignerError(
+                f"--fix '{item}' is not NAME=VALUE", "write it as, for example, --fix width=4.5"
+            )
+        if name not in space.BY_NAME:
+            close = difflib.get_close_matches(name, space.FACTOR_NAMES, n=1)
+            hint = f"did you mean '{close[0]}'? " if close else ""
+            raise DesignerError(
+                f"--fix {item}: '{name}' is not a factor",
+                f"{hint}factors: {', '.join(space.FACTOR_NAMES)}",
+            )
+        if name in fixed:
+            raise DesignerError(f"--fix {name} is given twice", f"give each factor once (--fix {name}=VALUE)")
+        try:
+            fixed[name] = float(value)
+        except ValueError:
+            f = space.BY_NAME[name]
+            raise DesignerError(
+                f"--fix {item}: '{value.strip()}' is not a number",
+                f"give {name} as a number, {f.describe_range()}",
+            ) from None
+    return fixed
+
 
 # piped output is not cut at rich's 80-column default: numbers must never be truncated
 console = Console(highlight=False, width=None if sys.stdout.isatty() else 120)

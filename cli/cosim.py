@@ -23,7 +23,9 @@ def cosim(
     Example: designer cosim examples/two_link_arm.toml -o results/ --validate
     """
     from designer.cosim import load, simulate
+    from designer.files import check_output
 
+    check_output(out, kind="folder")
     sc = load(scenario)
     with progress(f"co-simulating {scenario.name}", enabled=not json_out) as bar:
         summary = simulate(sc, out, with_validation=validate, progress=bar)

@@ -7,39 +7,15 @@ from typing import Annotated
 
 import typer
 
-from designer.errors import DesignerError
-
-from .common import console, print_json
+from .common import FixOpt, JsonOpt, SurrogateOpt, console, parse_fix, print_json
 
 AxisOpt = Annotated[str, typer.Option("--axis", help="Axis: x y z theta phi psi.")]
-SurrogateOpt = Annotated[
-    Path | None,
-    typer.Option("--surrogate", help="Surrogate JSON from `designer fit` (default: the shipped one)."),
-]
-JsonOpt = Annotated[bool, typer.Option("--json", help="Print machine-readable JSON only.")]
 
 
 def _load(path: Path | None):
     from designer.surrogate import Surrogate
 
     return Surrogate.load() if path is None else Surrogate.load(path)
-
-
-def _parse_fix(items: list[str]) -> dict[str, float]:
-    fixed = {}
-    for item in items:
-        name, sep, value = item.partition("=")
-        if not sep:
-            raise DesignerError(
-                f"--fix '{item}' is not NAME=VALUE", "write it as, for example, --fix width=4.5"
-            )
-        try:
-            fixed[name.strip()] = float(value)
-        except ValueError:
-            raise DesignerError(
-                f"--fix '{item}': '{value}' is not a number", "write --fix width=4.5"
-            ) from None
-    return fixed
 
 
 def _pi(p: dict) -> str:
@@ -61,8 +37,11 @@ def fit(
     Example: designer fit --data my_runs.csv -o my_surrogate.json
     """
     from designer.data import load_table
+    from designer.files import check_output
     from designer.surrogate import Surrogate
 
+    if out is not None:
+        check_output(out, suffixes=[".json"])
     table = load_table(data)
     sur = Surrogate().fit(table)
     if out is not None:
@@ -168,9 +147,7 @@ def suggest(
         float | None, typer.Option("--c", help="Target damping (N.s/mm; N.mm.s/rad on rotational axes).")
     ] = None,
     axis: AxisOpt = "x",
-    fix: Annotated[
-        list[str] | None, typer.Option("--fix", help="Hold a factor, e.g. --fix width=4.5 (repeatable).")
-    ] = None,
+    fix: FixOpt = None,
     top: Annotated[int, typer.Option("--top", help="How many distinct candidates.")] = 5,
     importance_k: Annotated[float, typer.Option("--importance-k", help="Importance of the k target.")] = 1.0,
     importance_c: Annotated[float, typer.Option("--importance-c", help="Importance of the c target.")] = 1.0,
@@ -206,7 +183,7 @@ def suggest(
         k=k,
         c=c,
         axis=axis,
-        fixed=_parse_fix(fix or []),
+        fixed=parse_fix(fix),
         top=top,
         importance={"k": importance_k, "c": importance_c},
         bounds={"k": (k_low, k_high), "c": (c_low, c_high)},

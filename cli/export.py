@@ -120,7 +120,9 @@ def register(app: typer.Typer) -> None:
         Example: designer export fmu --k 0.8 --c 2e-3 --m 0.01 --interface body --fmi 3 -o joint.fmu
         """
         from designer.export.fmu import export_fmu
+        from designer.files import check_output
 
+        check_output(output, suffixes=[".fmu"])
         joint = _joint(
             axis,
             k,
@@ -183,6 +185,9 @@ def register(app: typer.Typer) -> None:
             ] = False,
             json_out: Annotated[bool, typer.Option("--json", help="print the result as JSON")] = False,
         ) -> None:
+            from designer.files import check_output
+
+            check_output(output, suffixes=[suffix])
             joint = _joint(
                 axis,
                 k,

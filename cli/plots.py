@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from .common import console, print_json
+from .common import FixOpt, console, parse_fix, print_json
 from .common import progress as progress_bar
 
 plot_app = typer.Typer(
@@ -27,6 +27,14 @@ Json = Annotated[bool, typer.Option("--json", help="print the plotted numbers as
 def _quantities(response: str | None) -> list[str] | None:
     """'c,k' -> ['c', 'k']; None -> every quantity the table has."""
     return None if response is None else [q.strip() for q in response.split(",") if q.strip()]
+
+
+def _image_out(path: Path) -> Path:
+    """Check before drawing that an image can be written at `path` (format by suffix, folder, space)."""
+    from designer.files import check_output
+    from designer.plots.common import FORMATS
+
+    return check_output(path, suffixes=FORMATS)
 
 
 def _saved(path: Path) -> None:
@@ -51,7 +59,7 @@ def effects_cmd(
     from designer.data import load_table
     from designer.plots import common, effects
 
-    common.check_image_path(output)
+    _image_out(output)
     t = load_table(table)
     responses = common.responses_for(t, _quantities(response), axis)
     path = effects.plot_effects(t, responses, output)
@@ -79,7 +87,7 @@ def heatmap_cmd(
     from designer.plots import common, heatmap
     from designer.stats import correlation
 
-    common.check_image_path(output)
+    _image_out(output)
     t = load_table(table)
     responses = common.responses_for(t, None, axis)
     path = heatmap.plot_heatmap(t, responses, output)
@@ -101,24 +109,6 @@ def _surrogate(path: Path | None):
     return _S.load() if path is None else _S.load(path)
 
 
-def _fixed(pairs: list[str]) -> dict[str, float]:
-    """['density=60', 'raster=45'] -> {'density': 60.0, 'raster': 45.0}."""
-    from designer.errors import DesignerError
-
-    out = {}
-    for pair in pairs:
-        name, sep, value = pair.partition("=")
-        if not sep:
-            raise DesignerError(f"--fix '{pair}' is not NAME=VALUE", "write it as --fix density=60")
-        try:
-            out[name.strip()] = float(value)
-        except ValueError:
-            raise DesignerError(
-                f"--fix {pair}: '{value}' is not a number", "write it as --fix density=60"
-            ) from None
-    return out
-
-
 @plot_app.command("space")
 def space_cmd(
     x: Annotated[str, typer.Option("--x", help="continuous factor on the first axis")] = "width",
@@ -126,10 +116,7 @@ def space_cmd(
     z: Annotated[str | None, typer.Option("--z", help="third factor (with --volume)")] = None,
     response: Annotated[str, typer.Option("--response", help="quantity: k or c")] = "k",
     axis: Axis = "x",
-    fix: Annotated[
-        list[str] | None,
-        typer.Option("--fix", help="hold a factor, NAME=VALUE (repeat); others at the centre"),
-    ] = None,
+    fix: FixOpt = None,
     target: Annotated[
         float | None, typer.Option("--target", help="target value in rig units (N/mm, N.s/mm)")
     ] = None,
@@ -144,20 +131,24 @@ def space_cmd(
     Example: designer plot space --x width --y height --response k --target 0.8 -o space.png --html space.html
     """
     from designer.errors import DesignerError
-    from designer.plots import common, space
+    from designer.plots import space
 
-    common.check_image_path(output)
+    _image_out(output)
+    if html is not None:
+        from designer.files import check_output
+
+        check_output(html, suffixes=[".html"])
     sur = _surrogate(surrogate)
     resp = f"{response}_{axis}"
     with progress_bar("rendering") as bar:
         if volume:
             if z is None:
                 raise DesignerError("--volume needs a third factor", "add --z, e.g. --z density")
-            view = space.plot_volume(sur, resp, [x, y, z], output, _fixed(fix or []), target, html)
+            view = space.plot_volume(sur, resp, [x, y, z], output, parse_fix(fix), target, html)
         else:
             if z is not None:
                 raise DesignerError("--z draws only with --volume", "add --volume or drop --z")
-            view = space.plot_surface(sur, resp, x, y, output, _fixed(fix or []), target, html)
+            view = space.plot_surface(sur, resp, x, y, output, parse_fix(fix), target, html)
         bar(1.0)
     if as_json:
         print_json(view.to_dict())
@@ -186,9 +177,9 @@ def loo_cmd(
     Example: designer plot loo -o loo.png
     """
     from designer.errors import DesignerError
-    from designer.plots import common, loo
+    from designer.plots import loo
 
-    common.check_image_path(output)
+    _image_out(output)
     sur = _surrogate(surrogate)
     responses = [r for r in sur.responses if axis is None or r.split("_", 1)[1] == axis]
     if not responses:
@@ -219,18 +210,34 @@ def timeseries_cmd(
         str | None, typer.Option("--columns", help="signals, comma-separated (default: all)")
     ] = None,
     reference: Annotated[Path | None, typer.Option("--reference", help="reference series to overlay")] = None,
+    as_json: Json = False,
 ) -> None:
     """Co-simulation signals against time, one panel each, a reference dashed.
 
     Example: designer plot timeseries results/timeseries.csv --columns joint.x.s,joint.x.f -o ts.png
     """
-    from designer.plots import common, timeseries
+    from designer.plots import timeseries
 
-    common.check_image_path(output)
+    _image_out(output)
     frame = _read_series(series)
     ref = None if reference is None else _read_series(reference)
     cols = None if columns is None else [c.strip() for c in columns.split(",") if c.strip()]
-    _saved(timeseries.plot_timeseries(frame, output, cols, reference=ref))
+    path = timeseries.plot_timeseries(frame, output, cols, reference=ref)
+    if as_json:
+        shown = cols or [c for c in frame.columns if c != "t"]
+        print_json(
+            {
+                "figure": str(path),
+                "rows": len(frame),
+                "t": [frame["t"].iloc[0], frame["t"].iloc[-1]],
+                "signals": {
+                    c: {"min": frame[c].min(), "max": frame[c].max(), "final": frame[c].iloc[-1]}
+                    for c in shown
+                },
+            }
+        )
+        return
+    _saved(path)
 
 
 def _read_series(path: Path):
@@ -259,20 +266,18 @@ def validate_cmd(
 
     Example: designer validate -o report/
     """
+    from designer.files import atomic_dir, check_output
     from designer.report import validate
 
-    with progress_bar("validating") as bar:
-        results, page, md, seconds = validate(output, table, progress=bar)
+    check_output(output, kind="folder", estimate_bytes=20e6)
+    # staged beside the target and moved in at the end: an interrupt leaves the old report whole
+    with atomic_dir(output) as stage, progress_bar("validating") as bar:
+        results, page, md, seconds = validate(stage, table, progress=bar)
+        checks = [_moved(r.to_dict(), stage, output) for r in results]
+    page, md = output / page.name, output / md.name
     failed = [r for r in results if not r.passed]
     if as_json:
-        print_json(
-            {
-                "passed": not failed,
-                "seconds": seconds,
-                "report": str(page),
-                "checks": [r.to_dict() for r in results],
-            }
-        )
+        print_json({"passed": not failed, "seconds": seconds, "report": str(page), "checks": checks})
     else:
         for r in results:
             mark = "[green]PASS[/green]" if r.passed else "[red]FAIL[/red]"
@@ -283,6 +288,17 @@ def validate_cmd(
         )
     if failed:
         raise typer.Exit(1)
+
+
+def _moved(obj, stage: Path, target: Path):
+    """`obj` with paths inside the staging folder rewritten to where they end up."""
+    if isinstance(obj, dict):
+        return {k: _moved(v, stage, target) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_moved(v, stage, target) for v in obj]
+    if isinstance(obj, (str, Path)) and str(obj).startswith(str(stage)):
+        return str(target) + str(obj)[len(str(stage)) :]
+    return obj
 
 
 def register(app: typer.Typer) -> None:

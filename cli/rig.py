@@ -9,7 +9,7 @@ import typer
 
 from designer.errors import DesignerError
 
-from .common import console, print_json, progress
+from .common import console, err_console, print_json, progress
 
 rig_app = typer.Typer(help="The virtual rig: simulate the study's experiment.", no_args_is_help=True)
 
@@ -32,15 +32,24 @@ def identify(
 
     Example: designer identify run1.csv run2.parquet -o table.csv
     """
+    from designer.files import check_output
     from designer.rig.identify import identify as run
     from designer.rig.identify import results_table
 
+    if output is not None:
+        check_output(output, suffixes=TABLE_SUFFIXES)
+    if window is not None and not window > 0:
+        raise DesignerError(
+            f"--window {window:g}", "give the Savitzky-Golay window in seconds, > 0, or omit it"
+        )
     results = []
     with progress("identifying") as bar:
         for i, path in enumerate(logs):
             results.append(run(path, window_s=window, progress=lambda f, i=i: bar((i + f) / len(logs))))
     if output is not None:
-        results_table(results).pipe(_write_csv, output)
+        from designer.data import write_frame
+
+        write_frame(results_table(results), output)
     if json_out:
         print_json({"logs": [r.to_dict() for r in results], "table": None if output is None else str(output)})
         return
@@ -68,11 +77,7 @@ def identify(
         console.print(f"wrote {output}")
 
 
-def _write_csv(df, path: Path) -> None:
-    from designer.files import atomic_write
-
-    with atomic_write(path, newline="") as fh:
-        df.to_csv(fh, index=False)
+TABLE_SUFFIXES = (".csv", ".parquet", ".pq")
 
 
 @rig_app.command("simulate")
@@ -103,9 +108,13 @@ def simulate(
 
     Example: designer rig simulate --k 0.8 --c 2e-3 --m 0.001 --duration 200 --dropouts 0.001 -o log.csv
     """
+    from designer.files import check_output
     from designer.rig.logs import write_log
+    from designer.rig.simulate import footprint
     from designer.rig.simulate import simulate as run
 
+    size = footprint(len(axis), duration=duration, rate=rate, parquet=output.suffix.lower() != ".csv")
+    check_output(output, suffixes=TABLE_SUFFIXES, estimate_bytes=size["file"])
     given = {"density": density, "length": length, "width": width, "height": height}
     given |= {"layer": layer, "raster": raster}
     factors = {n: v for n, v in given.items() if v is not None}
@@ -134,31 +143,59 @@ def clean(
     table: Annotated[
         Path, typer.Argument(help="coefficient table (CSV or Parquet), e.g. from designer identify")
     ],
-    output: Annotated[Path | None, typer.Option("-o", "--output", help="write the kept runs (CSV)")] = None,
+    output: Annotated[
+        Path | None, typer.Option("-o", "--output", help="write the kept runs (CSV or Parquet)")
+    ] = None,
     eps: Annotated[float, typer.Option(help="DBSCAN radius in standard deviations (the study: 0.5)")] = 0.5,
     min_samples: Annotated[int, typer.Option(help="DBSCAN core size (the study: 5)")] = 5,
+    max_drop: Annotated[
+        float,
+        typer.Option(help="refuse (exit 1, nothing written) when more than this share of runs would go"),
+    ] = 0.2,
     json_out: Annotated[bool, typer.Option("--json", help="print JSON")] = False,
 ) -> None:
-    """Drop runs with NaN or zero coefficients, then DBSCAN outliers; say why for each.
+    """Drop runs with NaN or zero coefficients, then DBSCAN outliers; say why for each and what DBSCAN did.
+
+    Refuses (exit 1, nothing written) to drop more than --max-drop of the runs, or all of them.
 
     Example: designer clean table.csv -o clean.csv
     """
-    import pandas as pd
-
+    from designer.data import read_frame, write_frame
+    from designer.files import check_output
     from designer.rig.clean import clean as run
 
-    if not table.exists():
-        raise DesignerError(f"no such table: {table}", "give the path of a CSV or Parquet table")
-    raw = pd.read_parquet(table) if table.suffix.lower() in (".parquet", ".pq") else pd.read_csv(table)
-    res = run(raw, eps=eps, min_samples=min_samples, source=table.name)
     if output is not None:
-        _write_csv(res.table, output)
+        check_output(output, suffixes=TABLE_SUFFIXES)
+    if not 0 <= max_drop <= 1:
+        raise DesignerError(f"--max-drop {max_drop:g}", "give a share between 0 and 1, e.g. 0.2")
+    res = run(read_frame(table), eps=eps, min_samples=min_samples, source=table.name)
+    refused = res.drop_share > max_drop or len(res.table) == 0
+    if output is not None and not refused:
+        write_frame(res.table, output)
     if json_out:
-        print_json(res.summary())
-        return
-    console.print(f"kept {len(res.table)} of {len(raw)} runs")
+        print_json(res.summary() | {"refused": refused, "max_drop": max_drop})
+    else:
+        _print_clean(res, output if not refused else None)
+    if refused:
+        why = (
+            "no run"
+            if len(res.table) == 0
+            else f"{100 * res.drop_share:.0f} % dropped, over --max-drop {max_drop:g}"
+        )
+        err_console.print(
+            f"refused: cleaning would keep {len(res.table)} of {res.runs} runs ({why}); nothing written "
+            "(check the reasons above; loosen --eps/--min-samples, or accept it with --max-drop 1)",
+            soft_wrap=True,
+        )
+        raise typer.Exit(1)
+
+
+def _print_clean(res, output: Path | None) -> None:
+    console.print(f"kept {len(res.table)} of {res.runs} runs")
     for row in res.dropped.itertuples():
         console.print(f"  dropped row {row.row}: {row.reason}")
+    for line in res.explanation:
+        console.print(f"  {line}")
     if output is not None:
         console.print(f"wrote {output}")
 
@@ -189,7 +226,10 @@ def doe(
     Example: designer doe --augment 8 --k 0.8 --c 2e-3 -o next.csv
     """
     from designer import doe as plans
+    from designer.files import check_output
 
+    if output is not None:
+        check_output(output, suffixes=TABLE_SUFFIXES)
     if augment is None:
         if k is not None or c is not None or data is not None:
             raise DesignerError("--k, --c and --data go with --augment", "add --augment N")
@@ -199,8 +239,29 @@ def doe(
             plan = plans.study_plan(plans.CENTER if center is None else center, seed)
         _finish_plan(plan, output, json_out, {})
         return
+    if all_continuous or center is not None:
+        given = "--all-continuous" if all_continuous else "--center"
+        raise DesignerError(
+            f"{given} plans a new design; --augment adds to the data", f"drop {given} or --augment"
+        )
+    _check_augment(plans, augment)
     plan, narrowing = _augment(plans, augment, k, c, axis, data)
     _finish_plan(plan, output, json_out, narrowing)
+
+
+#: seconds per greedy pick, measured: `designer doe --augment 100000` took 94 s
+_SECONDS_PER_PICK = 94 / 100_000
+
+
+def _check_augment(plans, n: int) -> None:
+    """Refuse more specimens than printable level combinations before the greedy search starts."""
+    grid = len(plans.printable_grid())
+    if n < 1 or n > grid:
+        cost = f" (about {n * _SECONDS_PER_PICK:.0f} s of search, repeating combinations)" if n > grid else ""
+        raise DesignerError(
+            f"--augment {n}: give 1 to {grid} specimens, the number of printable level combinations{cost}",
+            "a campaign adds a few to a few dozen specimens: plan them, print, measure, refit",
+        )
 
 
 def _augment(plans, n: int, k: float | None, c: float | None, axis: str, data: Path | None):
@@ -225,7 +286,9 @@ def _finish_plan(plan, output: Path | None, json_out: bool, narrowing: dict) -> 
     from designer import units
 
     if output is not None:
-        _write_csv(plan, output)
+        from designer.data import write_frame
+
+        write_frame(plan, output)
     if json_out:
         print_json({"runs": plan.to_dict(orient="records"), "pi_narrowing": narrowing})
         return

@@ -82,8 +82,12 @@ def _canonical_name(col: str, source: str) -> str | None:
     return f"{q}_{axis}"
 
 
-def normalise(raw: pd.DataFrame, source: str = "table") -> pd.DataFrame:
-    """Rename, check and order a raw table; raise DesignerError naming the first problem."""
+def canonical_columns(raw: pd.DataFrame, *, source: str = "table") -> pd.DataFrame:
+    """`raw` with unit-suffixed names (`k_x [N/mm]`, `length_mm`) renamed canonical, values untouched.
+
+    Raises:
+        DesignerError: a column in another unit, or two columns giving the same quantity.
+    """
     mapping: dict[str, str] = {}
     for col in raw.columns:
         canon = _canonical_name(str(col), source)
@@ -92,7 +96,12 @@ def normalise(raw: pd.DataFrame, source: str = "table") -> pd.DataFrame:
         if canon in mapping.values():
             raise DesignerError(f"{source}: two columns give '{canon}'", "keep one of them")
         mapping[col] = canon
-    table = raw.rename(columns=mapping)
+    return raw.rename(columns=mapping)
+
+
+def normalise(raw: pd.DataFrame, source: str = "table") -> pd.DataFrame:
+    """Rename, check and order a raw table; raise DesignerError naming the first problem."""
+    table = canonical_columns(raw, source=source)
     missing = [f for f in space.FACTOR_NAMES if f not in table.columns]
     if missing:
         raise DesignerError(
@@ -163,6 +172,8 @@ def load_table(source: str | Path | pd.DataFrame | None = None) -> pd.DataFrame:
         raise DesignerError(f"no such table: {p}", "give the path of a CSV or Parquet file")
     try:
         raw = read_frame(p)
+    except DesignerError:
+        raise
     except (ValueError, OSError, pd.errors.ParserError, UnicodeDecodeError) as exc:
         raise DesignerError(
             f"cannot read {p}: {str(exc).splitlines()[0]}", "give a CSV or Parquet coefficient table"
@@ -176,7 +187,11 @@ def is_parquet(path: str | Path) -> bool:
 
 
 def read_frame(path: str | Path) -> pd.DataFrame:
-    """A CSV or Parquet file (by suffix) as a DataFrame, unvalidated."""
+    """A CSV or Parquet file (by suffix) as a DataFrame, unvalidated (DesignerError naming a wrong
+    delimiter, binary content or an empty file)."""
+    from .files import check_table_file
+
+    check_table_file(path, parquet=is_parquet(path))
     return pd.read_parquet(path) if is_parquet(path) else pd.read_csv(path)
 
 

@@ -229,3 +229,51 @@ def atomic_dir(path: str | Path) -> Iterator[Path]:
         raise _space_error(target, exc) from None
     finally:
         shutil.rmtree(stage, ignore_errors=True)
+
+
+_DELIMITERS = {";": "semicolons", "\t": "tabs", "|": "vertical bars"}
+
+
+def check_table_file(path: str | Path, *, parquet: bool) -> None:
+    """Check a table file before parsing it, for messages a parser cannot give.
+
+    Args:
+        path: the file.
+        parquet: whether its suffix names Parquet (else it is read as comma-separated CSV).
+
+    Raises:
+        DesignerError: missing, a folder, empty, binary where text is expected, Parquet named as CSV
+            or the reverse, or a CSV separated by semicolons, tabs or bars (named) instead of commas.
+    """
+    p = Path(path)
+    if not p.exists():
+        raise DesignerError(f"no such file: {p}", "check the path")
+    if p.is_dir():
+        raise DesignerError(f"{p} is a folder", "give a CSV or Parquet file")
+    with open(p, "rb") as fh:
+        head = fh.read(4096)
+    if not head:
+        raise DesignerError(f"{p} is empty", "give a table with a header row and data rows")
+    if parquet != head.startswith(b"PAR1"):
+        kind = "a Parquet file" if head.startswith(b"PAR1") else "not a Parquet file"
+        raise DesignerError(
+            f"{p} is {kind}", "name Parquet files .parquet or .pq, and CSV files anything else"
+        )
+    if parquet:
+        return
+    line = head.splitlines()[0] if head.splitlines() else head
+    try:
+        text = line.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        text = "\0"
+    if "\0" in text or b"\0" in head:
+        raise DesignerError(
+            f"{p} is not a text CSV file (it holds binary data)", "give a CSV or Parquet table"
+        )
+    if "," not in text:
+        used = [name for d, name in _DELIMITERS.items() if d in text]
+        if used:
+            raise DesignerError(
+                f"{p} is separated by {used[0]}, not commas",
+                "save it as comma-separated CSV (decimal point '.'), or as Parquet",
+            )

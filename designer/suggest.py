@@ -152,6 +152,7 @@ class Suggestion:
     @classmethod
     def from_dict(cls, d: Mapping[str, Any], *, where: str = "suggestion") -> Suggestion:
         """Read back `to_dict` output (a `designer suggest --json` file); DesignerError when malformed."""
+        _check_schema(d, where)
         try:
             axis = units.check_axis(d["axis"])
             bounds = d.get("desirability_bounds") or {}
@@ -212,6 +213,35 @@ class Suggestion:
         if not isinstance(data, dict):
             raise DesignerError(f"{path.name} is not a suggestion", "give designer suggest --json output")
         return cls.from_dict(data, where=path.name)
+
+
+_SUGGESTION_KEYS = (
+    "axis", "units", "targets", "desirability_bounds", "fixed", "reachable", "statements",
+    "predictability", "surrogate_id", "candidates",
+)  # fmt: skip
+_CANDIDATE_KEYS = ("params", "predicted", "desirability", "rel_error", "extrapolated", "notes")
+
+
+def _check_schema(d: Any, where: str) -> None:
+    """The keys of a suggestion dict: required ones present, none unknown (with the closest valid one)."""
+    from .keys import check_keys
+
+    fix = "use the output of designer.suggest(...).to_dict() (designer suggest --json)"
+    if not isinstance(d, Mapping):
+        raise DesignerError(f"{where} is not a suggestion (a JSON {type(d).__name__}, not an object)", fix)
+    missing = [k for k in ("axis", "targets", "candidates") if k not in d]
+    if missing:
+        has = ", ".join(f"'{k}'" for k in list(d)[:6]) or "nothing"
+        raise DesignerError(
+            f"{where} is not a suggestion: no {', '.join(map(repr, missing))} (it has {has})", fix
+        )
+    check_keys(d, _SUGGESTION_KEYS, where=where)
+    if not isinstance(d["candidates"], list) or not d["candidates"]:
+        raise DesignerError(f"{where}: 'candidates' is not a non-empty list", fix)
+    for i, c in enumerate(d["candidates"], 1):
+        if not isinstance(c, Mapping) or "params" not in c or "predicted" not in c:
+            raise DesignerError(f"{where}: candidate {i} has no 'params' and 'predicted'", fix)
+        check_keys(c, _CANDIDATE_KEYS, where=f"candidate {i} of {where}")
 
 
 class _Problem:

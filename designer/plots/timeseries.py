@@ -14,6 +14,15 @@ from .common import save_figure
 MAX_PANELS = 8
 
 
+def by_quantity(columns: list[str]) -> dict[str, list[str]]:
+    """Group `system.variable` columns by the variable (the name after the last dot), one panel each:
+    ['robot.j1.q', 'robot.j2.q', 'j1.theta.f'] -> {'q': [both q], 'f': ['j1.theta.f']} (same units)."""
+    groups: dict[str, list[str]] = {}
+    for c in columns:
+        groups.setdefault(str(c).rsplit(".", 1)[-1], []).append(c)
+    return groups
+
+
 def plot_timeseries(
     frame: pd.DataFrame,
     path: str | Path,
@@ -31,7 +40,10 @@ def plot_timeseries(
             f"the time series has no '{time}' column", f"it has {', '.join(map(str, frame.columns))}"
         )
     if panels is None:
-        panels = {c: [c] for c in columns or [c for c in frame.columns if c != time]}
+        names = columns or [c for c in frame.columns if c != time]
+        panels = {c: [c] for c in names}
+        if columns is None and len(panels) > MAX_PANELS:
+            panels = by_quantity(names)
     wanted = [c for cols in panels.values() for c in cols]
     missing = [c for c in wanted if c not in frame.columns]
     if missing or not wanted:

@@ -20,6 +20,7 @@ import pandas as pd
 from .. import space, units
 from ..errors import DesignerError
 from ..files import atomic_path, atomic_write
+from ..keys import check_keys
 
 #: the load column of each axis
 LOAD: dict[str, str] = {
@@ -92,6 +93,10 @@ class RigLog:
         }
 
 
+#: keys a sidecar may hold: the six factors, and the load channel's lag behind the positions (s)
+SIDECAR_KEYS = ("factors", "load_delay_s")
+
+
 def sidecar_path(path: str | Path) -> Path:
     """The JSON sidecar holding a log's factors: the log's path with the suffix `.json`."""
     return Path(path).with_suffix(".json")
@@ -147,6 +152,8 @@ def _read_sidecar(path: Path) -> dict[str, float] | None:
         doc = json.loads(side.read_text())
     except (OSError, ValueError) as exc:
         raise DesignerError(f"cannot read {side}: {exc}", 'write it as {"factors": {...}}') from None
+    if isinstance(doc, dict):
+        check_keys(doc, SIDECAR_KEYS, where=side.name)
     if not isinstance(doc, dict) or not isinstance(doc.get("factors"), dict):
         raise DesignerError(f"{side}: no 'factors' object", 'write it as {"factors": {"density": 60, ...}}')
     return _check_factors(doc["factors"], side.name)
@@ -260,6 +267,9 @@ def _read_frame(p: Path) -> pd.DataFrame:
     import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
 
+    from ..files import check_table_file
+
+    check_table_file(p, parquet=p.suffix.lower() in _PARQUET)
     table = pq.read_table(p) if p.suffix.lower() in _PARQUET else pacsv.read_csv(p)
     if len(set(table.column_names)) < table.num_columns:
         return table.to_pandas()
@@ -274,6 +284,8 @@ def read_log(path: str | Path) -> RigLog:
         raise DesignerError(f"no such log: {p}", "give the path of a CSV or Parquet rig log")
     try:
         raw = _read_frame(p)
+    except DesignerError:
+        raise
     except (ValueError, OSError, pd.errors.ParserError, UnicodeDecodeError) as exc:
         first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise DesignerError(f"cannot read {p}: {first}", "give a CSV or Parquet rig log") from None
