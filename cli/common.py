@@ -60,7 +60,7 @@ def parse_fix(items: list[str] | None) -> dict[str, float]:
             close = difflib.get_close_matches(name, space.FACTOR_NAMES, n=1)
             hint = f"did you mean '{close[0]}'? " if close else ""
             raise DesignerError(
-                f"--fix {item}: '{name}' is not a factor",
+                f"unknown factor '{name}' in --fix {item}",
                 f"{hint}factors: {', '.join(space.FACTOR_NAMES)}",
             )
         if name in fixed:
