@@ -134,6 +134,8 @@ def space_cmd(
     from designer.plots import space
 
     _image_out(output)
+    if target is not None and not target > 0:
+        raise DesignerError(f"--target {target:g}", "give a positive target in rig units (N/mm, N.s/mm)")
     if html is not None:
         from designer.files import check_output
 

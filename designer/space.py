@@ -80,6 +80,8 @@ def check_value(name: str, value: float, allow_extrapolation: bool = False) -> f
         )
     if v <= 0:
         raise DesignerError(f"{name} = {v:g} {f.unit} must be positive", f"give {f.describe_range()}")
+    if f.unit == "%" and v > 100:
+        raise DesignerError(f"{name} = {v:g} % is more than solid", f"give {f.describe_range()}")
     return v
 
 

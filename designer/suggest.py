@@ -169,7 +169,7 @@ class Suggestion:
             }
             candidates = [
                 Candidate(
-                    params=dict(c["params"]),
+                    params=space.validate(c["params"], allow_extrapolation=True),
                     predicted={
                         q: Prediction.from_dict(p, where=f"{where} candidate {i + 1} {q}")
                         for q, p in c["predicted"].items()
