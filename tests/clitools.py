@@ -38,7 +38,8 @@ def snapshot(*folders: Path) -> dict[str, tuple[int, float]]:
             for name in dirs + files:
                 p = Path(root, name)
                 st = p.lstat()
-                seen[str(p)] = (st.st_size if p.is_file() else -1, st.st_mtime_ns)
+                # a folder's own time changes when a probe file comes and goes: only files' times count
+                seen[str(p)] = (st.st_size, st.st_mtime_ns) if p.is_file() else (-1, 0)
     return seen
 
 

@@ -1,0 +1,149 @@
+"""Exit codes, interrupts and outputs: SIGINT, SIGTERM and SIGHUP at random moments of long commands
+leave complete files or none; output folders are staged and swapped; a full disk is one line."""
+
+from __future__ import annotations
+
+import json
+import random
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from clitools import CLI, run_inprocess, snapshot
+
+FACTORS = ["--density", "60", "--length", "24", "--width", "4.5", "--height", "9", "--layer", "0.16"]
+SIMULATE = ["rig", "simulate", "--k", "0.8", "--c", "2e-3", "--duration", "150", *FACTORS, "--raster", "0"]
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def _interrupt(args: list[str], cwd: Path, sig: int, after: float) -> subprocess.CompletedProcess:
+    proc = subprocess.Popen([*CLI, *args], cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(after)
+    if proc.poll() is None:
+        proc.send_signal(sig)
+    out, err = proc.communicate(timeout=120)
+    return subprocess.CompletedProcess(args, proc.returncode, out, err)
+
+
+def _complete(path: Path) -> None:
+    """Raise unless `path` is a whole file of its kind."""
+    if path.suffix == ".csv":
+        frame = pd.read_csv(path)
+        assert len(frame) > 0 and not frame.iloc[-1].isna().all()
+    elif path.suffix == ".parquet":
+        pd.read_parquet(path)
+    elif path.suffix == ".json":
+        json.loads(path.read_text())
+    elif path.suffix == ".png":
+        from PIL import Image
+
+        with Image.open(path) as im:
+            im.load()
+    else:
+        raise AssertionError(f"unexpected file {path}")
+
+
+@pytest.mark.parametrize(
+    ("sig", "seed"), [(signal.SIGTERM, 1), (signal.SIGINT, 2), (signal.SIGHUP, 3), (signal.SIGTERM, 4)]
+)
+def test_signal_during_rig_simulate_leaves_complete_files_or_none(tmp_path, sig, seed):
+    after = random.Random(seed).uniform(0.3, 3.0)
+    r = _interrupt([*SIMULATE, "-o", "big.csv"], tmp_path, sig, after)
+    assert r.returncode in (0, 128 + sig), r.stderr
+    assert "Traceback" not in r.stderr
+    names = {p.name for p in tmp_path.iterdir()}
+    assert not [n for n in names if n.startswith(".")], f"part files left: {names}"
+    if r.returncode == 0:
+        assert names == {"big.csv", "big.json"}
+    else:
+        assert r.stderr.strip() == f"stopped by {signal.Signals(sig).name}; partial files removed"
+    if "big.csv" in names:
+        assert len(pd.read_csv(tmp_path / "big.csv")) == 150_001
+    if "big.json" in names:
+        assert json.loads((tmp_path / "big.json").read_text())["factors"]["density"] == 60
+
+
+def test_sigterm_during_cosim_leaves_complete_files_or_none(tmp_path):
+    after = random.Random(5).uniform(1.0, 4.0)
+    r = _interrupt(["cosim", str(EXAMPLES / "rig.toml"), "-o", "res"], tmp_path, signal.SIGTERM, after)
+    assert r.returncode in (0, 143) and "Traceback" not in r.stderr, r.stderr
+    for p in tmp_path.rglob("*"):
+        assert not p.name.startswith("."), f"part file left: {p}"
+        if p.is_file():
+            _complete(p)
+
+
+def test_exit_codes_and_version(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run_inprocess(["--version"], capsys)
+    assert code == 0 and out.startswith("designer ")
+    assert run_inprocess(["predict", "--density", "60"], capsys)[0] == 2
+    # 1: a negative answer, nothing written (clean refuses to drop 12 of the 44 study runs)
+    from designer.data import load_table
+
+    load_table().to_csv("t.csv", index=False)
+    code, out, err = run_inprocess(["clean", "t.csv", "-o", "kept.csv"], capsys)
+    assert code == 1 and "refused" in err and not Path("kept.csv").exists()
+    # 3: an internal error says so in one line, with the hint; --debug shows the traceback
+    import designer.rig.clean as cleaning
+
+    monkeypatch.setattr(cleaning, "clean", lambda *a, **k: 1 / 0)
+    code, out, err = run_inprocess(["clean", "t.csv"], capsys)
+    assert code == 3 and err.count("\n") == 1 and "internal error: ZeroDivisionError" in err
+    assert "report" in err and "Traceback" not in err
+    code, out, err = run_inprocess(["clean", "t.csv", "--debug"], capsys)
+    assert code == 3 and "Traceback" in err and "1 / 0" in err
+
+
+def test_result_folder_is_staged_and_swapped(tmp_path):
+    from designer.files import atomic_dir
+
+    target = tmp_path / "report"
+    target.mkdir()
+    (target / "report.html").write_text("old")
+    (target / "notes.txt").write_text("the user's")
+    before = snapshot(tmp_path)
+    with pytest.raises(KeyboardInterrupt), atomic_dir(target) as stage:
+        (stage / "report.html").write_text("new")
+        (stage / "figures").mkdir()
+        raise KeyboardInterrupt  # an interrupt half-way: the old report stays whole, no stage left
+    assert snapshot(tmp_path) == before
+    with atomic_dir(target) as stage:
+        (stage / "report.html").write_text("new")
+        (stage / "figures").mkdir()
+        assert not (target / "figures").exists()
+    assert (target / "report.html").read_text() == "new" and (target / "figures").is_dir()
+    assert (target / "notes.txt").read_text() == "the user's"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]
+    with atomic_dir(tmp_path / "fresh") as stage:
+        (stage / "a.txt").write_text("a")
+    assert (tmp_path / "fresh" / "a.txt").read_text() == "a"
+
+
+@pytest.fixture()
+def small_disk(tmp_path):
+    """A 2 MiB tmpfs (skipped where mounting is not allowed)."""
+    mnt = tmp_path / "small"
+    mnt.mkdir()
+    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=2m", "tmpfs", str(mnt)], capture_output=True)
+    if r.returncode != 0:
+        pytest.skip("cannot mount a tmpfs here")
+    yield mnt
+    subprocess.run(["umount", str(mnt)], check=True)
+
+
+def test_full_disk_before_and_during_a_write(small_disk, capsys, monkeypatch):
+    from designer.errors import DesignerError
+    from designer.files import atomic_write
+
+    monkeypatch.chdir(small_disk)
+    # refused before the work, with the estimate
+    code, out, err = run_inprocess([*SIMULATE, "-o", "big.csv"], capsys)
+    assert code == 2 and "not enough space for big.csv: about 9.4 MiB needed" in err, err
+    # the disk filling up during a write: one message, no part file
+    with pytest.raises(DesignerError, match="disk filled up"), atomic_write(small_disk / "x.bin", "wb") as fh:
+        fh.write(bytes(4 << 20))
+    assert list(small_disk.iterdir()) == []
