@@ -17,6 +17,7 @@ import errno
 import signal
 import sys
 import traceback
+import warnings
 from typing import Annotated
 
 import typer
@@ -117,6 +118,13 @@ def run(argv: list[str] | None = None) -> int:
     debug = "--debug" in args[: args.index("--")] if "--" in args else "--debug" in args
     if debug:
         args.remove("--debug")
+    with warnings.catch_warnings():
+        if not debug:  # library warnings (numpy overflow, deprecations) are not the user's business
+            warnings.simplefilter("ignore")
+        return _run(args, debug)
+
+
+def _run(args: list[str], debug: bool) -> int:
     try:
         code = app(args=args, prog_name="designer", standalone_mode=False)
         return code if isinstance(code, int) else 0

@@ -88,6 +88,12 @@ def make_target(
     if not np.isfinite(importance) or importance <= 0:
         raise DesignerError(f"importance of {quantity} = {importance:g} must be positive", "give a value > 0")
     obs_lo, obs_hi = surrogate.model(f"{quantity}_{axis}").observed_range
+    if value > 1e6 * obs_hi:  # the desirability scale (bounds squared) would overflow
+        raise DesignerError(
+            f"target {quantity} = {value:g} {unit} is over a million times the largest measured, "
+            f"{obs_hi:.3g} {unit}",
+            "give a target near the data's range",
+        )
     lo = min(obs_lo, 0.5 * value) if low is None else low
     hi = max(obs_hi, 1.5 * value) if high is None else high
     if not lo < value < hi:
