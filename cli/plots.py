@@ -262,7 +262,7 @@ def validate_cmd(
     from designer.report import validate
 
     with progress_bar("validating") as bar:
-        results, page, md, seconds = validate(output, table, progress=bar)
+        results, page, md, seconds = validate(output, table=table, progress=bar)
     failed = [r for r in results if not r.passed]
     if as_json:
         print_json(
