@@ -115,3 +115,27 @@ def test_library_messages_name_python_arguments_and_the_library_never_prints():
                     for m in flag.findall(text.replace("cc --version", "")):
                         found.append(f"{path.name}:{node.lineno} {m}")
     assert not found, found
+
+
+def test_the_api_tour_runs_with_public_names_only(tmp_path):
+    import subprocess
+    import sys
+
+    script = Path(__file__).resolve().parent.parent / "examples" / "api_tour.py"
+    text = script.read_text()
+    tree = ast.parse(text)
+    imports = {a.name for n in ast.walk(tree) if isinstance(n, (ast.Import, ast.ImportFrom)) for a in n.names}
+    assert imports == {"sys", "Path", "designer"}
+    used = {
+        n.attr
+        for n in ast.walk(tree)
+        if isinstance(n, ast.Attribute) and getattr(n.value, "id", "") == "designer"
+    }
+    assert used <= set(designer.__all__), used - set(designer.__all__)
+    code = [line for line in text.splitlines() if line.strip() and not line.lstrip().startswith("#")]
+    body = code[code.index('"""') + 1 :] if '"""' in code else code
+    assert len(body) < 30, len(body)
+    run = subprocess.run([sys.executable, "-I", str(script), str(tmp_path)], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert "k_x = " in run.stdout and "overshoot" in run.stdout
+    assert {p.name for p in tmp_path.iterdir()} == {"joint.fmu", "arm.toml"}
