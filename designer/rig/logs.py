@@ -134,7 +134,7 @@ def _check_factors(factors: dict | None, source: str) -> dict[str, float] | None
     if factors is None:
         return None
     try:
-        return space.validate(factors, allow_extrapolation=True)
+        return space.check_design(factors, allow_extrapolation=True)
     except DesignerError as exc:
         raise DesignerError(f"{source}: {exc.problem}", exc.fix) from None
 
