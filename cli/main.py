@@ -25,6 +25,7 @@ import typer
 from designer.errors import DesignerError
 
 from . import cosim, design, export, plots, rig
+from .common import flag_message
 
 try:  # typer 0.28 vendors click
     from typer._click import exceptions as _click_errors
@@ -143,7 +144,7 @@ def _run(args: list[str], debug: bool) -> int:
         where = f"{ctx.command_path} --help" if ctx is not None else "designer --help"
         return _fail(exc.format_message(), f"see {where}", 2)
     except DesignerError as exc:
-        return _fail(exc.problem, exc.fix, 2)
+        return _fail(flag_message(exc.problem), exc.fix and flag_message(exc.fix), 2)
     except MemoryError:
         return _fail("out of memory", "ask for a smaller run (shorter, coarser, fewer cases)", 2)
     except OSError as exc:

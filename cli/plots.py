@@ -250,7 +250,9 @@ def _read_series(path: Path):
     if not path.is_file():
         raise DesignerError(f"no such file: {path}", "give a CSV or Parquet time series")
     try:
-        return pd.read_parquet(path) if path.suffix.lower() in (".parquet", ".pq") else pd.read_csv(path)
+        from designer.data import read_frame
+
+        return read_frame(path)
     except (ValueError, OSError, pd.errors.ParserError, UnicodeDecodeError) as exc:
         raise DesignerError(
             f"cannot read {path}: {str(exc).splitlines()[0]}", "give a CSV or Parquet file"
@@ -268,18 +270,22 @@ def validate_cmd(
 
     Example: designer validate -o report/
     """
-    from designer.files import atomic_dir, check_output
+    from designer.files import check_output
     from designer.report import validate
 
     check_output(output, kind="folder", estimate_bytes=20e6)
-    # staged beside the target and moved in at the end: an interrupt leaves the old report whole
-    with atomic_dir(output) as stage, progress_bar("validating") as bar:
-        results, page, md, seconds = validate(stage, table, progress=bar)
-        checks = [_moved(r.to_dict(), stage, output) for r in results]
-    page, md = output / page.name, output / md.name
+    with progress_bar("validating") as bar:
+        results, page, md, seconds = validate(output, table=table, progress=bar)
     failed = [r for r in results if not r.passed]
     if as_json:
-        print_json({"passed": not failed, "seconds": seconds, "report": str(page), "checks": checks})
+        print_json(
+            {
+                "passed": not failed,
+                "seconds": seconds,
+                "report": str(page),
+                "checks": [r.to_dict() for r in results],
+            }
+        )
     else:
         for r in results:
             mark = "[green]PASS[/green]" if r.passed else "[red]FAIL[/red]"
@@ -290,17 +296,6 @@ def validate_cmd(
         )
     if failed:
         raise typer.Exit(1)
-
-
-def _moved(obj, stage: Path, target: Path):
-    """`obj` with paths inside the staging folder rewritten to where they end up."""
-    if isinstance(obj, dict):
-        return {k: _moved(v, stage, target) for k, v in obj.items()}
-    if isinstance(obj, list):
-        return [_moved(v, stage, target) for v in obj]
-    if isinstance(obj, (str, Path)) and str(obj).startswith(str(stage)):
-        return str(target) + str(obj)[len(str(stage)) :]
-    return obj
 
 
 def register(app: typer.Typer) -> None:

@@ -4,7 +4,7 @@ Output paths are probed before any work (`check_output`): a folder where a file 
 reverse), a folder that does not exist or cannot be written (read-only, /proc), and too little free
 space for the estimated size are reported up front instead of after a long computation. Files are
 written to a temporary name beside the target and renamed over it (`atomic_write`, `atomic_path`); a
-folder of results is staged beside its target and moved in at the end (`atomic_dir`).
+folder of results is staged beside its target and moved in at the end (`atomic_folder`).
 """
 
 from __future__ import annotations
@@ -201,7 +201,7 @@ def _move_in(stage: Path, target: Path) -> None:
 
 
 @contextlib.contextmanager
-def atomic_dir(path: str | Path) -> Iterator[Path]:
+def atomic_folder(path: str | Path) -> Iterator[Path]:
     """A staging folder beside `path`, moved into place when the block succeeds (removed when not).
 
     A missing or empty target is replaced by the staged folder in one rename; into an existing folder
@@ -277,3 +277,26 @@ def check_table_file(path: str | Path, *, parquet: bool) -> None:
                 f"{p} is separated by {used[0]}, not commas",
                 "save it as comma-separated CSV (decimal point '.'), or as Parquet",
             )
+
+
+def check_output_folder(path: str | Path) -> Path:
+    """Check, before any work, that `path` is or can become a writable folder; returns it.
+
+    Raises:
+        DesignerError: `path` is a file, or it (or its nearest existing parent) is not writable.
+    """
+    return check_output(path, kind="folder")
+
+
+def check_suffix(path: str | Path, suffixes: tuple[str, ...], *, what: str) -> Path:
+    """Refuse a path whose suffix is not one of `suffixes` (a writer writes only its own format).
+
+    Raises:
+        DesignerError: naming the `path` argument, the format and the suffixes it takes.
+    """
+    path = Path(path)
+    if path.suffix.lower() not in suffixes:
+        raise DesignerError(
+            f"path={str(path)!r} does not name {what} file", f"give a path ending in {' or '.join(suffixes)}"
+        )
+    return path

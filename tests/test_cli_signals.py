@@ -99,26 +99,26 @@ def test_exit_codes_and_version(tmp_path, monkeypatch, capsys):
 
 
 def test_result_folder_is_staged_and_swapped(tmp_path):
-    from designer.files import atomic_dir
+    from designer.files import atomic_folder
 
     target = tmp_path / "report"
     target.mkdir()
     (target / "report.html").write_text("old")
     (target / "notes.txt").write_text("the user's")
     before = snapshot(tmp_path)
-    with pytest.raises(KeyboardInterrupt), atomic_dir(target) as stage:
+    with pytest.raises(KeyboardInterrupt), atomic_folder(target) as stage:
         (stage / "report.html").write_text("new")
         (stage / "figures").mkdir()
         raise KeyboardInterrupt  # an interrupt half-way: the old report stays whole, no stage left
     assert snapshot(tmp_path) == before
-    with atomic_dir(target) as stage:
+    with atomic_folder(target) as stage:
         (stage / "report.html").write_text("new")
         (stage / "figures").mkdir()
         assert not (target / "figures").exists()
     assert (target / "report.html").read_text() == "new" and (target / "figures").is_dir()
     assert (target / "notes.txt").read_text() == "the user's"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]
-    with atomic_dir(tmp_path / "fresh") as stage:
+    with atomic_folder(tmp_path / "fresh") as stage:
         (stage / "a.txt").write_text("a")
     assert (tmp_path / "fresh" / "a.txt").read_text() == "a"
 
