@@ -8,9 +8,12 @@ real `python -I` processes of the installed package.
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 import pytest
 from clitools import assert_clean_failure, make_inputs, run_inprocess, run_process, snapshot
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 # commands that write one file with -o, and the suffix they write
 FILE_COMMANDS = {
@@ -277,7 +280,7 @@ def test_messages_name_the_problem(workdir, capsys):
         ("doe", "--all-continuous", "--augment", "3"): "--all-continuous",
         ("fit", "-o", "in"): "is a folder",
         ("rig", "simulate", *K, "-o", "l.xlsx"): "suffix '.xlsx'",
-        ("cosim", "in/bad.toml", "-o", "in/good.csv"): "is a file",
+        ("cosim", str(EXAMPLES / "rig.toml"), "-o", "in/good.csv"): "is a file",
     }
     for args, text in expect.items():
         code, out, err = run_inprocess(list(args), capsys)
