@@ -174,6 +174,8 @@ def suggest(
     Either target may be omitted. Each candidate comes with predicted values, 95 % prediction
     intervals and its composite desirability; targets the data cannot reach or predict are said so.
 
+    Exits 1 when a target is out of reach (the nearest designs are still listed).
+
     Example: designer suggest --k 0.8 --c 2e-3 --fix raster=0 --top 3
     """
     from designer.suggest import suggest as run_suggest
@@ -192,8 +194,10 @@ def suggest(
     data = result.to_dict()
     if as_json:
         print_json(data)
-        return
-    _print_suggestion(data)
+    else:
+        _print_suggestion(data)
+    if not data["reachable"]:  # a negative answer: the nearest designs are shown, none meets the target
+        raise typer.Exit(1)
 
 
 def _print_suggestion(data: dict) -> None:

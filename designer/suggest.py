@@ -175,7 +175,7 @@ class Suggestion:
             }
             candidates = [
                 Candidate(
-                    params=space.validate(c["params"], allow_extrapolation=True),
+                    params=space.check_design(c["params"], allow_extrapolation=True),
                     predicted={
                         q: Prediction.from_dict(p, where=f"{where} candidate {i + 1} {q}")
                         for q, p in c["predicted"].items()

@@ -274,6 +274,7 @@ def test_messages_name_the_problem(workdir, capsys):
         ("suggest", "--k", "0.8", "--fix", "width=3", "--fix", "width=5"): "given twice",
         ("export", "fmu", "--from", "in/sug_other.json"): "is not a suggestion: no 'axis'",
         ("export", "fmu", "--from", "in/sug_typo.json"): "did you mean 'candidates'",
+        ("export", "fmu", "--from", "in/sug_range.json"): "density = 500 % is more than solid",
         ("identify", "in/side_typo.csv"): "did you mean 'load_delay_s'",
         ("rig", "simulate", *K, "--duration", "1e9", "-o", "big.csv"): "TiB",
         ("doe", "--augment", "100000"): "486",
