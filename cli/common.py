@@ -38,6 +38,14 @@ def output_option(help: str) -> Any:
     return typer.Option("-o", "--output", help=help)
 
 
+def quiet_mujoco() -> None:
+    """Drop MuJoCo's warnings for this process: by default MuJoCo prints them and appends them to
+    MUJOCO_LOG.TXT in the current folder; the co-simulation reports an unstable run itself, in one line."""
+    import mujoco
+
+    mujoco.set_mju_user_warning(lambda message: None)
+
+
 def parse_fix(items: list[str] | None) -> dict[str, float]:
     """['width=4.5', 'raster=0'] -> {'width': 4.5, 'raster': 0.0}; names checked, each factor once.
 

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from .common import console, print_json, progress
+from .common import console, print_json, progress, quiet_mujoco
 
 
 def cosim(
@@ -25,6 +25,7 @@ def cosim(
     from designer.cosim import load, run, write_outputs
     from designer.files import check_output_folder
 
+    quiet_mujoco()
     sc = load(scenario)
     check_output_folder(out)
     with progress(f"co-simulating {scenario.name}", enabled=not json_out) as bar:

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from .common import FixOpt, console, parse_fix, print_json
+from .common import FixOpt, console, parse_fix, print_json, quiet_mujoco
 from .common import progress as progress_bar
 
 plot_app = typer.Typer(
@@ -274,6 +274,7 @@ def validate_cmd(
     from designer.report import validate
 
     check_output(output, kind="folder", estimate_bytes=20e6)
+    quiet_mujoco()
     with progress_bar("validating") as bar:
         results, page, md, seconds = validate(output, table=table, progress=bar)
     failed = [r for r in results if not r.passed]
