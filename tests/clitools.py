@@ -90,6 +90,11 @@ def make_inputs(folder: Path) -> None:
     _make_suggestions(folder)
     _make_series(folder)
     (folder / "bad.toml").write_text("[simulation\nduration = ")
+    # a step far too large for the arm: MuJoCo warns (printed, and MUJOCO_LOG.TXT by default) and resets
+    (folder / "diverge.toml").write_text(
+        '[simulation]\nduration = 1.0\nstep = 0.08\n[robot]\nmodel = "arm"\n[joints.j1]\naxis = "theta"\n'
+        'coefficients = { k = 330, c = 0.83 }\nreference = { type = "step", amplitude = 0.3, at = 0.1 }\n'
+    )
     (folder / "binary.toml").write_bytes(bytes(range(256)))
 
 

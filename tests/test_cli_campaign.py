@@ -180,6 +180,7 @@ BAD_FLAGS = [
     ["cosim", "in/bad.toml"],
     ["cosim", "in/binary.toml"],
     ["cosim", "in/good.csv"],
+    ["cosim", "in/diverge.toml", "-o", "res"],
     ["cosim", "in/bad.toml", "-o", "in/good.csv"],
     ["validate", "-o", "in/good.csv"],
     ["validate", "-o", "/proc/report"],
@@ -253,6 +254,7 @@ REAL = [
     ["doe", "--augment", "100000"],
     ["cosim", "in/bad.toml", "-o", "in/good.csv"],
     ["clean", "in/empty.csv", "-o", "c.csv"],
+    ["cosim", "in/diverge.toml", "-o", "res"],
 ]
 
 
