@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from .common import FixOpt, JsonOpt, SurrogateOpt, console, parse_fix, print_json
+from .common import DataOpt, FixOpt, JsonOpt, SurrogateOpt, console, output_option, parse_fix, print_json
 
 AxisOpt = Annotated[str, typer.Option("--axis", help="Axis: x y z theta phi psi.")]
 
@@ -24,15 +24,13 @@ def _pi(p: dict) -> str:
 
 
 def fit(
-    data: Annotated[Path | None, typer.Option("--data", help="Coefficient table (CSV/Parquet).")] = None,
-    out: Annotated[
-        Path | None, typer.Option("--out", "-o", help="Where to write the surrogate JSON.")
-    ] = None,
+    data: DataOpt = None,
+    out: Annotated[Path | None, output_option("Where to write the surrogate JSON.")] = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Fit the response surfaces (form and ridge penalty chosen by leave-one-out) and save them.
 
-    Without --data, fits the bundled 44-run study table; without --out, writes nothing and reports.
+    Without --data, fits the bundled 44-run study table; without -o, writes nothing and reports.
 
     Example: designer fit --data my_runs.csv -o my_surrogate.json
     """
