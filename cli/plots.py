@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from .common import FixOpt, console, parse_fix, print_json, quiet_mujoco
+from .common import DataOpt, FixOpt, console, parse_fix, print_json, quiet_mujoco
 from .common import progress as progress_bar
 
 plot_app = typer.Typer(
@@ -16,10 +16,6 @@ plot_app = typer.Typer(
 )
 
 Output = Annotated[Path, typer.Option("-o", "--output", help="image file (.png .svg .pdf)")]
-Table = Annotated[
-    Path | None,
-    typer.Option("--table", help="coefficient table (CSV/Parquet); default: the bundled 44 runs"),
-]
 Axis = Annotated[str, typer.Option("--axis", help="axis: x y z theta phi psi")]
 Json = Annotated[bool, typer.Option("--json", help="print the plotted numbers as JSON")]
 
@@ -49,7 +45,7 @@ def effects_cmd(
         typer.Option("--response", help="quantities, comma-separated: c,k (default: all)"),
     ] = None,
     axis: Axis = "x",
-    table: Table = None,
+    table: DataOpt = None,
     as_json: Json = False,
 ) -> None:
     """Main-effect boxplots of each response against each factor's levels, medians in red.
@@ -76,7 +72,7 @@ def heatmap_cmd(
         str | None,
         typer.Option("--axis", help="only this axis' responses (default: all in the table)"),
     ] = None,
-    table: Table = None,
+    table: DataOpt = None,
     as_json: Json = False,
 ) -> None:
     """Heat map of the Pearson correlations between the six factors and the responses.
@@ -263,7 +259,7 @@ def validate_cmd(
     output: Annotated[
         Path, typer.Option("-o", "--output", help="folder for report.html, report.md, figures/")
     ] = Path("report"),
-    table: Table = None,
+    table: DataOpt = None,
     as_json: Json = False,
 ) -> None:
     """Check the tool against the study and itself; write HTML and Markdown reports; exit 1 if a check fails.

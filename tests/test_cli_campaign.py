@@ -57,10 +57,10 @@ TABLE_COMMANDS = {
     "fit": lambda t: ["fit", "--data", t],
     "analyze": lambda t: ["analyze", "--data", t],
     "doe --augment": lambda t: ["doe", "--augment", "2", "--data", t],
-    "plot effects": lambda t: ["plot", "effects", "--table", t],
-    "plot heatmap": lambda t: ["plot", "heatmap", "--table", t],
+    "plot effects": lambda t: ["plot", "effects", "--data", t],
+    "plot heatmap": lambda t: ["plot", "heatmap", "--data", t],
     "clean": lambda t: ["clean", t],
-    "validate": lambda t: ["validate", "--table", t],
+    "validate": lambda t: ["validate", "--data", t],
 }
 BAD_LOGS = [
     "log_semicolon.csv",
@@ -169,7 +169,7 @@ BAD_FLAGS = [
     ["plot", "space", "--z", "density"],
     ["plot", "space", "--volume"],
     ["plot", "space", "--fix", "colour=red"],
-    ["plot", "heatmap", "--table", "in/onerun.csv"],
+    ["plot", "heatmap", "--data", "in/onerun.csv"],
     ["plot", "effects", "--response", "q"],
     ["plot", "loo", "--axis", "theta"],
     ["plot", "timeseries", "in/nots.csv"],

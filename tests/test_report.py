@@ -60,7 +60,7 @@ def test_bad_table_fails_in_one_line(tmp_path):
     bad.write_text("density,length\n1,2\n")
     exe = Path(sys.executable).with_name("designer")
     run = subprocess.run(
-        [str(exe), "validate", "--table", str(bad), "-o", "rep"], capture_output=True, text=True, cwd=tmp_path
+        [str(exe), "validate", "--data", str(bad), "-o", "rep"], capture_output=True, text=True, cwd=tmp_path
     )
     assert run.returncode == 2 and run.stderr.startswith("error:") and "Traceback" not in run.stderr
 
