@@ -9,7 +9,7 @@ import typer
 
 from designer.errors import DesignerError
 
-from .common import console, err_console, print_json, progress
+from .common import JsonOpt, console, err_console, print_json, progress
 
 rig_app = typer.Typer(help="The virtual rig: simulate the study's experiment.", no_args_is_help=True)
 
@@ -26,7 +26,7 @@ def identify(
     window: Annotated[
         float | None, typer.Option(help="Savitzky-Golay window, s (default: from the excitation)")
     ] = None,
-    json_out: Annotated[bool, typer.Option("--json", help="print JSON")] = False,
+    json_out: JsonOpt = False,
 ) -> None:
     """Identify m, c, k per axis from rig logs (least squares of F = m r'' + c r' + k r).
 
@@ -103,6 +103,7 @@ def simulate(
     height: Annotated[float | None, typer.Option(help=_FACTOR_HELP)] = None,
     layer: Annotated[float | None, typer.Option(help=_FACTOR_HELP)] = None,
     raster: Annotated[float | None, typer.Option(help=_FACTOR_HELP)] = None,
+    json_out: JsonOpt = False,
 ) -> None:
     """Drive a joint with the study's chirp (0.2 to 1.85 Hz) and write the rig log.
 
@@ -136,6 +137,21 @@ def simulate(
         bar(0.5)
         write_log(df, output, factors or None)
         bar(1.0)
+    if json_out:
+        from designer.rig.logs import sidecar_path
+
+        sidecar = str(sidecar_path(output)) if factors else None
+        print_json(
+            {
+                "path": str(output),
+                "rows": len(df),
+                "duration_s": duration,
+                "rate_hz": rate,
+                "axes": list(axis),
+            }
+            | {"coefficients": {"m": m, "c": c, "k": k}, "factors": factors or None, "sidecar": sidecar}
+        )
+        return
     console.print(f"wrote {output}: {len(df)} rows, {duration:g} s at {rate:g} Hz, axes {', '.join(axis)}")
 
 
@@ -152,7 +168,7 @@ def clean(
         float,
         typer.Option(help="refuse (exit 1, nothing written) when more than this share of runs would go"),
     ] = 0.2,
-    json_out: Annotated[bool, typer.Option("--json", help="print JSON")] = False,
+    json_out: JsonOpt = False,
 ) -> None:
     """Drop runs with NaN or zero coefficients, then DBSCAN outliers; say why for each and what DBSCAN did.
 
@@ -218,7 +234,7 @@ def doe(
     data: Annotated[
         Path | None, typer.Option(help="with --augment: table to fit (default: bundled surrogate)")
     ] = None,
-    json_out: Annotated[bool, typer.Option("--json", help="print JSON")] = False,
+    json_out: JsonOpt = False,
 ) -> None:
     """Plan specimens: the study's Box-Behnken run sheet, or the next N that most narrow the 95 % PIs.
 
@@ -311,7 +327,7 @@ def analyze(
     data: Annotated[
         Path | None, typer.Option(help="coefficient table (default: the bundled study table)")
     ] = None,
-    json_out: Annotated[bool, typer.Option("--json", help="print JSON")] = False,
+    json_out: JsonOpt = False,
 ) -> None:
     """MANOVA over the responses, ANOVA per response with contribution %, correlations, Table 4.
 
