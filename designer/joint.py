@@ -24,6 +24,11 @@ if TYPE_CHECKING:
 PRB_GAMMA = 0.85
 
 
+#: largest m, c or k in rig units a joint may have (1e9 N/mm is 1e12 N/m, stiffer than a 10 mm steel
+#: cube, ~2e9 N/m); above it a number is a unit mistake, and squared in a simulation it overflows
+MAX_COEFFICIENT = 1e9
+
+
 @dataclass(frozen=True)
 class AxisCoefficients:
     """One axis of a joint in rig units; `m` may be None (force element needs none)."""
@@ -47,6 +52,12 @@ class AxisCoefficients:
                 raise DesignerError(
                     f"{q} on axis {self.axis} = {v:g} {units.rig_unit(q, self.axis)} is not a valid value",
                     f"give a finite, {'non-negative' if q == 'c' else 'positive'} number",
+                )
+            if v > MAX_COEFFICIENT:
+                unit = units.rig_unit(q, self.axis)
+                raise DesignerError(
+                    f"{q} on axis {self.axis} = {v:g} {unit} is beyond any physical joint",
+                    f"give it in rig units, at most {MAX_COEFFICIENT:g} {unit}",
                 )
 
     def si(self) -> dict[str, float | None]:

@@ -38,7 +38,8 @@ _MANOVA_STATS = {
 }
 
 
-def _responses(table: pd.DataFrame, responses: list[str] | None) -> list[str]:
+def _responses(table: pd.DataFrame, responses: list[str] | None, *, fit: bool = True) -> list[str]:
+    """The response columns, checked present; with `fit`, also enough runs for the six-factor model."""
     cols = coefficient_columns(table) if responses is None else responses
     missing = [r for r in cols if r not in table.columns]
     if missing:
@@ -48,7 +49,7 @@ def _responses(table: pd.DataFrame, responses: list[str] | None) -> list[str]:
     if not cols:
         raise DesignerError("no response columns", "give a table with c_<axis>, k_<axis> columns")
     dof = len(table) - len(space.FACTOR_NAMES) - 1
-    if dof < 1:
+    if fit and dof < 1:
         raise DesignerError(f"{len(table)} runs leave no error degrees of freedom", "give at least 8 runs")
     return cols
 
@@ -92,8 +93,14 @@ def manova(table: pd.DataFrame, responses: list[str] | None = None) -> list[dict
 
 
 def correlation(table: pd.DataFrame, responses: list[str] | None = None) -> pd.DataFrame:
-    """Pearson correlation of the six factors and the responses."""
-    return table[list(space.FACTOR_NAMES) + _responses(table, responses)].corr()
+    """Pearson correlation of the six factors and the responses (NaN for a column that does not vary)."""
+    cols = list(space.FACTOR_NAMES) + _responses(table, responses, fit=False)
+    if len(table) < 3:
+        raise DesignerError(
+            f"{len(table)} run(s): a correlation needs at least 3 runs (with 2, every one is +1 or -1)",
+            "give a table of more runs",
+        )
+    return table[cols].corr()
 
 
 def paper_table4() -> pd.DataFrame:
