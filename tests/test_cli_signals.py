@@ -147,3 +147,25 @@ def test_full_disk_before_and_during_a_write(small_disk, capsys, monkeypatch):
     with pytest.raises(DesignerError, match="disk filled up"), atomic_write(small_disk / "x.bin", "wb") as fh:
         fh.write(bytes(4 << 20))
     assert list(small_disk.iterdir()) == []
+
+
+def test_validate_exit_1_when_a_check_fails_3_when_it_crashes(tmp_path, monkeypatch, capsys):
+    import designer.report as report
+    from designer.checks import CheckResult
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(
+        report, "run_checks", lambda ctx, progress=None: [CheckResult("toy", False, "off by 2")]
+    )
+    code, out, err = run_inprocess(["validate", "-o", "rep"], capsys)
+    assert code == 1 and "FAIL toy" in out and (tmp_path / "rep" / "report.html").is_file()
+
+    def crash(ctx, progress=None):
+        (ctx.figures / "half.png").write_bytes(b"")
+        raise RuntimeError("the report itself broke")
+
+    monkeypatch.setattr(report, "run_checks", crash)
+    before = snapshot(tmp_path)
+    code, out, err = run_inprocess(["validate", "-o", "rep"], capsys)
+    assert code == 3 and "internal error: RuntimeError: the report itself broke" in err
+    assert snapshot(tmp_path) == before, "the old report stays whole, no staging folder left"
