@@ -1,96 +1,126 @@
-"""Export a Joint as MJCF (MuJoCo) or URDF snippets: stiffness, damping and moving mass per axis, SI units."""
+"""What the robot formats (MJCF, URDF, SDF) share: axis vectors, the joint's moving links, step advice.
+
+A robot format needs real bodies, never placeholder masses: a moving body without mass breaks MuJoCo
+("mass and inertia of moving bodies must be larger than mjMINVAL") and pybullet silently makes it 1 kg
+or recomputes its inertia from the collision shape. Each axis of a joint therefore gets a link that
+carries that axis' moving mass (translational axes) or moving inertia (rotational axes), modelled as a
+solid sphere centred on the joint origin: its inertia is isotropic, so importers that recompute inertia
+from a collision sphere of that radius (pybullet by default) get the same number.
+"""
 
 from __future__ import annotations
 
 import json
+import math
+from dataclasses import dataclass
 from pathlib import Path
-from xml.sax.saxutils import quoteattr
 
 from .. import units
-from ..files import atomic_write
+from ..errors import DesignerError
 from ..joint import Joint
+from ..mass import specimen_mass
+from .stability import StepAdvice, step_advice
 
 #: the joint axis of each channel; the rotational ones follow roll (phi, x), pitch (theta, y), yaw (psi, z)
 AXIS_VECTORS = {"x": "1 0 0", "y": "0 1 0", "z": "0 0 1", "phi": "1 0 0", "theta": "0 1 0", "psi": "0 0 1"}
 
 
-def _comment(joint: Joint) -> str:
+@dataclass(frozen=True)
+class Sphere:
+    """A solid sphere on the joint origin: mass (kg), inertia about axes through it (kg.m^2), radius (m)."""
+
+    mass: float
+    inertia: float
+    radius: float
+    basis: str
+
+
+def sphere_with_mass(mass: float, basis: str) -> Sphere:
+    """The solid TPU sphere of `mass` kg (radius from the TPU density)."""
+    r = (3 * mass / (4 * math.pi * units.TPU_DENSITY)) ** (1 / 3)
+    return Sphere(mass, 0.4 * mass * r * r, r, basis)
+
+
+def sphere_with_inertia(inertia: float, mass: float | None, basis: str) -> Sphere:
+    """A sphere of `inertia` kg.m^2: of `mass` kg when given, else solid TPU (both from the density)."""
+    if mass is None:
+        r = (15 * inertia / (8 * math.pi * units.TPU_DENSITY)) ** (1 / 5)
+        mass = units.TPU_DENSITY * 4 / 3 * math.pi * r**3
+    return Sphere(mass, inertia, math.sqrt(2.5 * inertia / mass), basis)
+
+
+def check_suffix(path: str | Path, suffixes: tuple[str, ...], what: str) -> Path:
+    """`path` as a Path if its suffix is one of `suffixes`, else a DesignerError naming `path`."""
+    path = Path(path)
+    if path.suffix.lower() not in suffixes:
+        raise DesignerError(
+            f"path={str(path)!r} does not end in {' or '.join(suffixes)}, the suffix of {what}",
+            f"give path a {suffixes[0]} name",
+        )
+    return path
+
+
+def with_masses(joint: Joint) -> Joint:
+    """The joint with every axis' moving mass: given, or from the design's geometry.
+
+    Raises:
+        DesignerError: an axis has no mass and the joint has no design to compute it from.
+    """
+    if all(ac.m is not None for ac in joint.axes.values()):
+        return joint
+    try:
+        return joint.with_masses()
+    except DesignerError:
+        missing = [a for a, ac in joint.axes.items() if ac.m is None]
+        raise DesignerError(
+            f"joint '{joint.name}' has no mass on axis {', '.join(missing)}: a robot link needs a real mass",
+            "build the joint with m for every axis (kg, or kg.m^2 on rotational axes), or from a design",
+        ) from None
+
+
+def links(joint: Joint) -> dict[str, Sphere]:
+    """Per axis the moving link: its mass on a translational axis, its inertia on a rotational one.
+
+    A rotational link weighs the specimen's mass when the joint comes from a design, else the mass of
+    a solid TPU sphere with that inertia. The joint must carry masses (see `with_masses`).
+    """
+    params = joint.provenance.get("params")
+    out = {}
+    for a, ac in joint.axes.items():
+        m = ac.si()["m"]
+        if not units.is_rotational(a):
+            out[a] = sphere_with_mass(m, f"the axis' moving mass {m:.4g} kg as a solid TPU sphere")
+        elif params is not None:
+            ms = specimen_mass(params)
+            out[a] = sphere_with_inertia(
+                m, ms, f"the axis' moving inertia {m:.4g} kg.m^2 with the specimen's mass {ms:.4g} kg"
+            )
+        else:
+            out[a] = sphere_with_inertia(m, None, f"the axis' moving inertia {m:.4g} kg.m^2 as solid TPU")
+    return out
+
+
+def chain_advice(joint: Joint, bodies: dict[str, Sphere]) -> dict[str, StepAdvice]:
+    """Step advice per axis of the joint's chain of links (each axis moves its link and those after it).
+
+    All links sit on the joint origin, so an axis sees the sum of the masses (translational) or of the
+    inertias (rotational) of its own and the following links, the other axes held.
+    """
+    order = list(joint.axes)
+    out = {}
+    for i, a in enumerate(order):
+        after = [bodies[b] for b in order[i:]]
+        inertia = sum(s.inertia if units.is_rotational(a) else s.mass for s in after)
+        si = joint.axes[a].si()
+        out[a] = step_advice(si["k"], si["c"], inertia)
+    return out
+
+
+def provenance_comment(joint: Joint) -> str:
+    """The joint's record as an XML comment (a '--' inside would end the comment early)."""
     text = json.dumps(joint.to_dict(), sort_keys=True, default=str).replace("--", "- -")
     return f"<!-- flexjoint designer: {text} -->"
 
 
-def mjcf_text(joint: Joint) -> str:
-    """A loadable MJCF model: one body carrying the joint's axes, moving mass as joint armature."""
-    joints = []
-    for a, ac in joint.axes.items():
-        si = ac.si()
-        kind = "hinge" if units.is_rotational(a) else "slide"
-        armature = f' armature="{si["m"]!r}"' if si["m"] is not None else ""
-        joints.append(
-            f'      <joint name="{joint.name}_{a}" type="{kind}" axis="{AXIS_VECTORS[a]}" '
-            f'stiffness="{si["k"]!r}" damping="{si["c"]!r}"{armature} springref="0"/>'
-        )
-    return "\n".join(
-        [
-            _comment(joint),
-            f"<mujoco model={quoteattr(joint.name)}>",
-            "  <!-- MJCF reads angles in degrees by default; these joints use radians -->",
-            '  <compiler angle="radian"/>',
-            "  <worldbody>",
-            f'    <body name="{joint.name}_link">',
-            "      <!-- the joint's moving mass is its armature; replace this placeholder inertial -->",
-            '      <inertial pos="0 0 0" mass="1e-9" diaginertia="1e-12 1e-12 1e-12"/>',
-            *joints,
-            "    </body>",
-            "  </worldbody>",
-            "</mujoco>",
-            "",
-        ]
-    )
-
-
-def urdf_text(joint: Joint) -> str:
-    """A URDF chain with one joint per axis; damping is declared, stiffness only stated (URDF has none)."""
-    lines = ['<?xml version="1.0"?>', _comment(joint), f"<robot name={quoteattr(joint.name)}>"]
-    lines.append(f'  <link name="{joint.name}_base"/>')
-    parent = f"{joint.name}_base"
-    for a, ac in joint.axes.items():
-        si = ac.si()
-        rot = units.is_rotational(a)
-        child = f"{joint.name}_{a}_link"
-        lines += [
-            f"  <!-- URDF has no joint stiffness: add k = {si['k']!r} {units.si_unit('k', a)} "
-            "on this joint in the simulator (a spring plugin or a controller) -->",
-            f'  <joint name="{joint.name}_{a}" type="{"revolute" if rot else "prismatic"}">',
-            f'    <parent link="{parent}"/>',
-            f'    <child link="{child}"/>',
-            f'    <axis xyz="{AXIS_VECTORS[a]}"/>',
-            f'    <limit lower="{-3.14159 if rot else -0.01}" upper="{3.14159 if rot else 0.01}" '
-            'effort="1000" velocity="100"/>',
-            f'    <dynamics damping="{si["c"]!r}" friction="0"/>',
-            "  </joint>",
-            f'  <link name="{child}">',
-        ]
-        if si["m"] is not None:
-            mass = si["m"] if not rot else 1e-9
-            inertia = si["m"] if rot else 1e-12
-            lines += [
-                "    <inertial>",
-                f'      <mass value="{mass!r}"/>',
-                f'      <inertia ixx="{inertia!r}" ixy="0" ixz="0" iyy="{inertia!r}" iyz="0" '
-                f'izz="{inertia!r}"/>',
-                "    </inertial>",
-            ]
-        lines.append("  </link>")
-        parent = child
-    lines += ["</robot>", ""]
-    return "\n".join(lines)
-
-
-def export_robot(joint: Joint, path: str | Path, fmt: str) -> Path:
-    """Write the MJCF ('mjcf') or URDF ('urdf') snippet atomically and return its path."""
-    text = mjcf_text(joint) if fmt == "mjcf" else urdf_text(joint)
-    path = Path(path)
-    with atomic_write(path) as fh:
-        fh.write(text)
-    return path
+def xml_comment(text: str) -> str:
+    return "<!-- " + text.replace("--", "- -") + " -->"

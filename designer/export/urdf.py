@@ -1,0 +1,208 @@
+"""Export a Joint as URDF (spring in a Gazebo extension) or SDFormat (spring in the joint's dynamics).
+
+URDF has damping (`<dynamics damping>`) but no joint spring: the stiffness goes into
+`<gazebo reference="joint"><springStiffness>`/`<springReference>`, which Gazebo's URDF converter turns
+into SDFormat's `//joint/axis/dynamics/spring_stiffness` and `spring_reference`; engines without a URDF
+spring (MuJoCo, pybullet) read those two values from there. Each axis' link has a real mass and an
+isotropic inertia and a collision sphere whose own inertia equals it (see `robot`), so pybullet's
+default of recomputing inertia from collision shapes gives the same number.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .. import units
+from ..errors import DesignerError
+from ..files import atomic_path, atomic_write
+from ..joint import Joint
+from . import robot
+from .mjcf import RobotExport, pick_axis
+
+#: a prismatic URDF joint needs limits; these (m) are wide enough never to act on a flexure
+PRISMATIC_LIMIT = 1.0
+
+
+def _num(v: float) -> str:
+    return repr(float(v))
+
+
+def _gazebo(name: str, k: float, rest: float) -> list[str]:
+    return [
+        f'  <gazebo reference="{name}">',
+        f"    <springStiffness>{_num(k)}</springStiffness>",
+        f"    <springReference>{_num(rest)}</springReference>",
+        "  </gazebo>",
+    ]
+
+
+def urdf_text(joint: Joint) -> tuple[str, dict[str, robot.StepAdvice]]:
+    """A fixed base link and one moving link per axis, chained; damping declared, spring in extensions."""
+    bodies = robot.links(joint)
+    advice = {f"{joint.name}_{a}": adv for a, adv in robot.chain_advice(joint, bodies).items()}
+    lines = ['<?xml version="1.0"?>', robot.provenance_comment(joint), f'<robot name="{joint.name}">']
+    lines += [
+        f'  <link name="{joint.name}_base">',
+        "    " + robot.xml_comment("fixed base: mass 0 said, as pybullet makes a link without inertial 1 kg"),
+        '    <inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/>'
+        "</inertial>",
+        "  </link>",
+    ]
+    parent = f"{joint.name}_base"
+    for a, ac in joint.axes.items():
+        si, name, s = ac.si(), f"{joint.name}_{a}", bodies[a]
+        rot = units.is_rotational(a)
+        limit = (
+            ""
+            if rot
+            else f'\n    <limit lower="{-PRISMATIC_LIMIT}" upper="{PRISMATIC_LIMIT}" effort="1e9" '
+            'velocity="1e9"/>'
+        )
+        i = _num(s.inertia)
+        lines += [
+            "  " + robot.xml_comment(f"{name}: {advice[name].text()}"),
+            f'  <joint name="{name}" type="{"continuous" if rot else "prismatic"}">',
+            f'    <parent link="{parent}"/>',
+            f'    <child link="{name}_link"/>',
+            f'    <axis xyz="{robot.AXIS_VECTORS[a]}"/>{limit}',
+            f'    <dynamics damping="{_num(si["c"])}" friction="0"/>',
+            "  </joint>",
+            *_gazebo(name, si["k"], 0.0),
+            f'  <link name="{name}_link">',
+            "    " + robot.xml_comment(s.basis + "; the collision sphere has the same inertia"),
+            "    <inertial>",
+            '      <origin xyz="0 0 0" rpy="0 0 0"/>',
+            f'      <mass value="{_num(s.mass)}"/>',
+            f'      <inertia ixx="{i}" ixy="0" ixz="0" iyy="{i}" iyz="0" izz="{i}"/>',
+            "    </inertial>",
+            f'    <collision><geometry><sphere radius="{_num(s.radius)}"/></geometry></collision>',
+            "  </link>",
+        ]
+        parent = f"{name}_link"
+    return "\n".join([*lines, "</robot>", ""]), advice
+
+
+def sdf_text(joint: Joint) -> tuple[str, dict[str, robot.StepAdvice]]:
+    """SDFormat 1.7: the same chain, fixed to the world, with spring_stiffness/spring_reference/damping."""
+    bodies = robot.links(joint)
+    advice = {f"{joint.name}_{a}": adv for a, adv in robot.chain_advice(joint, bodies).items()}
+    lines = ['<?xml version="1.0"?>', robot.provenance_comment(joint), '<sdf version="1.7">']
+    lines += [f'  <model name="{joint.name}">', f'    <link name="{joint.name}_base"/>']
+    lines += [
+        f'    <joint name="{joint.name}_fixed" type="fixed">',
+        f"      <parent>world</parent><child>{joint.name}_base</child>",
+        "    </joint>",
+    ]
+    parent = f"{joint.name}_base"
+    for a, ac in joint.axes.items():
+        si, name, s = ac.si(), f"{joint.name}_{a}", bodies[a]
+        i = _num(s.inertia)
+        lines += [
+            "    " + robot.xml_comment(f"{name}: {advice[name].text()}"),
+            f'    <joint name="{name}" type="{"revolute" if units.is_rotational(a) else "prismatic"}">',
+            f"      <parent>{parent}</parent><child>{name}_link</child>",
+            f"      <axis><xyz>{robot.AXIS_VECTORS[a]}</xyz>",
+            f"        <dynamics><damping>{_num(si['c'])}</damping><friction>0</friction>"
+            f"<spring_reference>0</spring_reference><spring_stiffness>{_num(si['k'])}</spring_stiffness>"
+            "</dynamics>",
+            "      </axis>",
+            "    </joint>",
+            f'    <link name="{name}_link">',
+            "      " + robot.xml_comment(s.basis + "; the collision sphere has the same inertia"),
+            f"      <inertial><mass>{_num(s.mass)}</mass>",
+            f"        <inertia><ixx>{i}</ixx><ixy>0</ixy><ixz>0</ixz><iyy>{i}</iyy><iyz>0</iyz><izz>{i}</izz>"
+            "</inertia>",
+            "      </inertial>",
+            f'      <collision name="{name}_sphere"><geometry><sphere><radius>{_num(s.radius)}</radius>'
+            "</sphere></geometry></collision>",
+            "    </link>",
+        ]
+        parent = f"{name}_link"
+    return "\n".join([*lines, "  </model>", "</sdf>", ""]), advice
+
+
+def _into_urdf(joint: Joint, host: Path, *, joint_name: str, axis: str | None, rest: float) -> bytes:
+    """The host URDF with `joint_name`'s damping set and its Gazebo spring extension (re)written."""
+    from lxml import etree
+
+    if not host.is_file():
+        raise DesignerError(f"into={str(host)!r} does not exist", "give the path of the robot's URDF file")
+    try:
+        tree = etree.parse(str(host))
+    except etree.XMLSyntaxError as exc:
+        raise DesignerError(f"into={str(host)!r} is not XML: {exc}", "give a URDF file") from None
+    root = tree.getroot()
+    found = root.xpath("/robot/joint[@name=$n]", n=joint_name)
+    kinds = {"revolute": True, "continuous": True, "prismatic": False}
+    if len(found) != 1 or found[0].get("type") not in kinds:
+        have = [j.get("name") for j in root.xpath("/robot/joint") if j.get("type") in kinds]
+        raise DesignerError(
+            f"joint_name={joint_name!r}: the robot has no revolute, continuous or prismatic joint so named",
+            f"its movable joints are: {', '.join(have) or 'none'}",
+        )
+    rot = kinds[found[0].get("type")]
+    a = pick_axis(joint, axis, rot)
+    if units.is_rotational(a) != rot:
+        raise DesignerError(
+            f"axis={a!r} does not match the kind of robot joint '{joint_name}' ({found[0].get('type')})",
+            "give an axis of the same kind as the robot joint",
+        )
+    si = joint.axes[a].si()
+    dynamics = found[0].find("dynamics")
+    if dynamics is None:
+        dynamics = etree.SubElement(found[0], "dynamics")
+    dynamics.set("damping", _num(si["c"]))
+    for old in root.xpath("/robot/gazebo[@reference=$n]", n=joint_name):
+        for tag in ("springStiffness", "springReference"):
+            for e in old.findall(tag):
+                old.remove(e)
+    gz = etree.fromstring("\n".join(_gazebo(joint_name, si["k"], rest)))
+    gz.tail = "\n"
+    root.append(gz)
+    return etree.tostring(tree, xml_declaration=True, encoding="utf-8")
+
+
+def export_urdf(
+    joint: Joint,
+    path: str | Path,
+    *,
+    into: str | Path | None = None,
+    joint_name: str | None = None,
+    axis: str | None = None,
+    rest: float = 0.0,
+) -> RobotExport:
+    """Write `joint` as URDF at `path` (.urdf) and return the path and the stated step advice.
+
+    Standalone: a chain of links with real masses (see `urdf_text`). With `into` (a URDF file) and
+    `joint_name`: a copy of that robot with the joint's damping set and a Gazebo spring extension
+    (stiffness, and `rest` in rad or m as springReference); its links are left as they are (URDF has
+    no armature, so the flexure's own moving inertia is not added), and no step advice is given.
+
+    Raises:
+        DesignerError: a wrong suffix, a missing mass, or an `into` problem.
+    """
+    path = robot.check_suffix(path, (".urdf",), "a URDF file")
+    if into is not None:
+        if joint_name is None:
+            raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
+        data = _into_urdf(joint, Path(into), joint_name=joint_name, axis=axis, rest=rest)
+        with atomic_path(path) as tmp:
+            tmp.write_bytes(data)
+        return RobotExport(path, {})
+    text, advice = urdf_text(robot.with_masses(joint))
+    with atomic_write(path) as fh:
+        fh.write(text)
+    return RobotExport(path, advice)
+
+
+def export_sdf(joint: Joint, path: str | Path) -> RobotExport:
+    """Write `joint` as an SDFormat 1.7 model at `path` (.sdf); see `sdf_text`.
+
+    Raises:
+        DesignerError: a wrong suffix or a missing mass.
+    """
+    path = robot.check_suffix(path, (".sdf",), "an SDFormat file")
+    text, advice = sdf_text(robot.with_masses(joint))
+    with atomic_write(path) as fh:
+        fh.write(text)
+    return RobotExport(path, advice)
