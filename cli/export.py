@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 from pathlib import Path
 from typing import Annotated
 
@@ -23,7 +24,7 @@ def _joint(
     axis, k, c, m, density, length, width, height, layer, raster, from_, candidate, name, allow_extrapolation
 ):
     """The joint from exactly one source: --k/--c numbers, a design (six factors) or --from."""
-    from designer.export import sources
+    from designer.joint import from_one_source
 
     design = {
         "density": density,
@@ -33,23 +34,34 @@ def _joint(
         "layer": layer,
         "raster": raster,
     }
-    given = [n for n, v in design.items() if v is not None]
-    chosen = [
-        s
-        for s, on in (("--k/--c", bool(k or c)), ("a design", bool(given)), ("--from", from_ is not None))
-        if on
-    ]
-    if len(chosen) != 1:
+    design = {n: v for n, v in design.items() if v is not None}
+    coefficients = None
+    if k or c or m:
+        axes = axis or ["x"]
+        if len(k or []) != len(axes) or len(c or []) != len(axes) or len(m or []) not in (0, len(axes)):
+            raise DesignerError(
+                f"{len(axes)} axis/axes but {len(k or [])} --k, {len(c or [])} --c and {len(m or [])} --m",
+                "give one --k and one --c per --axis (and one --m per axis, or none), in the same order",
+            )
+        if len(set(axes)) != len(axes):
+            raise DesignerError(f"an axis is given twice in --axis {' '.join(axes)}", "give each --axis once")
+        coefficients = {a: {"k": k[i], "c": c[i]} | ({"m": m[i]} if m else {}) for i, a in enumerate(axes)}
+    sources = [n for n, v in (("--k/--c", coefficients), ("a design", design), ("--from", from_)) if v]
+    if len(sources) != 1:
         raise DesignerError(
-            "give the joint one way: " + ("none given" if not chosen else f"got {' and '.join(chosen)}"),
+            "give the joint one way: " + ("none given" if not sources else f"got {' and '.join(sources)}"),
             "use --k and --c (rig units, N/mm and N.s/mm), or the six print settings --density ... --raster, "
             "or --from suggestion.json",
         )
-    if from_ is not None:
-        return sources.from_suggestion(from_, candidate, axis or None, name)
-    if given:
-        return sources.from_design(design, axis or ["x"], name, allow_extrapolation)
-    return sources.from_numbers(axis or ["x"], k or [], c or [], m or [], name)
+    return from_one_source(
+        coefficients=coefficients,
+        design=design or None,
+        suggestion=from_,
+        candidate=candidate,
+        axes=None if coefficients else axis or (None if from_ else ["x"]),
+        name=name,
+        allow_extrapolation=allow_extrapolation,
+    )
 
 
 def _print_joint(joint, what: str, path: Path) -> None:
@@ -145,7 +157,9 @@ def register(app: typer.Typer) -> None:
                 "  no binary: build it from sources/ with 'python -m fmpy compile " + str(path) + "'"
             )
 
-    def snippet(fmt: str, suffix: str, title: str):
+    def snippet(fmt: str, suffix: str, title: str, write, example: str, extra: tuple = ()):
+        """Add `export FMT`: the joint options, `extra` options (inspect.Parameters) passed to `write`."""
+
         def command(
             output: Annotated[Path, typer.Option("-o", "--output", help="the file to write")] = Path(
                 f"joint{suffix}"
@@ -171,6 +185,7 @@ def register(app: typer.Typer) -> None:
                 bool, typer.Option(help="accept a design outside the ranges")
             ] = False,
             json_out: Annotated[bool, typer.Option("--json", help="print the result as JSON")] = False,
+            **options,
         ) -> None:
             joint = _joint(
                 axis,
@@ -188,27 +203,119 @@ def register(app: typer.Typer) -> None:
                 name,
                 allow_extrapolation,
             )
-            if fmt == "modelica":
-                from designer.export.modelica import export_modelica
-
-                path = export_modelica(joint, output)
-            else:
-                from designer.export.robot import export_robot
-
-                path = export_robot(joint, output, fmt)
+            result = write(joint, output, **options)
+            advice = getattr(result, "advice", {})
             if json_out:
-                print_json({"path": str(path), "format": fmt, "joint": joint.to_dict()})
+                print_json(
+                    {"path": str(output), "format": fmt, "joint": joint.to_dict()}
+                    | ({"advice": {n: a.to_dict() for n, a in advice.items()}} if advice else {})
+                )
                 return
-            _print_joint(joint, title, path)
+            _print_joint(joint, title, output)
+            for n, a in advice.items():
+                console.print(f"  {n}: {a.text()}")
 
         command.__doc__ = (
             f"Write the joint as {title}, SI units, provenance in a comment.\n\n"
             f"The joint comes from --k/--c [--m] ({JOINT_HELP}), the six print settings, or --from.\n\n"
-            f"Example: designer export {fmt} --k 0.8 --c 2e-3 --m 0.01 -o joint{suffix}"
+            f"Example: {example}"
         )
+        signature = inspect.signature(command, eval_str=True)  # typer reads a __signature__ as it is
+        params = [p for p in signature.parameters.values() if p.kind is not p.VAR_KEYWORD]
+        command.__signature__ = signature.replace(parameters=[*params, *extra])
         export_app.command(fmt)(command)
 
-    snippet("modelica", ".mo", "a Modelica package (MSL SpringDamper, Mass/Inertia)")
-    snippet("mjcf", ".xml", "an MJCF model (joint stiffness, damping, armature)")
-    snippet("urdf", ".urdf", "a URDF chain (dynamics damping; URDF has no stiffness)")
+    _formats(snippet)
     app.add_typer(export_app, name="export")
+
+
+def _option(name: str, annotation, default) -> inspect.Parameter:
+    return inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=annotation)
+
+
+INTO = _option(
+    "into",
+    Annotated[Path | None, typer.Option(help="the robot file to copy with --joint made flexible")],  # noqa: UP007
+    None,
+)
+ROBOT_JOINT = _option("joint_name", Annotated[str | None, typer.Option("--joint", help="robot joint")], None)
+REST = _option("rest", Annotated[float, typer.Option(help="spring rest position, rad or m")], 0.0)
+AXIS_PICK = _option(
+    "axis_pick", Annotated[str | None, typer.Option("--use-axis", help="joint axis to use")], None
+)
+
+
+def _mjcf(joint, output, *, into, joint_name, rest, axis_pick, form, motor_inertia, motor_bandwidth):
+    from designer.export.mjcf import export_mjcf
+
+    return export_mjcf(
+        joint,
+        output,
+        into=into,
+        joint_name=joint_name,
+        axis=axis_pick,
+        form=form,
+        rest=rest,
+        motor_inertia=motor_inertia,
+        motor_bandwidth=motor_bandwidth,
+    )
+
+
+def _urdf(joint, output, *, into, joint_name, rest, axis_pick):
+    from designer.export.urdf import export_urdf
+
+    return export_urdf(joint, output, into=into, joint_name=joint_name, axis=axis_pick, rest=rest)
+
+
+def _sdf(joint, output):
+    from designer.export.urdf import export_sdf
+
+    return export_sdf(joint, output)
+
+
+def _formats(snippet) -> None:
+    """The robot and Modelica sub-commands of `export`, each with its own options."""
+    from designer.export.modelica import export_modelica
+
+    snippet(
+        "modelica",
+        ".mo",
+        "a Modelica package (MSL SpringDamper, Mass/Inertia)",
+        lambda joint, output, msl: export_modelica(joint, output, msl=msl),
+        "designer export modelica --k 0.8 --c 2e-3 --m 0.01 --msl 3.2.3 -o joint.mo",
+        (_option("msl", Annotated[str, typer.Option(help="MSL version: 4.0.0 or 3.2.3")], "4.0.0"),),
+    )
+    snippet(
+        "mjcf",
+        ".xml",
+        "an MJCF model (joint stiffness, damping; real link inertia)",
+        _mjcf,
+        "designer export mjcf --k 50 --c 0.5 --m 1e-5 --axis theta --into robot.xml --joint elbow "
+        "-o robot_flex.xml",
+        (
+            INTO,
+            ROBOT_JOINT,
+            REST,
+            AXIS_PICK,
+            _option(
+                "form", Annotated[str, typer.Option(help="parallel or series (motor -> flexure)")], "parallel"
+            ),
+            _option("motor_inertia", Annotated[float | None, typer.Option(help="series: SI")], None),  # noqa: UP007
+            _option("motor_bandwidth", Annotated[float | None, typer.Option(help="series: servo Hz")], None),  # noqa: UP007
+        ),
+    )
+    snippet(
+        "urdf",
+        ".urdf",
+        "a URDF chain (damping; spring in a <gazebo reference> extension)",
+        _urdf,
+        "designer export urdf --k 50 --c 0.5 --m 1e-5 --axis theta -o joint.urdf",
+        (INTO, ROBOT_JOINT, REST, AXIS_PICK),
+    )
+    snippet(
+        "sdf",
+        ".sdf",
+        "an SDFormat model (spring_stiffness, spring_reference, damping)",
+        _sdf,
+        "designer export sdf --k 50 --c 0.5 --m 1e-5 --axis theta -o joint.sdf",
+    )

@@ -17,7 +17,7 @@ from designer.errors import DesignerError
 from designer.export.mjcf import export_mjcf
 from designer.export.stability import step_advice
 from designer.export.urdf import export_sdf, export_urdf
-from designer.joint import from_coefficients
+from designer.joint import Joint
 
 mujoco = pytest.importorskip("mujoco")
 
@@ -66,7 +66,7 @@ def run_mujoco(model, steps, load=0.0, q0=0.0):
 @pytest.mark.parametrize("c", [0.0, 0.5, 20.0])
 def test_stated_timesteps_bound_mujoco_stepping(tmp_path, c):
     """Just below each stated limit MuJoCo stays bounded, just above it diverges (all three integrators)."""
-    joint = from_coefficients({"theta": {"k": 50.0, "c": c, "m": 1e-5}})
+    joint = Joint.from_coefficients({"theta": {"k": 50.0, "c": c, "m": 1e-5}})
     out = export_mjcf(joint, tmp_path / "j.xml")
     advice = out.advice["FlexJoint_theta"]
     for integrator, h in advice.max_timestep.items():
@@ -80,7 +80,7 @@ def test_stated_timesteps_bound_mujoco_stepping(tmp_path, c):
 
 
 def test_snippet_has_nothing_global_and_steps_with_the_stated_k_and_c(tmp_path):
-    joint = from_coefficients(THETA)
+    joint = Joint.from_coefficients(THETA)
     out = export_mjcf(joint, tmp_path / "flex.xml")
     text = out.path.read_text()
     root = ET.fromstring(text)
@@ -112,7 +112,7 @@ def test_snippet_has_nothing_global_and_steps_with_the_stated_k_and_c(tmp_path):
 def test_into_a_degree_robot_keeps_every_host_unit(tmp_path):
     host_path = tmp_path / "robot.xml"
     host_path.write_text(HOST)
-    joint = from_coefficients(THETA)
+    joint = Joint.from_coefficients(THETA)
     out = export_mjcf(
         joint, tmp_path / "robot_flex.xml", into=host_path, joint_name="elbow", rest=math.radians(10)
     )
@@ -130,7 +130,7 @@ def test_into_a_degree_robot_keeps_every_host_unit(tmp_path):
     assert flex.dof_damping[0] == host.dof_damping[0] == 0.01
     with pytest.raises(DesignerError, match="joint_name='wrist'"):
         export_mjcf(joint, tmp_path / "x.xml", into=host_path, joint_name="wrist")
-    slide = from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}})
+    slide = Joint.from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}})
     with pytest.raises(DesignerError, match="axis"):
         export_mjcf(slide, tmp_path / "x.xml", into=host_path, joint_name="elbow")
 
@@ -140,7 +140,7 @@ def test_series_form_matches_the_cosimulation_reference(tmp_path):
     from designer.cosim.references import Sine
     from designer.cosim.robot import Robot, SpringDamper
 
-    joint = from_coefficients(THETA)
+    joint = Joint.from_coefficients(THETA)
     # a smooth motor move from rest: 0.5 rad, 2 Hz
     h, n, motor = 1e-4, 10000, Sine(amplitude=0.25, frequency=2.0, offset=0.25, phase=-math.pi / 2)
     # the reference: the link alone on an absolute hinge, the flexure torque computed in-engine
@@ -174,7 +174,7 @@ def test_series_form_matches_the_cosimulation_reference(tmp_path):
 
 
 def test_urdf_loads_in_mujoco_with_real_links_and_the_gazebo_spring(tmp_path):
-    joint = from_coefficients(THETA)
+    joint = Joint.from_coefficients(THETA)
     out = export_urdf(joint, tmp_path / "j.urdf")
     root = ET.parse(out.path).getroot()
     gz = root.find("gazebo[@reference='FlexJoint_theta']")
@@ -192,7 +192,7 @@ def test_urdf_loads_in_mujoco_with_real_links_and_the_gazebo_spring(tmp_path):
 
 def test_urdf_steps_in_pybullet_with_default_flags(tmp_path):
     p = pytest.importorskip("pybullet")
-    out = export_urdf(from_coefficients(THETA), tmp_path / "j.urdf")
+    out = export_urdf(Joint.from_coefficients(THETA), tmp_path / "j.urdf")
     gz = ET.parse(out.path).getroot().find("gazebo/springStiffness")
     k = float(gz.text)
     client = p.connect(p.DIRECT)
@@ -223,7 +223,7 @@ def test_urdf_into_a_robot_sets_damping_and_the_spring_extension(tmp_path):
         '<joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 1 0"/>'
         '<limit lower="-1.5" upper="1.5" effort="5" velocity="3"/></joint></robot>'
     )
-    out = export_urdf(from_coefficients(THETA), tmp_path / "arm_flex.urdf", into=host, joint_name="j1")
+    out = export_urdf(Joint.from_coefficients(THETA), tmp_path / "arm_flex.urdf", into=host, joint_name="j1")
     root = ET.parse(out.path).getroot()
     assert root.find("joint/dynamics").get("damping") == "0.0005"
     assert root.find("gazebo[@reference='j1']/springStiffness").text == "0.05"
@@ -232,7 +232,7 @@ def test_urdf_into_a_robot_sets_damping_and_the_spring_extension(tmp_path):
 
 
 def test_sdf_spring_becomes_a_drake_revolute_spring(tmp_path):
-    out = export_sdf(from_coefficients(THETA), tmp_path / "j.sdf")
+    out = export_sdf(Joint.from_coefficients(THETA), tmp_path / "j.sdf")
     dyn = ET.parse(out.path).getroot().find("model/joint[@name='FlexJoint_theta']/axis/dynamics")
     assert [dyn.find(t).text for t in ("spring_stiffness", "spring_reference", "damping")] == [
         "0.05",
@@ -255,12 +255,12 @@ def test_sdf_spring_becomes_a_drake_revolute_spring(tmp_path):
 
 
 def test_robot_writers_refuse_other_suffixes_naming_path(tmp_path):
-    joint = from_coefficients(THETA)
+    joint = Joint.from_coefficients(THETA)
     for writer, bad in ((export_mjcf, "j.urdf"), (export_urdf, "j.xml"), (export_sdf, "j.urdf")):
         with pytest.raises(DesignerError, match="path="):
             writer(joint, tmp_path / bad)
     with pytest.raises(DesignerError, match="m for every axis"):
-        export_urdf(from_coefficients({"theta": {"k": 50.0, "c": 0.5}}), tmp_path / "j.urdf")
+        export_urdf(Joint.from_coefficients({"theta": {"k": 50.0, "c": 0.5}}), tmp_path / "j.urdf")
 
 
 def test_step_advice_closed_forms():
