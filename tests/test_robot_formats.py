@@ -248,7 +248,8 @@ def test_sdf_spring_becomes_a_drake_revolute_spring(tmp_path):
     plant.Finalize()
     elements = [plant.get_force_element(ForceElementIndex(i)) for i in range(plant.num_force_elements())]
     springs = [e for e in elements if isinstance(e, RevoluteSpring)]
-    assert len(springs) == 1 and springs[0].default_stiffness() == 0.05 and springs[0].default_nominal_angle() == 0.0
+    assert len(springs) == 1 and springs[0].default_stiffness() == 0.05
+    assert springs[0].default_nominal_angle() == 0.0
     assert plant.GetJointByName("FlexJoint_theta").default_damping() == 5e-4
     body = plant.GetBodyByName("FlexJoint_theta_link")
     assert body.default_rotational_inertia().get_moments()[1] == pytest.approx(1e-5)

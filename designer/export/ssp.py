@@ -1,0 +1,248 @@
+"""Export joints as an SSP archive (System Structure and Parameterization 1.0) and read SSV files.
+
+The archive holds `SystemStructure.ssd`: one FMI 2 co-simulation FMU component per joint (body
+interface by default: input load, outputs deflection, velocity, acceleration), its connectors exposed
+on the system as `<joint>_<variable>` and wired to them; `resources/<joint>.fmu`; and per parameter
+set an SSV file (`resources/<set>.ssv`) with the joints' m, c, k in SI units, declared with their
+base units. The SSD binds the first set to each component; the others (for example a suggestion's
+other candidates) sit beside it for a tool to bind instead. Element names and namespaces follow the
+SSP 1.0 standard and its XML schemas (as shipped with FMPy, which validates them when it reads the archive).
+
+Parameter names inside an SSV are the FMU's own (`theta.k`), relative to the component it is bound to.
+"""
+
+from __future__ import annotations
+
+import zipfile
+from collections.abc import Mapping
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+from .. import units
+from ..errors import DesignerError
+from ..files import atomic_path
+from ..joint import Joint
+from . import fmu
+from .robot import check_suffix, with_masses
+
+NS = {
+    "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
+    "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon",
+    "ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
+}
+_XMLNS = " ".join(f'xmlns:{p}="{u}"' for p, u in NS.items())
+#: the joint coefficients an SSV carries, per axis
+SSV_QUANTITIES = ("m", "c", "k")
+
+
+def _units(names: set[str]) -> list[str]:
+    """`ssc:Unit` elements with their SI base-unit exponents (the FMU's table)."""
+    lines = []
+    for u in sorted(names):
+        exps = fmu._BASE_UNITS[u]
+        base = " ".join(f'{k}="{exps[k]}"' for k in fmu._BASE_ORDER if k in exps)
+        lines.append(f"    <ssc:Unit name={quoteattr(u)}><ssc:BaseUnit {base}/></ssc:Unit>")
+    return lines
+
+
+def ssv_text(joint: Joint, name: str) -> str:
+    """An SSV parameter set: m, c, k of every axis of `joint` in SI, named as the FMU's parameters."""
+    params, used = [], set()
+    for a, ac in joint.axes.items():
+        si = ac.si()
+        for q in SSV_QUANTITIES:
+            if si[q] is None:
+                continue
+            unit = units.si_unit(q, a)
+            used.add(unit)
+            params.append(
+                f'    <ssv:Parameter name="{a}.{q}"><ssv:Real value="{si[q]!r}" unit={quoteattr(unit)}/>'
+                "</ssv:Parameter>"
+            )
+    return "\n".join(
+        [
+            '<?xml version="1.0" encoding="UTF-8"?>',
+            f'<ssv:ParameterSet {_XMLNS} version="1.0" name={quoteattr(name)}>',
+            "  <ssv:Parameters>",
+            *params,
+            "  </ssv:Parameters>",
+            "  <ssv:Units>",
+            *_units(used),
+            "  </ssv:Units>",
+            "</ssv:ParameterSet>",
+            "",
+        ]
+    )
+
+
+def _connectors(joint: Joint, interface: str, pad: str) -> tuple[list[str], list[tuple[str, str]], set[str]]:
+    """The FMU's inputs, outputs and parameters as SSD connectors; (name, kind) of the wired ones; units."""
+    lines, wired, used = [], [], set()
+    for v in fmu._variables(joint, interface):
+        if v.causality not in ("input", "output", "parameter"):
+            continue
+        typ = "<ssc:Boolean/>" if v.kind == "Boolean" else f"<ssc:Real unit={quoteattr(v.unit)}/>"
+        if v.unit and v.unit in fmu._BASE_UNITS:
+            used.add(v.unit)
+        elif v.kind != "Boolean":
+            typ = "<ssc:Real/>"
+        lines.append(f'{pad}<ssd:Connector name="{v.name}" kind="{v.causality}">{typ}</ssd:Connector>')
+        if v.causality != "parameter":
+            wired.append((v.name, v.causality, typ))
+    return lines, wired, used
+
+
+def ssd_text(joints: list[Joint], parameter_set: str, interface: str) -> str:
+    """The SSD: one component per joint, its inputs and outputs exposed as `<joint>_<variable>`.
+
+    (Not `<joint>.<variable>`: fmpy.ssp names results by dotted path, where that would clash with the
+    component's own connector.)
+    """
+    outer, elements, connections, used = [], [], [], set()
+    for j in joints:
+        inner, wired, u = _connectors(j, interface, "          ")
+        used |= u
+        for var, kind, typ in wired:
+            outer.append(f'      <ssd:Connector name="{j.name}_{var}" kind="{kind}">{typ}</ssd:Connector>')
+            ends = (
+                f'startConnector="{j.name}_{var}" endElement="{j.name}" endConnector="{var}"'
+                if kind == "input"
+                else f'startElement="{j.name}" startConnector="{var}" endConnector="{j.name}_{var}"'
+            )
+            connections.append(f"      <ssd:Connection {ends}/>")
+        elements += [
+            f'      <ssd:Component name="{j.name}" type="application/x-fmu-sharedlibrary" '
+            f'source="resources/{j.name}.fmu">',
+            "        <ssd:Connectors>",
+            *inner,
+            "        </ssd:Connectors>",
+            "        <ssd:ParameterBindings>",
+            f'          <ssd:ParameterBinding type="application/x-ssp-parameter-set" '
+            f'source="resources/{parameter_set}.ssv"/>',
+            "        </ssd:ParameterBindings>",
+            "      </ssd:Component>",
+        ]
+    return "\n".join(
+        [
+            '<?xml version="1.0" encoding="UTF-8"?>',
+            f'<ssd:SystemStructureDescription {_XMLNS} version="1.0" name="flexjoints">',
+            '  <ssd:System name="flexjoints">',
+            "    <ssd:Connectors>",
+            *outer,
+            "    </ssd:Connectors>",
+            "    <ssd:Elements>",
+            *elements,
+            "    </ssd:Elements>",
+            "    <ssd:Connections>",
+            *connections,
+            "    </ssd:Connections>",
+            "  </ssd:System>",
+            "  <ssd:Units>",
+            *_units(used),
+            "  </ssd:Units>",
+            "</ssd:SystemStructureDescription>",
+            "",
+        ]
+    )
+
+
+def export_ssp(
+    joint: Joint,
+    path: str | Path,
+    *,
+    parameter_sets: Mapping[str, Joint] | None = None,
+    interface: str = "body",
+) -> Path:
+    """Write an SSP archive at `path` (.ssp) with `joint`'s FMI 2 FMU, the SSD and SSV parameter sets.
+
+    Args:
+        joint: the joint; its numbers are the FMU's start values and the first parameter set.
+        parameter_sets: named alternatives (e.g. a suggestion's candidates) with the same axes, one SSV
+            each; None gives one set named after the joint. The SSD binds the first.
+        interface: "body" (load in, motion out; needs masses, from geometry when a design) or "force".
+
+    Raises:
+        DesignerError: a wrong suffix, a set whose axes differ from the joint's, or a missing mass.
+    """
+    path = check_suffix(path, (".ssp",), "an SSP archive")
+    if interface == "body":
+        joint = with_masses(joint)
+    sets = dict(parameter_sets) if parameter_sets else {joint.name: joint}
+    for set_name, other in sets.items():
+        if not set_name.isidentifier() or list(other.axes) != list(joint.axes):
+            raise DesignerError(
+                f"parameter_sets[{set_name!r}] is not a set for joint '{joint.name}'",
+                f"give identifier names and joints with the axes {', '.join(joint.axes)}",
+            )
+        if interface == "body":
+            sets[set_name] = with_masses(other)
+    entries = {f"resources/{n}.ssv": ssv_text(j, n).encode() for n, j in sets.items()}
+    entries["SystemStructure.ssd"] = ssd_text([joint], next(iter(sets)), interface).encode()
+    entries[f"resources/{joint.name}.fmu"] = _fmu_bytes(joint, interface)
+    with atomic_path(path) as tmp, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
+        for name in sorted(entries):
+            z.writestr(name, entries[name])
+    return path
+
+
+def _fmu_bytes(joint: Joint, interface: str) -> bytes:
+    """The joint's FMI 2 FMU as bytes, written through `fmu.export_fmu` into a temporary folder."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / f"{joint.name}.fmu"
+        fmu.export_fmu(joint, out, fmi_version=2, interface=interface)
+        return out.read_bytes()
+
+
+def read_ssv(path: str | Path) -> dict[str, float]:
+    """The Real parameters of an SSV file, converted to SI: {"theta.k": 0.05, ...}.
+
+    Units are read from each parameter's `unit` and the file's unit definitions; a unit whose
+    base-unit exponents differ from the SI unit of that quantity, or a factor/offset other than 1/0,
+    is refused rather than guessed.
+
+    Raises:
+        DesignerError: the file is missing or not an SSV, or a unit is not the quantity's SI unit.
+    """
+    import xml.etree.ElementTree as ET
+
+    path = Path(path)
+    try:
+        root = ET.parse(path).getroot()
+    except (OSError, ET.ParseError) as exc:
+        raise DesignerError(f"path={str(path)!r} cannot be read as XML: {exc}", "give an SSV file") from None
+    if root.tag != f"{{{NS['ssv']}}}ParameterSet":
+        raise DesignerError(f"path={str(path)!r} is not an SSV parameter set", "give an .ssv file")
+    declared = {}
+    for u in root.iterfind("ssv:Units/ssc:Unit", NS):
+        base = u.find("ssc:BaseUnit", NS)
+        declared[u.get("name")] = {k: float(v) for k, v in (base.attrib if base is not None else {}).items()}
+    out = {}
+    for p in root.iterfind("ssv:Parameters/ssv:Parameter", NS):
+        real = p.find("ssv:Real", NS)
+        if real is None:
+            continue
+        name, unit = p.get("name"), real.get("unit")
+        out[name] = _si_value(name, float(real.get("value")), unit, declared.get(unit), path)
+    return out
+
+
+def _si_value(name: str, value: float, unit: str | None, base: dict | None, path: Path) -> float:
+    """`value` checked to be in the SI unit of the joint quantity `name` (axis.quantity) when known."""
+    axis, _, quantity = name.rpartition(".")
+    if axis not in units.AXES or quantity not in SSV_QUANTITIES or unit is None:
+        return value
+    si = units.si_unit(quantity, axis)
+    want = {k: float(v) for k, v in fmu._BASE_UNITS[si].items()}
+    if base is not None:
+        factor, offset = base.pop("factor", 1.0), base.pop("offset", 0.0)
+        ok = base == want and factor == 1.0 and offset == 0.0
+    else:
+        ok = unit == si
+    if not ok:
+        raise DesignerError(
+            f"parameter {name} in {path} has unit {unit!r}, not the SI unit {si}",
+            f"give {name} in {si}",
+        )
+    return value
