@@ -158,7 +158,11 @@ def register(app: typer.Typer) -> None:
             )
 
     def snippet(fmt: str, suffix: str, title: str, write, example: str, extra: tuple = ()):
-        """Add `export FMT`: the joint options, `extra` options (inspect.Parameters) passed to `write`."""
+        """Add `export FMT`: the joint options, `extra` options (inspect.Parameters) passed to `write`.
+
+        `write(joint, output, (suggestion path, candidate) or None, **extra)` writes and returns the
+        path or a result with `advice`.
+        """
 
         def command(
             output: Annotated[Path, typer.Option("-o", "--output", help="the file to write")] = Path(
@@ -203,7 +207,7 @@ def register(app: typer.Typer) -> None:
                 name,
                 allow_extrapolation,
             )
-            result = write(joint, output, **options)
+            result = write(joint, output, (from_, candidate) if from_ else None, **options)
             advice = getattr(result, "advice", {})
             if json_out:
                 print_json(
@@ -245,7 +249,7 @@ AXIS_PICK = _option(
 )
 
 
-def _mjcf(joint, output, *, into, joint_name, rest, axis_pick, form, motor_inertia, motor_bandwidth):
+def _mjcf(joint, output, _from, *, into, joint_name, rest, axis_pick, form, motor_inertia, motor_bandwidth):
     from designer.export.mjcf import export_mjcf
 
     return export_mjcf(
@@ -261,16 +265,27 @@ def _mjcf(joint, output, *, into, joint_name, rest, axis_pick, form, motor_inert
     )
 
 
-def _urdf(joint, output, *, into, joint_name, rest, axis_pick):
+def _urdf(joint, output, _from, *, into, joint_name, rest, axis_pick):
     from designer.export.urdf import export_urdf
 
     return export_urdf(joint, output, into=into, joint_name=joint_name, axis=axis_pick, rest=rest)
 
 
-def _sdf(joint, output):
+def _sdf(joint, output, _from):
     from designer.export.urdf import export_sdf
 
     return export_sdf(joint, output)
+
+
+def _ssp(joint, output, suggestion, *, interface):
+    """The SSP archive; from a suggestion, every candidate becomes an SSV parameter set."""
+    from designer.export.ssp import candidate_sets, export_ssp
+
+    sets = None
+    if suggestion is not None:
+        path, first = suggestion
+        sets = candidate_sets(path, first=first, axes=list(joint.axes), name=joint.name)
+    return export_ssp(joint, output, parameter_sets=sets, interface=interface)
 
 
 def _formats(snippet) -> None:
@@ -281,7 +296,7 @@ def _formats(snippet) -> None:
         "modelica",
         ".mo",
         "a Modelica package (MSL SpringDamper, Mass/Inertia)",
-        lambda joint, output, msl: export_modelica(joint, output, msl=msl),
+        lambda joint, output, _from, msl: export_modelica(joint, output, msl=msl),
         "designer export modelica --k 0.8 --c 2e-3 --m 0.01 --msl 3.2.3 -o joint.mo",
         (_option("msl", Annotated[str, typer.Option(help="MSL version: 4.0.0 or 3.2.3")], "4.0.0"),),
     )
@@ -318,4 +333,12 @@ def _formats(snippet) -> None:
         "an SDFormat model (spring_stiffness, spring_reference, damping)",
         _sdf,
         "designer export sdf --k 50 --c 0.5 --m 1e-5 --axis theta -o joint.sdf",
+    )
+    snippet(
+        "ssp",
+        ".ssp",
+        "an SSP archive (SSD, FMI 2 FMU, SSV parameter sets in SI; --from: one set per candidate)",
+        _ssp,
+        "designer export ssp --from suggestion.json -o joint.ssp",
+        (_option("interface", Annotated[str, typer.Option(help="body (load in) or force")], "body"),),
     )

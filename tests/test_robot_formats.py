@@ -271,3 +271,30 @@ def test_step_advice_closed_forms():
     assert undamped.max_timestep["RK4"] == pytest.approx(math.sqrt(2), rel=1e-6)  # 2 sqrt(2) / omega
     overdamped = step_advice(1.0, 1e3, 1.0)  # fast root -1e3: RK4's real-axis limit 2.785 / 1e3
     assert overdamped.max_timestep["RK4"] == pytest.approx(2.785293563 / (1e3 - 1e-3), rel=1e-6)
+
+
+def test_cli_mjcf_into_urdf_and_sdf(tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    (tmp_path / "robot.xml").write_text(HOST)
+
+    def run(*args):
+        cmd = "from designer_cli.main import main; main()"
+        return subprocess.run(
+            [sys.executable, "-I", "-c", cmd, "export", *args], capture_output=True, text=True, cwd=tmp_path
+        )
+
+    joint = ["--k", "50", "--c", "0.5", "--m", "1e-5", "--axis", "theta"]
+    r = run("mjcf", *joint, "--into", "robot.xml", "--joint", "elbow", "-o", "robot_flex.xml", "--json")
+    assert r.returncode == 0, r.stderr
+    advice = json.loads(r.stdout)["advice"]["elbow"]
+    assert set(advice["max_stable_timestep_s"]) == {"Euler", "implicitfast", "RK4"}
+    assert 'range="-120 120"' in (tmp_path / "robot_flex.xml").read_text()
+    r = run("mjcf", *joint, "--form", "series", "-o", "sea.xml")
+    assert r.returncode == 0 and "natural frequency" in r.stdout and "FlexJoint_motor" in r.stdout
+    assert run("urdf", *joint, "-o", "j.urdf").returncode == 0
+    assert run("sdf", *joint, "-o", "j.sdf").returncode == 0
+    r = run("mjcf", *joint, "--into", "robot.xml", "--joint", "wrist", "-o", "x.xml")
+    assert r.returncode == 2 and "elbow" in r.stderr and "Traceback" not in r.stderr

@@ -85,3 +85,27 @@ def test_read_ssv_refuses_a_non_si_unit(tmp_path):
     )
     with pytest.raises(DesignerError, match="not the SI unit N/m"):
         read_ssv(p)
+
+
+def test_cli_exports_every_candidate_as_a_parameter_set(tmp_path):
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    suggestion = Path(__file__).resolve().parents[1] / "examples" / "suggestion.json"
+    out = tmp_path / "joint.ssp"
+    cmd = "from designer_cli.main import main; main()"
+    args = ["export", "ssp", "--from", str(suggestion), "--candidate", "2", "-o", str(out)]
+    r = subprocess.run([sys.executable, "-I", "-c", cmd, *args], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    with zipfile.ZipFile(out) as z:
+        names = z.namelist()
+        ssd = z.read("SystemStructure.ssd").decode()
+    assert {"resources/candidate_1.ssv", "resources/candidate_2.ssv"} <= set(names)
+    assert 'source="resources/candidate_2.ssv"' in ssd
+    r = subprocess.run(
+        [sys.executable, "-I", "-c", cmd, "export", "ssp", "--k", "0.8", "--c", "2e-3", "-o", str(out)],
+        capture_output=True,
+        text=True,
+    )
+    assert r.returncode == 2 and "body interface needs a mass" in r.stderr and "Traceback" not in r.stderr

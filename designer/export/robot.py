@@ -60,7 +60,7 @@ def check_suffix(path: str | Path, suffixes: tuple[str, ...], what: str) -> Path
     return path
 
 
-def with_masses(joint: Joint) -> Joint:
+def with_masses(joint: Joint, why: str = "a robot link needs a real mass") -> Joint:
     """The joint with every axis' moving mass: given, or from the design's geometry.
 
     Raises:
@@ -73,7 +73,7 @@ def with_masses(joint: Joint) -> Joint:
     except DesignerError:
         missing = [a for a, ac in joint.axes.items() if ac.m is None]
         raise DesignerError(
-            f"joint '{joint.name}' has no mass on axis {', '.join(missing)}: a robot link needs a real mass",
+            f"joint '{joint.name}' has no mass on axis {', '.join(missing)}: {why}",
             "build the joint with m for every axis (kg, or kg.m^2 on rotational axes), or from a design",
         ) from None
 

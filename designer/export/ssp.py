@@ -165,8 +165,9 @@ def export_ssp(
         DesignerError: a wrong suffix, a set whose axes differ from the joint's, or a missing mass.
     """
     path = check_suffix(path, (".ssp",), "an SSP archive")
+    why = "the body interface needs a mass (or use interface='force')"
     if interface == "body":
-        joint = with_masses(joint)
+        joint = with_masses(joint, why)
     sets = dict(parameter_sets) if parameter_sets else {joint.name: joint}
     for set_name, other in sets.items():
         if not set_name.isidentifier() or list(other.axes) != list(joint.axes):
@@ -175,14 +176,36 @@ def export_ssp(
                 f"give identifier names and joints with the axes {', '.join(joint.axes)}",
             )
         if interface == "body":
-            sets[set_name] = with_masses(other)
+            sets[set_name] = with_masses(other, why)
     entries = {f"resources/{n}.ssv": ssv_text(j, n).encode() for n, j in sets.items()}
     entries["SystemStructure.ssd"] = ssd_text([joint], next(iter(sets)), interface).encode()
     entries[f"resources/{joint.name}.fmu"] = _fmu_bytes(joint, interface)
     with atomic_path(path) as tmp, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
-        for name in sorted(entries):
-            z.writestr(name, entries[name])
+        for name in sorted(entries):  # fixed dates: the same joints give the same bytes
+            z.writestr(zipfile.ZipInfo(name, date_time=fmu._ZIP_DATE), entries[name], zipfile.ZIP_DEFLATED)
     return path
+
+
+def candidate_sets(
+    suggestion, *, first: int = 1, axes: list[str] | None = None, name: str = "FlexJoint"
+) -> dict[str, Joint]:
+    """Every candidate of a suggestion (object or saved JSON) as a parameter set `candidate_<i>`.
+
+    Candidate `first` comes first (export_ssp binds the first set); the others follow in rank order.
+
+    Raises:
+        DesignerError: the suggestion cannot be read, has no candidates, or no candidate `first`.
+    """
+    from ..suggest import Suggestion
+
+    if not isinstance(suggestion, Suggestion):
+        suggestion = Suggestion.load(suggestion)
+    if not suggestion.candidates:
+        raise DesignerError("the suggestion has no candidates", "run suggest with reachable targets")
+    order = [first] + [i for i in range(1, len(suggestion.candidates) + 1) if i != first]
+    return {
+        f"candidate_{i}": Joint.from_suggestion(suggestion, candidate=i, axes=axes, name=name) for i in order
+    }
 
 
 def _fmu_bytes(joint: Joint, interface: str) -> bytes:
