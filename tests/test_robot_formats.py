@@ -273,28 +273,33 @@ def test_step_advice_closed_forms():
     assert overdamped.max_timestep["RK4"] == pytest.approx(2.785293563 / (1e3 - 1e-3), rel=1e-6)
 
 
-def test_cli_mjcf_into_urdf_and_sdf(tmp_path):
+def test_cli_mjcf_into_urdf_and_sdf(tmp_path, monkeypatch, capsys):
+    """The sub-commands in-process through the installed entry point (one interpreter: the suite's budget)."""
     import json
-    import subprocess
     import sys
 
+    from designer_cli.main import main
+
     (tmp_path / "robot.xml").write_text(HOST)
+    monkeypatch.chdir(tmp_path)
 
     def run(*args):
-        cmd = "from designer_cli.main import main; main()"
-        return subprocess.run(
-            [sys.executable, "-I", "-c", cmd, "export", *args], capture_output=True, text=True, cwd=tmp_path
-        )
+        monkeypatch.setattr(sys, "argv", ["designer", "export", *args])
+        with pytest.raises(SystemExit) as exit_:
+            main()
+        out = capsys.readouterr()
+        return exit_.value.code or 0, out.out, out.err
 
     joint = ["--k", "50", "--c", "0.5", "--m", "1e-5", "--axis", "theta"]
-    r = run("mjcf", *joint, "--into", "robot.xml", "--joint", "elbow", "-o", "robot_flex.xml", "--json")
-    assert r.returncode == 0, r.stderr
-    advice = json.loads(r.stdout)["advice"]["elbow"]
+    code, out, err = run(
+        "mjcf", *joint, "--into", "robot.xml", "--joint", "elbow", "-o", "robot_flex.xml", "--json"
+    )
+    assert code == 0, err
+    advice = json.loads(out)["advice"]["elbow"]
     assert set(advice["max_stable_timestep_s"]) == {"Euler", "implicitfast", "RK4"}
     assert 'range="-120 120"' in (tmp_path / "robot_flex.xml").read_text()
-    r = run("mjcf", *joint, "--form", "series", "-o", "sea.xml")
-    assert r.returncode == 0 and "natural frequency" in r.stdout and "FlexJoint_motor" in r.stdout
-    assert run("urdf", *joint, "-o", "j.urdf").returncode == 0
-    assert run("sdf", *joint, "-o", "j.sdf").returncode == 0
-    r = run("mjcf", *joint, "--into", "robot.xml", "--joint", "wrist", "-o", "x.xml")
-    assert r.returncode == 2 and "elbow" in r.stderr and "Traceback" not in r.stderr
+    code, out, _ = run("mjcf", *joint, "--form", "series", "-o", "sea.xml")
+    assert code == 0 and "natural frequency" in out and "FlexJoint_motor" in out
+    assert run("urdf", *joint, "-o", "j.urdf")[0] == 0 and run("sdf", *joint, "-o", "j.sdf")[0] == 0
+    code, _, err = run("mjcf", *joint, "--into", "robot.xml", "--joint", "wrist", "-o", "x.xml")
+    assert code == 2 and "elbow" in err and "Traceback" not in err
