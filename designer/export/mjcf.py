@@ -269,7 +269,10 @@ def into_robot(
     full = np.zeros((after.nv, after.nv))
     data = mujoco.MjData(after)
     mujoco.mj_forward(after, data)
-    mujoco.mj_fullM(after, data, full)
+    try:
+        mujoco.mj_fullM(after, data, full)  # MuJoCo 4
+    except TypeError:
+        mujoco.mj_fullM(after, full, data.qM)  # MuJoCo 3
     dof = j.dofadr[0]
     return {joint_name: step_advice(si["k"], si["c"], full[dof, dof])}
 

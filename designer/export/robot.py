@@ -104,7 +104,8 @@ def chain_advice(joint: Joint, bodies: dict[str, Sphere]) -> dict[str, StepAdvic
     """Step advice per axis of the joint's chain of links (each axis moves its link and those after it).
 
     All links sit on the joint origin, so an axis sees the sum of the masses (translational) or of the
-    inertias (rotational) of its own and the following links, the other axes held.
+    inertias (rotational) of its own and the following links, the other axes held: on a joint with
+    several axes that is more than the axis' own m, and the advice (which states it) uses it.
     """
     order = list(joint.axes)
     out = {}

@@ -30,14 +30,17 @@ INTEGRATORS = ("Euler", "implicitfast", "RK4")
 
 @dataclass(frozen=True)
 class StepAdvice:
-    """Natural frequency (Hz), damping ratio and the largest stable timestep (s) per integrator."""
+    """Natural frequency (Hz), damping ratio, the largest stable timestep (s) per integrator, and the
+    inertia (kg.m^2, or kg on a slide) they were computed with."""
 
+    inertia: float
     natural_frequency: float
     damping_ratio: float
     max_timestep: dict[str, float]
 
     def to_dict(self) -> dict[str, object]:
         return {
+            "inertia_si": self.inertia,
             "natural_frequency_hz": self.natural_frequency,
             "damping_ratio": self.damping_ratio,
             "max_stable_timestep_s": dict(self.max_timestep),
@@ -47,7 +50,8 @@ class StepAdvice:
         """One line for an XML comment or a terminal: frequency and the three step limits."""
         steps = ", ".join(f"{n} {h * 1e3:.3g} ms" for n, h in self.max_timestep.items())
         return (
-            f"natural frequency {self.natural_frequency:.4g} Hz, damping ratio {self.damping_ratio:.3g}; "
+            f"natural frequency {self.natural_frequency:.4g} Hz (moving inertia {self.inertia:.4g} SI), "
+            f"damping ratio {self.damping_ratio:.3g}; "
             f"largest stable timestep: {steps}"
         )
 
@@ -84,6 +88,7 @@ def step_advice(k: float, c: float, inertia: float) -> StepAdvice:
     omega = math.sqrt(k / inertia)
     implicit = (c + math.sqrt(c * c + 4 * k * inertia)) / k
     return StepAdvice(
+        inertia=inertia,
         natural_frequency=omega / (2 * math.pi),
         damping_ratio=c / (2 * math.sqrt(k * inertia)),
         max_timestep={"Euler": implicit, "implicitfast": implicit, "RK4": _rk4_limit(k, c, inertia)},
