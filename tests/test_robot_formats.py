@@ -257,7 +257,14 @@ def test_sdf_spring_becomes_a_drake_revolute_spring(tmp_path):
 
 def test_robot_writers_refuse_other_suffixes_naming_path(tmp_path):
     joint = Joint.from_coefficients(THETA)
-    for writer, bad in ((export_mjcf, "j.urdf"), (export_urdf, "j.xml"), (export_sdf, "j.urdf")):
+    from designer import export_fmu
+
+    for writer, bad in (
+        (export_mjcf, "j.urdf"),
+        (export_urdf, "j.xml"),
+        (export_sdf, "j.urdf"),
+        (export_fmu, "j.zip"),
+    ):
         with pytest.raises(DesignerError, match="path="):
             writer(joint, tmp_path / bad)
     with pytest.raises(DesignerError, match="m for every axis"):
