@@ -49,6 +49,71 @@ def sphere_with_inertia(inertia: float, mass: float | None, basis: str) -> Spher
     return Sphere(mass, inertia, math.sqrt(2.5 * inertia / mass), basis)
 
 
+@dataclass(frozen=True)
+class RobotExport:
+    """What a robot-format export wrote: the path and, per joint name, the step advice it states."""
+
+    path: Path
+    advice: dict[str, StepAdvice]
+
+    def __fspath__(self) -> str:
+        return str(self.path)
+
+    def to_dict(self) -> dict[str, object]:
+        return {"path": str(self.path), "advice": {n: a.to_dict() for n, a in self.advice.items()}}
+
+
+def pick_axis(joint: Joint, axis: str | None, rotational: bool | None = None) -> str:
+    """The joint's axis to export onto one robot joint: `axis`, or the only one (of the right kind)."""
+    if axis is not None:
+        return joint.axis(axis).axis
+    fits = [a for a in joint.axes if rotational is None or units.is_rotational(a) == rotational]
+    if len(fits) != 1:
+        raise DesignerError(
+            f"joint '{joint.name}' has axes {', '.join(joint.axes)}; cannot tell which one to export",
+            "give axis= one of them",
+        )
+    return fits[0]
+
+
+@dataclass(frozen=True)
+class Servo:
+    """A critically damped position servo on a motor of `motor_inertia` carrying a link (SI, Hz)."""
+
+    motor_inertia: float
+    bandwidth: float
+    kp: float
+    kv: float
+
+    @classmethod
+    def for_flexure(
+        cls, flex: StepAdvice, *, motor_inertia: float | None = None, bandwidth: float | None = None
+    ) -> Servo:
+        """Defaults: 10 x the link's inertia, 10 x the flexure's natural frequency (see `series_text`).
+
+        Raises:
+            DesignerError: a motor inertia or bandwidth that is not positive.
+        """
+        motor_inertia = 10 * flex.inertia if motor_inertia is None else motor_inertia
+        bandwidth = 10 * flex.natural_frequency if bandwidth is None else bandwidth
+        if not (motor_inertia > 0 and bandwidth > 0):
+            raise DesignerError(
+                f"motor_inertia = {motor_inertia:g} and motor_bandwidth = {bandwidth:g} must be positive",
+                "give positive numbers (SI inertia or mass, Hz)",
+            )
+        total = motor_inertia + flex.inertia
+        kp = total * (2 * math.pi * bandwidth) ** 2
+        return cls(motor_inertia, bandwidth, kp, 2 * math.sqrt(kp * total))
+
+    def motor_body(self, link: Sphere, rotational: bool) -> Sphere:
+        """The motor's body: its inertia as a sphere of the link's mass, or its mass as TPU."""
+        if rotational:
+            return sphere_with_inertia(
+                self.motor_inertia, link.mass, f"motor inertia {self.motor_inertia:.4g} kg.m^2"
+            )
+        return sphere_with_mass(self.motor_inertia, f"motor mass {self.motor_inertia:.4g} kg")
+
+
 def check_suffix(path: str | Path, suffixes: tuple[str, ...], what: str) -> Path:
     """`path` as a Path if its suffix is one of `suffixes`, else a DesignerError naming `path`."""
     path = Path(path)

@@ -17,7 +17,6 @@ from ..errors import DesignerError
 from ..files import atomic_path, atomic_write
 from ..joint import Joint
 from . import robot
-from .mjcf import RobotExport, pick_axis
 
 #: a prismatic URDF joint needs limits; these (m) are wide enough never to act on a flexure
 PRISMATIC_LIMIT = 1.0
@@ -141,7 +140,7 @@ def _into_urdf(joint: Joint, host: Path, *, joint_name: str, axis: str | None, r
             f"its movable joints are: {', '.join(have) or 'none'}",
         )
     rot = kinds[found[0].get("type")]
-    a = pick_axis(joint, axis, rot)
+    a = robot.pick_axis(joint, axis, rot)
     if units.is_rotational(a) != rot:
         raise DesignerError(
             f"axis={a!r} does not match the kind of robot joint '{joint_name}' ({found[0].get('type')})",
@@ -170,7 +169,7 @@ def export_urdf(
     joint_name: str | None = None,
     axis: str | None = None,
     rest: float = 0.0,
-) -> RobotExport:
+) -> robot.RobotExport:
     """Write `joint` as URDF at `path` (.urdf) and return the path and the stated step advice.
 
     Standalone: a chain of links with real masses (see `urdf_text`). With `into` (a URDF file) and
@@ -188,14 +187,14 @@ def export_urdf(
         data = _into_urdf(joint, Path(into), joint_name=joint_name, axis=axis, rest=rest)
         with atomic_path(path) as tmp:
             tmp.write_bytes(data)
-        return RobotExport(path, {})
+        return robot.RobotExport(path, {})
     text, advice = urdf_text(robot.with_masses(joint))
     with atomic_write(path) as fh:
         fh.write(text)
-    return RobotExport(path, advice)
+    return robot.RobotExport(path, advice)
 
 
-def export_sdf(joint: Joint, path: str | Path) -> RobotExport:
+def export_sdf(joint: Joint, path: str | Path) -> robot.RobotExport:
     """Write `joint` as an SDFormat 1.7 model at `path` (.sdf); see `sdf_text`.
 
     Raises:
@@ -205,4 +204,4 @@ def export_sdf(joint: Joint, path: str | Path) -> RobotExport:
     text, advice = sdf_text(robot.with_masses(joint))
     with atomic_write(path) as fh:
         fh.write(text)
-    return RobotExport(path, advice)
+    return robot.RobotExport(path, advice)
