@@ -173,6 +173,44 @@ def test_series_form_matches_the_cosimulation_reference(tmp_path):
     assert errors[0] < 1.0 * np.max(np.abs(deflection)) and errors[1] < 0.03 * np.max(np.abs(deflection))
 
 
+def test_series_into_a_robot_inserts_a_motor_and_holds_the_link_by_the_flexure(tmp_path):
+    host_path = tmp_path / "robot.xml"
+    host_path.write_text(HOST)
+    out = export_mjcf(
+        Joint.from_coefficients(THETA),
+        tmp_path / "sea.xml",
+        into=host_path,
+        joint_name="elbow",
+        form="series",
+    )
+    assert set(out.advice) == {"elbow", "elbow_motor"}
+    text = out.path.read_text()
+    assert 'name="elbow_motor" pos="0.1 0 0"' in text and '<compiler angle="degree"/>' in text
+    host, sea = (mujoco.MjModel.from_xml_path(str(p)) for p in (host_path, out.path))
+    assert np.array_equal(sea.joint("elbow_motor").range, host.joint("elbow").range)  # still +/-120 deg
+    assert sea.joint("elbow").limited[0] == 0 and sea.joint("elbow").stiffness[0] == 0.05
+    # a torque on the link, the servo holding the motor at 0: the flexure alone deflects tau / k
+    sea.opt.gravity[:] = 0
+    data = mujoco.MjData(sea)
+    flex = sea.joint("elbow").dofadr[0]
+    for _ in range(4000):
+        data.qfrc_applied[flex] = 1e-3
+        mujoco.mj_step(sea, data)
+    assert data.qpos[sea.joint("elbow").qposadr[0]] == pytest.approx(1e-3 / 0.05, rel=1e-3)
+    # an actuator already on the joint moves to the motor instead of a new servo
+    (tmp_path / "robot2.xml").write_text(
+        HOST.replace("</actuator>", '<motor name="m" joint="elbow"/></actuator>')
+    )
+    out = export_mjcf(
+        Joint.from_coefficients(THETA),
+        tmp_path / "sea2.xml",
+        into=tmp_path / "robot2.xml",
+        joint_name="elbow",
+        form="series",
+    )
+    assert set(out.advice) == {"elbow"} and '<motor name="m" joint="elbow_motor"/>' in out.path.read_text()
+
+
 def test_urdf_loads_in_mujoco_with_real_links_and_the_gazebo_spring(tmp_path):
     joint = Joint.from_coefficients(THETA)
     out = export_urdf(joint, tmp_path / "j.urdf")
@@ -199,7 +237,8 @@ def test_urdf_steps_in_pybullet_with_default_flags(tmp_path):
     try:
         body = p.loadURDF(str(out.path), useFixedBase=True, physicsClientId=client)
         info = p.getDynamicsInfo(body, 0, physicsClientId=client)
-        assert info[0] == pytest.approx(0.0525670, rel=1e-5) and info[2] == pytest.approx((1e-5,) * 3)
+        mass = 1e-5 / (0.85 * 0.024) ** 2  # m / (gamma L)^2 at the middle tested length
+        assert info[0] == pytest.approx(mass, rel=1e-9) and info[2] == pytest.approx((1e-5,) * 3)
         p.setTimeStep(1e-4, physicsClientId=client)
         # pybullet's default velocity motor would hold the joint; URDF damping it applies itself
         p.setJointMotorControl2(body, 0, p.VELOCITY_CONTROL, force=0, physicsClientId=client)

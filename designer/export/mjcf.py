@@ -14,7 +14,7 @@ from ..errors import DesignerError
 from ..files import atomic_write
 from ..joint import Joint
 from . import robot
-from .mjcf_into import into_parallel
+from .mjcf_into import into_parallel, into_series
 from .stability import StepAdvice, step_advice
 
 FORMS = ("parallel", "series")
@@ -22,11 +22,6 @@ FORMS = ("parallel", "series")
 
 def _num(v: float) -> str:
     return repr(float(v))
-
-
-def _inertial(s: robot.Sphere) -> str:
-    i = _num(s.inertia)
-    return f'<inertial pos="0 0 0" mass="{_num(s.mass)}" diaginertia="{i} {i} {i}"/>'
 
 
 def _joint_element(name: str, a: str, k: float, c: float) -> str:
@@ -62,7 +57,7 @@ def parallel_text(joint: Joint) -> tuple[str, dict[str, StepAdvice]]:
             f'{pad}<body name="{name}_link">',
             f"{pad}  {robot.xml_comment(f'{name}: {advice[name].text()}')}",
             f"{pad}  {robot.xml_comment('link: ' + bodies[a].basis)}",
-            f"{pad}  {_inertial(bodies[a])}",
+            f"{pad}  {robot.inertial_xml(bodies[a])}",
             f"{pad}  {_joint_element(name, a, si['k'], si['c'])}",
         ]
         closing.insert(0, f"{pad}</body>")
@@ -74,35 +69,39 @@ def series_text(
 ) -> tuple[str, dict[str, StepAdvice]]:
     """Motor -> flexure -> link on axis `a`: a position-servoed motor joint, the flexure joint on it.
 
-    The motor body carries `motor_inertia` (SI; default 10 x the link's) and a `position` actuator whose
-    gain puts the servo at `motor_bandwidth` Hz (default 10 x the flexure's natural frequency); the
-    servo's derivative gain is the motor joint's damping, critically damped, so MuJoCo's Euler and
-    implicitfast treat it implicitly. The actuator's ctrl is the motor angle (rad) or position (m).
+    The motor joint has armature `motor_inertia` (SI; default 10 x the link's), its body the flexure's
+    clamped part (as the link's body), and a `position` actuator whose gain puts the servo at
+    `motor_bandwidth` Hz (default 10 x the flexure's natural frequency); the servo's derivative gain is
+    the motor joint's damping, critically damped, so MuJoCo's Euler and implicitfast treat it
+    implicitly. The actuator's ctrl is the motor angle (rad) or position (m).
     """
     rot = units.is_rotational(a)
     link = robot.links(joint)[a]
-    link_inertia = link.inertia if rot else link.mass
+    moving = link.inertia if rot else link.mass
     si = joint.axes[a].si()
-    flex = step_advice(si["k"], si["c"], link_inertia)
-    servo = robot.Servo.for_flexure(flex, motor_inertia=motor_inertia, bandwidth=motor_bandwidth)
-    motor = servo.motor_body(link, rot)
+    flex = step_advice(si["k"], si["c"], moving)
+    # the motor turns its armature, its body (the flexure's clamped part, as the link) and the link
+    servo = robot.Servo.for_flexure(
+        flex, carried=2 * moving, motor_inertia=motor_inertia, bandwidth=motor_bandwidth
+    )
     n = joint.name
     advice = {
         f"{n}_{a}": flex,
-        f"{n}_motor": step_advice(servo.kp, servo.kv, servo.motor_inertia + link_inertia),
+        f"{n}_motor": step_advice(servo.kp, servo.kv, servo.motor_inertia + 2 * moving),
     }
     kind = "hinge" if rot else "slide"
     body = [
         f'    <body name="{n}_motor_rotor">',
         f"      {robot.xml_comment(f'{n}_motor servo, flexure held: ' + advice[f'{n}_motor'].text())}",
-        f"      {robot.xml_comment('rotor: ' + motor.basis)}",
-        f"      {_inertial(motor)}",
+        f"      {robot.xml_comment('motor output: ' + link.basis + '; its reflected inertia as armature')}",
+        f"      {robot.inertial_xml(link)}",
         f'      <joint name="{n}_motor" type="{kind}" axis="{robot.AXIS_VECTORS[a]}" '
-        f'damping="{_num(servo.kv)}" armature="0" frictionloss="0" limited="false"/>',
+        f'damping="{_num(servo.kv)}" armature="{_num(servo.motor_inertia)}" frictionloss="0" '
+        'limited="false"/>',
         f'      <body name="{n}_{a}_link">',
         f"        {robot.xml_comment(f'{n}_{a} flexure, motor held: ' + flex.text())}",
         f"        {robot.xml_comment('link: ' + link.basis)}",
-        f"        {_inertial(link)}",
+        f"        {robot.inertial_xml(link)}",
         f"        {_joint_element(f'{n}_{a}', a, si['k'], si['c'])}",
         "      </body>",
         "    </body>",
@@ -135,7 +134,8 @@ def export_mjcf(
 
     Standalone (`into` None): form "parallel" is a chain of links, one per axis, each on a spring-damper
     joint; form "series" is motor -> flexure -> link on one axis (see `series_text`). With `into` (an
-    MJCF file) and `joint_name`, a copy of that robot with the joint made flexible (see `into_robot`).
+    MJCF file) and `joint_name`, a copy of that robot with the joint made flexible, in parallel or in
+    series (see `mjcf_into.into_parallel`, `mjcf_into.into_series`).
     Masses come from the joint, or from the design's geometry.
 
     Raises:
@@ -145,14 +145,22 @@ def export_mjcf(
     if form not in FORMS:
         raise DesignerError(f"form={form!r} is not a form", f"use one of: {', '.join(FORMS)}")
     if into is not None:
-        if form != "parallel" or joint_name is None:
-            raise DesignerError(
-                "into= needs joint_name= and the parallel form",
-                "name the robot joint to make flexible; the series form is standalone only",
+        if joint_name is None:
+            raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
+        if form == "series":
+            advice = into_series(
+                joint,
+                into,
+                path,
+                joint_name=joint_name,
+                axis=axis,
+                rest=rest,
+                motor_inertia=motor_inertia,
+                motor_bandwidth=motor_bandwidth,
             )
-        return robot.RobotExport(
-            path, into_parallel(joint, into, path, joint_name=joint_name, axis=axis, rest=rest)
-        )
+        else:
+            advice = into_parallel(joint, into, path, joint_name=joint_name, axis=axis, rest=rest)
+        return robot.RobotExport(path, advice)
     joint = robot.with_masses(joint)
     if form == "series":
         a = robot.pick_axis(joint, axis)

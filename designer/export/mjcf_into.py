@@ -11,6 +11,7 @@ reference configuration and every other joint its numbers.
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -184,3 +185,138 @@ def into_parallel(
     return {
         joint_name: step_advice(si["k"], si["c"], _mass_diagonal(after)[after.joint(joint_name).dofadr[0]])
     }
+
+
+def _insert_motor(host: _Host, joint_name: str, motor: robot.Sphere, servo: robot.Servo) -> int:
+    """Put a motor body between the joint's body and its parent; return how many actuators moved to it.
+
+    The motor body (inertial `motor`) takes the link body's place and frame attributes; the link sits
+    in it at the identity. The motor joint is a copy of the host joint (type, axis, range...) with the
+    servo's armature. Actuators
+    on the host joint now drive the motor joint; without any, `servo` is added as a position actuator
+    (its derivative gain as the motor joint's damping).
+    """
+    from lxml import etree
+
+    link = host.element.getparent()
+    parent = link.getparent()
+    body = etree.Element("body", name=f"{joint_name}_motor")
+    for attr in _FRAME:
+        if attr in link.attrib:
+            body.set(attr, link.attrib.pop(attr))
+    parent.insert(parent.index(link), body)
+    motor_joint = copy.deepcopy(host.element)
+    motor_joint.set("name", f"{joint_name}_motor")
+    motor_joint.set("armature", _num(servo.motor_inertia))
+    comment = etree.Comment(f" flexjoint designer: the motor of series-elastic joint {joint_name} ")
+    for child in (comment, etree.fromstring(robot.inertial_xml(motor)), motor_joint, link):
+        body.append(child)
+    body.tail, link.tail = link.tail, None
+    etree.indent(body, space="  ", level=len(list(body.iterancestors())))
+    root = host.tree.getroot()
+    moved = root.xpath("//actuator/*[@joint=$n]", n=joint_name)
+    for act in moved:
+        act.set("joint", f"{joint_name}_motor")
+    if not moved:
+        motor_joint.set("damping", _num(servo.kv))
+        section = root.find("actuator")
+        if section is None:
+            section = etree.SubElement(root, "actuator")
+        servo_xml = f'<position name="{joint_name}_motor" joint="{joint_name}_motor" kp="{_num(servo.kp)}"/>'
+        section.append(etree.fromstring(servo_xml))
+    return len(moved)
+
+
+def _compare_series(before, after, joint_name: str) -> None:
+    """Raise unless every host body keeps its world pose and every host joint its numbers.
+
+    MuJoCo numbers bodies and joints in the file's depth-first order, so the inserted motor body and
+    joint shift the ids after them by one; the host joint is compared with the motor joint, which
+    took over its type, axis and range.
+    """
+    import mujoco
+
+    def shifted(i: int, at: int) -> int:
+        return i if i < at else i + 1
+
+    data = [mujoco.MjData(m) for m in (before, after)]
+    for m, d in zip((before, after), data, strict=True):
+        mujoco.mj_kinematics(m, d)
+    motor_body, motor_joint = after.body(f"{joint_name}_motor").id, after.joint(f"{joint_name}_motor").id
+    changed = [
+        before.body(i).name or f"body {i}"
+        for i in range(before.nbody)
+        if not (
+            np.allclose(data[0].xpos[i], data[1].xpos[shifted(i, motor_body)], atol=1e-12)
+            and np.allclose(data[0].xquat[i], data[1].xquat[shifted(i, motor_body)], atol=1e-12)
+        )
+    ]
+    for i in range(before.njnt):
+        mine, theirs = before.joint(i), after.joint(shifted(i, motor_joint + 1))
+        fields = (
+            ("type", "range", "axis", "limited")
+            if i == motor_joint
+            else ("type", "range", "axis", "limited", "stiffness", "armature", "damping")
+        )
+        if not all(np.array_equal(getattr(mine, f), getattr(theirs, f)) for f in fields):
+            changed.append(mine.name or f"joint {i}")
+    if changed:
+        raise RuntimeError(f"the series edit changed host bodies or joints: {', '.join(changed)}")
+
+
+def into_series(
+    joint: Joint,
+    host: str | Path,
+    path: Path,
+    *,
+    joint_name: str,
+    axis: str | None = None,
+    rest: float = 0.0,
+    motor_inertia: float | None = None,
+    motor_bandwidth: float | None = None,
+) -> dict[str, StepAdvice]:
+    """Write a copy of MJCF `host` to `path` with motor -> flexure -> link at robot joint `joint_name`.
+
+    A motor body `<joint_name>_motor` (carrying the flexure's clamped part) is inserted before the
+    joint's body; its joint (a copy of the host joint, `<joint_name>_motor`) takes over the host's
+    range and actuators, with armature `motor_inertia` (default: the host joint's armature if any, else
+    10 x the flexure's moving inertia), and the host joint becomes the flexure (stiffness, damping,
+    armature = its moving inertia, springref = `rest`, unlimited). With no actuator on the joint, a
+    position servo is added (see `robot.Servo`). Sensors, tendons and
+    equalities on `joint_name` now see the flexure's deflection. Returns the step advice of the flexure
+    (motor held) and, when added, of the servo (flexure held), inertias from the mass matrix.
+
+    Raises:
+        DesignerError: as `into_parallel`, or when the names `<joint_name>_motor` are taken.
+    """
+    h = _open(host, joint_name)
+    a = _axis(joint, axis, h, joint_name)
+    taken = {e.name for e in (*h.spec.joints, *h.spec.bodies, *h.spec.actuators)}
+    if f"{joint_name}_motor" in taken:
+        raise DesignerError(f"the robot already has something named {joint_name}_motor", "rename it first")
+    full = robot.with_masses(joint)
+    si, clamp = full.axes[a].si(), robot.links(full)[a]
+    # the link as the flexure sees it: the host's inertia at the joint, less the armature the motor
+    # keeps, plus the flexure's own moving inertia; the motor also turns the flexure's clamped part
+    dof = h.model.joint(joint_name).dofadr[0]
+    host_armature = float(h.model.dof_armature[dof])
+    link = _mass_diagonal(h.model)[dof] - host_armature + si["m"]
+    if motor_inertia is None and host_armature > 0:
+        motor_inertia = host_armature
+    servo = robot.Servo.for_flexure(
+        step_advice(si["k"], si["c"], link),
+        carried=link + (clamp.inertia if h.hinge else clamp.mass),
+        motor_inertia=motor_inertia,
+        bandwidth=motor_bandwidth,
+    )
+    moved = _insert_motor(h, joint_name, clamp, servo)
+    _flexure(h, joint, a, rest)
+    for attr, value in (("ref", "0"), ("limited", "false")):
+        h.element.set(attr, value)
+    after = _write_checked(h, path, lambda m: _compare_series(h.model, m, joint_name))
+    diag = _mass_diagonal(after)
+    flex_dof, motor_dof = after.joint(joint_name).dofadr[0], after.joint(f"{joint_name}_motor").dofadr[0]
+    advice = {joint_name: step_advice(si["k"], si["c"], diag[flex_dof])}
+    if not moved:
+        advice[f"{joint_name}_motor"] = step_advice(servo.kp, servo.kv, diag[motor_dof])
+    return advice

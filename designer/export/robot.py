@@ -15,9 +15,9 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from .. import units
+from .. import space, units
 from ..errors import DesignerError
-from ..joint import Joint
+from ..joint import PRB_GAMMA, Joint
 from ..mass import specimen_mass
 from .stability import StepAdvice, step_advice
 
@@ -78,7 +78,12 @@ def pick_axis(joint: Joint, axis: str | None, rotational: bool | None = None) ->
 
 @dataclass(frozen=True)
 class Servo:
-    """A critically damped position servo on a motor of `motor_inertia` carrying a link (SI, Hz)."""
+    """A critically damped position servo: the motor's reflected inertia (its joint armature, SI), the
+    bandwidth (Hz), the proportional gain kp and the derivative gain kv (the motor joint's damping).
+
+    The motor body itself carries the flexure's clamped TPU part (see `links`); the rotor's inertia, as
+    a geared motor's usually is, is reflected through the gearbox and so modelled as armature.
+    """
 
     motor_inertia: float
     bandwidth: float
@@ -87,9 +92,16 @@ class Servo:
 
     @classmethod
     def for_flexure(
-        cls, flex: StepAdvice, *, motor_inertia: float | None = None, bandwidth: float | None = None
+        cls,
+        flex: StepAdvice,
+        *,
+        carried: float,
+        motor_inertia: float | None = None,
+        bandwidth: float | None = None,
     ) -> Servo:
-        """Defaults: 10 x the link's inertia, 10 x the flexure's natural frequency (see `series_text`).
+        """Gains for a servo moving `motor_inertia` plus `carried` (what else turns with the motor).
+
+        Defaults: 10 x the flexure's moving inertia (`flex.inertia`), 10 x its natural frequency.
 
         Raises:
             DesignerError: a motor inertia or bandwidth that is not positive.
@@ -101,17 +113,15 @@ class Servo:
                 f"motor_inertia = {motor_inertia:g} and motor_bandwidth = {bandwidth:g} must be positive",
                 "give positive numbers (SI inertia or mass, Hz)",
             )
-        total = motor_inertia + flex.inertia
+        total = motor_inertia + carried
         kp = total * (2 * math.pi * bandwidth) ** 2
         return cls(motor_inertia, bandwidth, kp, 2 * math.sqrt(kp * total))
 
-    def motor_body(self, link: Sphere, rotational: bool) -> Sphere:
-        """The motor's body: its inertia as a sphere of the link's mass, or its mass as TPU."""
-        if rotational:
-            return sphere_with_inertia(
-                self.motor_inertia, link.mass, f"motor inertia {self.motor_inertia:.4g} kg.m^2"
-            )
-        return sphere_with_mass(self.motor_inertia, f"motor mass {self.motor_inertia:.4g} kg")
+
+def inertial_xml(s: Sphere) -> str:
+    """The MJCF `<inertial>` of a sphere on the body's origin."""
+    i = repr(float(s.inertia))
+    return f'<inertial pos="0 0 0" mass="{float(s.mass)!r}" diaginertia="{i} {i} {i}"/>'
 
 
 def check_suffix(path: str | Path, suffixes: tuple[str, ...], what: str) -> Path:
@@ -146,10 +156,12 @@ def with_masses(joint: Joint, why: str = "a robot link needs a real mass") -> Jo
 def links(joint: Joint) -> dict[str, Sphere]:
     """Per axis the moving link: its mass on a translational axis, its inertia on a rotational one.
 
-    A rotational link weighs the specimen's mass when the joint comes from a design, else the mass of
-    a solid TPU sphere with that inertia. The joint must carry masses (see `with_masses`).
+    A rotational link weighs the specimen's mass when the joint comes from a design; otherwise the
+    mass whose pseudo-rigid-body inertia m (gamma L)^2 is the axis' inertia, for the middle of the
+    tested lengths (bounds over the whole range stated). The joint must carry masses (`with_masses`).
     """
     params = joint.provenance.get("params")
+    lengths = space.BY_NAME["length"]
     out = {}
     for a, ac in joint.axes.items():
         m = ac.si()["m"]
@@ -161,7 +173,18 @@ def links(joint: Joint) -> dict[str, Sphere]:
                 m, ms, f"the axis' moving inertia {m:.4g} kg.m^2 with the specimen's mass {ms:.4g} kg"
             )
         else:
-            out[a] = sphere_with_inertia(m, None, f"the axis' moving inertia {m:.4g} kg.m^2 as solid TPU")
+
+            def mass(length_mm: float) -> float:
+                return m / (PRB_GAMMA * length_mm * units.MM) ** 2  # noqa: B023
+
+            mid = (lengths.low + lengths.high) / 2
+            out[a] = sphere_with_inertia(
+                m,
+                mass(mid),
+                f"the axis' moving inertia {m:.4g} kg.m^2 with mass {mass(mid):.3g} kg = m / (gamma L)^2 at "
+                f"L = {mid:g} mm ({mass(lengths.high):.3g} to {mass(lengths.low):.3g} kg over the tested "
+                f"{lengths.describe_range()})",
+            )
     return out
 
 
