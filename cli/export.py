@@ -80,6 +80,77 @@ def _print_joint(joint, what: str, path: Path) -> None:
 JOINT_HELP = "rig units: --k N/mm (N.mm/rad), --c N.s/mm (N.mm.s/rad), --m kg (kg.m^2)"
 
 
+def _snippet(fmt: str, suffix: str, title: str, write, example: str, extra: tuple = ()) -> None:
+    """Add `export FMT`: the joint options, `extra` options (inspect.Parameters) passed to `write`.
+
+    `write(joint, output, (suggestion path, candidate) or None, **extra)` writes and returns the
+    path or a result with `advice`.
+    """
+
+    def command(
+        output: Annotated[Path, typer.Option("-o", "--output", help="the file to write")] = Path(
+            f"joint{suffix}"
+        ),
+        axis: Annotated[
+            list[str] | None, typer.Option(help="x y z theta phi psi; repeat for several")
+        ] = None,  # noqa: UP007
+        k: Floats = None,
+        c: Floats = None,
+        m: Floats = None,
+        density: Number = None,
+        length: Number = None,
+        width: Number = None,
+        height: Number = None,
+        layer: Number = None,
+        raster: Number = None,
+        from_: Annotated[
+            Path | None, typer.Option("--from", help="output of designer suggest --json")
+        ] = None,  # noqa: UP007
+        candidate: Annotated[int, typer.Option(help="candidate in --from, 1 = best")] = 1,
+        name: Annotated[str, typer.Option(help="joint (model) name")] = "FlexJoint",
+        allow_extrapolation: Annotated[bool, typer.Option(help="accept a design outside the ranges")] = False,
+        json_out: Annotated[bool, typer.Option("--json", help="print the result as JSON")] = False,
+        **options,
+    ) -> None:
+        joint = _joint(
+            axis,
+            k,
+            c,
+            m,
+            density,
+            length,
+            width,
+            height,
+            layer,
+            raster,
+            from_,
+            candidate,
+            name,
+            allow_extrapolation,
+        )
+        result = write(joint, output, (from_, candidate) if from_ else None, **options)
+        advice = getattr(result, "advice", {})
+        if json_out:
+            print_json(
+                {"path": str(output), "format": fmt, "joint": joint.to_dict()}
+                | ({"advice": {n: a.to_dict() for n, a in advice.items()}} if advice else {})
+            )
+            return
+        _print_joint(joint, title, output)
+        for n, a in advice.items():
+            console.print(f"  {n}: {a.text()}")
+
+    command.__doc__ = (
+        f"Write the joint as {title}, SI units, provenance in a comment.\n\n"
+        f"The joint comes from --k/--c [--m] ({JOINT_HELP}), the six print settings, or --from.\n\n"
+        f"Example: {example}"
+    )
+    signature = inspect.signature(command, eval_str=True)  # typer reads a __signature__ as it is
+    params = [p for p in signature.parameters.values() if p.kind is not p.VAR_KEYWORD]
+    command.__signature__ = signature.replace(parameters=[*params, *extra])
+    export_app.command(fmt)(command)
+
+
 def register(app: typer.Typer) -> None:
     """Add the `export` command group to the app."""
 
@@ -157,79 +228,7 @@ def register(app: typer.Typer) -> None:
                 "  no binary: build it from sources/ with 'python -m fmpy compile " + str(path) + "'"
             )
 
-    def snippet(fmt: str, suffix: str, title: str, write, example: str, extra: tuple = ()):
-        """Add `export FMT`: the joint options, `extra` options (inspect.Parameters) passed to `write`.
-
-        `write(joint, output, (suggestion path, candidate) or None, **extra)` writes and returns the
-        path or a result with `advice`.
-        """
-
-        def command(
-            output: Annotated[Path, typer.Option("-o", "--output", help="the file to write")] = Path(
-                f"joint{suffix}"
-            ),
-            axis: Annotated[
-                list[str] | None, typer.Option(help="x y z theta phi psi; repeat for several")
-            ] = None,  # noqa: UP007
-            k: Floats = None,
-            c: Floats = None,
-            m: Floats = None,
-            density: Number = None,
-            length: Number = None,
-            width: Number = None,
-            height: Number = None,
-            layer: Number = None,
-            raster: Number = None,
-            from_: Annotated[
-                Path | None, typer.Option("--from", help="output of designer suggest --json")
-            ] = None,  # noqa: UP007
-            candidate: Annotated[int, typer.Option(help="candidate in --from, 1 = best")] = 1,
-            name: Annotated[str, typer.Option(help="joint (model) name")] = "FlexJoint",
-            allow_extrapolation: Annotated[
-                bool, typer.Option(help="accept a design outside the ranges")
-            ] = False,
-            json_out: Annotated[bool, typer.Option("--json", help="print the result as JSON")] = False,
-            **options,
-        ) -> None:
-            joint = _joint(
-                axis,
-                k,
-                c,
-                m,
-                density,
-                length,
-                width,
-                height,
-                layer,
-                raster,
-                from_,
-                candidate,
-                name,
-                allow_extrapolation,
-            )
-            result = write(joint, output, (from_, candidate) if from_ else None, **options)
-            advice = getattr(result, "advice", {})
-            if json_out:
-                print_json(
-                    {"path": str(output), "format": fmt, "joint": joint.to_dict()}
-                    | ({"advice": {n: a.to_dict() for n, a in advice.items()}} if advice else {})
-                )
-                return
-            _print_joint(joint, title, output)
-            for n, a in advice.items():
-                console.print(f"  {n}: {a.text()}")
-
-        command.__doc__ = (
-            f"Write the joint as {title}, SI units, provenance in a comment.\n\n"
-            f"The joint comes from --k/--c [--m] ({JOINT_HELP}), the six print settings, or --from.\n\n"
-            f"Example: {example}"
-        )
-        signature = inspect.signature(command, eval_str=True)  # typer reads a __signature__ as it is
-        params = [p for p in signature.parameters.values() if p.kind is not p.VAR_KEYWORD]
-        command.__signature__ = signature.replace(parameters=[*params, *extra])
-        export_app.command(fmt)(command)
-
-    _formats(snippet)
+    _formats(_snippet)
     app.add_typer(export_app, name="export")
 
 

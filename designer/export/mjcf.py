@@ -20,15 +20,11 @@ from .stability import StepAdvice, step_advice
 FORMS = ("parallel", "series")
 
 
-def _num(v: float) -> str:
-    return repr(float(v))
-
-
 def _joint_element(name: str, a: str, k: float, c: float) -> str:
     kind = "hinge" if units.is_rotational(a) else "slide"
     return (
-        f'<joint name="{name}" type="{kind}" axis="{robot.AXIS_VECTORS[a]}" stiffness="{_num(k)}" '
-        f'damping="{_num(c)}" springref="0" ref="0" armature="0" frictionloss="0" limited="false"/>'
+        f'<joint name="{name}" type="{kind}" axis="{robot.AXIS_VECTORS[a]}" stiffness="{robot.num(k)}" '
+        f'damping="{robot.num(c)}" springref="0" ref="0" armature="0" frictionloss="0" limited="false"/>'
     )
 
 
@@ -96,7 +92,7 @@ def series_text(
         f"      {robot.xml_comment('motor output: ' + link.basis + '; its reflected inertia as armature')}",
         f"      {robot.inertial_xml(link)}",
         f'      <joint name="{n}_motor" type="{kind}" axis="{robot.AXIS_VECTORS[a]}" '
-        f'damping="{_num(servo.kv)}" armature="{_num(servo.motor_inertia)}" frictionloss="0" '
+        f'damping="{robot.num(servo.kv)}" armature="{robot.num(servo.motor_inertia)}" frictionloss="0" '
         'limited="false"/>',
         f'      <body name="{n}_{a}_link">',
         f"        {robot.xml_comment(f'{n}_{a} flexure, motor held: ' + flex.text())}",
@@ -107,7 +103,7 @@ def series_text(
         "    </body>",
     ]
     actuators = [
-        f'    <position name="{n}_motor" joint="{n}_motor" kp="{_num(servo.kp)}" ctrllimited="false"/>'
+        f'    <position name="{n}_motor" joint="{n}_motor" kp="{robot.num(servo.kp)}" ctrllimited="false"/>'
     ]
     notes = [
         "series elastic: motor -> flexure -> link; ctrl of actuator "

@@ -33,10 +33,6 @@ _EDITED = {"jnt_stiffness": "jnt", "dof_damping": "dof", "dof_armature": "dof", 
 _FRAME = ("pos", "quat", "euler", "axisangle", "xyaxes", "zaxis")
 
 
-def _num(v: float) -> str:
-    return repr(float(v))
-
-
 @dataclass
 class _Host:
     """The robot as loaded: its file, compiled model, spec, lxml tree and the joint's element."""
@@ -162,7 +158,7 @@ def _flexure(host: _Host, joint: Joint, a: str, rest: float) -> None:
     if si["m"] is not None:
         values["armature"] = si["m"]
     for attr, v in values.items():
-        host.element.set(attr, _num(v))
+        host.element.set(attr, robot.num(v))
 
 
 def into_parallel(
@@ -207,7 +203,7 @@ def _insert_motor(host: _Host, joint_name: str, motor: robot.Sphere, servo: robo
     parent.insert(parent.index(link), body)
     motor_joint = copy.deepcopy(host.element)
     motor_joint.set("name", f"{joint_name}_motor")
-    motor_joint.set("armature", _num(servo.motor_inertia))
+    motor_joint.set("armature", robot.num(servo.motor_inertia))
     comment = etree.Comment(f" flexjoint designer: the motor of series-elastic joint {joint_name} ")
     for child in (comment, etree.fromstring(robot.inertial_xml(motor)), motor_joint, link):
         body.append(child)
@@ -218,11 +214,13 @@ def _insert_motor(host: _Host, joint_name: str, motor: robot.Sphere, servo: robo
     for act in moved:
         act.set("joint", f"{joint_name}_motor")
     if not moved:
-        motor_joint.set("damping", _num(servo.kv))
+        motor_joint.set("damping", robot.num(servo.kv))
         section = root.find("actuator")
         if section is None:
             section = etree.SubElement(root, "actuator")
-        servo_xml = f'<position name="{joint_name}_motor" joint="{joint_name}_motor" kp="{_num(servo.kp)}"/>'
+        servo_xml = (
+            f'<position name="{joint_name}_motor" joint="{joint_name}_motor" kp="{robot.num(servo.kp)}"/>'
+        )
         section.append(etree.fromstring(servo_xml))
     return len(moved)
 

@@ -118,10 +118,15 @@ class Servo:
         return cls(motor_inertia, bandwidth, kp, 2 * math.sqrt(kp * total))
 
 
+def num(v: float) -> str:
+    """A number for XML: the shortest text that reads back as the same float."""
+    return repr(float(v))
+
+
 def inertial_xml(s: Sphere) -> str:
     """The MJCF `<inertial>` of a sphere on the body's origin."""
-    i = repr(float(s.inertia))
-    return f'<inertial pos="0 0 0" mass="{float(s.mass)!r}" diaginertia="{i} {i} {i}"/>'
+    i = num(s.inertia)
+    return f'<inertial pos="0 0 0" mass="{num(s.mass)}" diaginertia="{i} {i} {i}"/>'
 
 
 def check_suffix(path: str | Path, suffixes: tuple[str, ...], what: str) -> Path:

@@ -22,15 +22,11 @@ from . import robot
 PRISMATIC_LIMIT = 1.0
 
 
-def _num(v: float) -> str:
-    return repr(float(v))
-
-
 def _gazebo(name: str, k: float, rest: float) -> list[str]:
     return [
         f'  <gazebo reference="{name}">',
-        f"    <springStiffness>{_num(k)}</springStiffness>",
-        f"    <springReference>{_num(rest)}</springReference>",
+        f"    <springStiffness>{robot.num(k)}</springStiffness>",
+        f"    <springReference>{robot.num(rest)}</springReference>",
         "  </gazebo>",
     ]
 
@@ -57,24 +53,24 @@ def urdf_text(joint: Joint) -> tuple[str, dict[str, robot.StepAdvice]]:
             else f'\n    <limit lower="{-PRISMATIC_LIMIT}" upper="{PRISMATIC_LIMIT}" effort="1e9" '
             'velocity="1e9"/>'
         )
-        i = _num(s.inertia)
+        i = robot.num(s.inertia)
         lines += [
             "  " + robot.xml_comment(f"{name}: {advice[name].text()}"),
             f'  <joint name="{name}" type="{"continuous" if rot else "prismatic"}">',
             f'    <parent link="{parent}"/>',
             f'    <child link="{name}_link"/>',
             f'    <axis xyz="{robot.AXIS_VECTORS[a]}"/>{limit}',
-            f'    <dynamics damping="{_num(si["c"])}" friction="0"/>',
+            f'    <dynamics damping="{robot.num(si["c"])}" friction="0"/>',
             "  </joint>",
             *_gazebo(name, si["k"], 0.0),
             f'  <link name="{name}_link">',
             "    " + robot.xml_comment(s.basis + "; the collision sphere has the same inertia"),
             "    <inertial>",
             '      <origin xyz="0 0 0" rpy="0 0 0"/>',
-            f'      <mass value="{_num(s.mass)}"/>',
+            f'      <mass value="{robot.num(s.mass)}"/>',
             f'      <inertia ixx="{i}" ixy="0" ixz="0" iyy="{i}" iyz="0" izz="{i}"/>',
             "    </inertial>",
-            f'    <collision><geometry><sphere radius="{_num(s.radius)}"/></geometry></collision>',
+            f'    <collision><geometry><sphere radius="{robot.num(s.radius)}"/></geometry></collision>',
             "  </link>",
         ]
         parent = f"{name}_link"
@@ -95,24 +91,24 @@ def sdf_text(joint: Joint) -> tuple[str, dict[str, robot.StepAdvice]]:
     parent = f"{joint.name}_base"
     for a, ac in joint.axes.items():
         si, name, s = ac.si(), f"{joint.name}_{a}", bodies[a]
-        i = _num(s.inertia)
+        i = robot.num(s.inertia)
         lines += [
             "    " + robot.xml_comment(f"{name}: {advice[name].text()}"),
             f'    <joint name="{name}" type="{"revolute" if units.is_rotational(a) else "prismatic"}">',
             f"      <parent>{parent}</parent><child>{name}_link</child>",
             f"      <axis><xyz>{robot.AXIS_VECTORS[a]}</xyz>",
-            f"        <dynamics><damping>{_num(si['c'])}</damping><friction>0</friction>"
-            f"<spring_reference>0</spring_reference><spring_stiffness>{_num(si['k'])}</spring_stiffness>"
+            f"        <dynamics><damping>{robot.num(si['c'])}</damping><friction>0</friction>"
+            f"<spring_reference>0</spring_reference><spring_stiffness>{robot.num(si['k'])}</spring_stiffness>"
             "</dynamics>",
             "      </axis>",
             "    </joint>",
             f'    <link name="{name}_link">',
             "      " + robot.xml_comment(s.basis + "; the collision sphere has the same inertia"),
-            f"      <inertial><mass>{_num(s.mass)}</mass>",
+            f"      <inertial><mass>{robot.num(s.mass)}</mass>",
             f"        <inertia><ixx>{i}</ixx><ixy>0</ixy><ixz>0</ixz><iyy>{i}</iyy><iyz>0</iyz><izz>{i}</izz>"
             "</inertia>",
             "      </inertial>",
-            f'      <collision name="{name}_sphere"><geometry><sphere><radius>{_num(s.radius)}</radius>'
+            f'      <collision name="{name}_sphere"><geometry><sphere><radius>{robot.num(s.radius)}</radius>'
             "</sphere></geometry></collision>",
             "    </link>",
         ]
@@ -150,7 +146,7 @@ def _into_urdf(joint: Joint, host: Path, *, joint_name: str, axis: str | None, r
     dynamics = found[0].find("dynamics")
     if dynamics is None:
         dynamics = etree.SubElement(found[0], "dynamics")
-    dynamics.set("damping", _num(si["c"]))
+    dynamics.set("damping", robot.num(si["c"]))
     for old in root.xpath("/robot/gazebo[@reference=$n]", n=joint_name):
         for tag in ("springStiffness", "springReference"):
             for e in old.findall(tag):
