@@ -11,7 +11,7 @@ from pathlib import Path
 
 from .. import units
 from ..errors import DesignerError
-from ..files import atomic_write
+from ..files import atomic_write, check_suffix
 from ..joint import Joint
 from . import robot
 from .mjcf_into import into_parallel, into_series
@@ -137,7 +137,7 @@ def export_mjcf(
     Raises:
         DesignerError: a wrong suffix, unknown form, missing mass, or an `into` problem.
     """
-    path = robot.check_suffix(path, (".xml", ".mjcf"), "an MJCF model")
+    path = check_suffix(path, (".xml", ".mjcf"), what="an MJCF")
     if form not in FORMS:
         raise DesignerError(f"form={form!r} is not a form", f"use one of: {', '.join(FORMS)}")
     if into is not None:

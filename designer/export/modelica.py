@@ -12,9 +12,8 @@ from pathlib import Path
 
 from .. import units
 from ..errors import DesignerError
-from ..files import atomic_write
+from ..files import atomic_write, check_suffix
 from ..joint import Joint
-from .robot import check_suffix
 
 #: supported MSL versions and the package holding their SI types
 MSL_UNITS = {"4.0.0": "Modelica.Units.SI", "3.2.3": "Modelica.SIunits"}
@@ -93,7 +92,7 @@ def export_modelica(joint: Joint, path: str | Path, *, msl: str = "4.0.0") -> Pa
     Raises:
         DesignerError: a path not ending in .mo, or an unsupported `msl`.
     """
-    path = check_suffix(path, (".mo",), "a Modelica file")
+    path = check_suffix(path, (".mo",), what="a Modelica")
     text = modelica_text(joint, msl=msl)
     with atomic_write(path) as fh:
         fh.write(text)

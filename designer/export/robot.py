@@ -129,17 +129,6 @@ def inertial_xml(s: Sphere) -> str:
     return f'<inertial pos="0 0 0" mass="{num(s.mass)}" diaginertia="{i} {i} {i}"/>'
 
 
-def check_suffix(path: str | Path, suffixes: tuple[str, ...], what: str) -> Path:
-    """`path` as a Path if its suffix is one of `suffixes`, else a DesignerError naming `path`."""
-    path = Path(path)
-    if path.suffix.lower() not in suffixes:
-        raise DesignerError(
-            f"path={str(path)!r} does not end in {' or '.join(suffixes)}, the suffix of {what}",
-            f"give path a {suffixes[0]} name",
-        )
-    return path
-
-
 def with_masses(joint: Joint, why: str = "a robot link needs a real mass") -> Joint:
     """The joint with every axis' moving mass: given, or from the design's geometry.
 

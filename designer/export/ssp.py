@@ -20,10 +20,10 @@ from xml.sax.saxutils import quoteattr
 
 from .. import units
 from ..errors import DesignerError
-from ..files import atomic_path
+from ..files import atomic_path, check_suffix
 from ..joint import Joint
 from . import fmu
-from .robot import check_suffix, with_masses
+from .robot import with_masses
 
 NS = {
     "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
@@ -164,7 +164,7 @@ def export_ssp(
     Raises:
         DesignerError: a wrong suffix, a set whose axes differ from the joint's, or a missing mass.
     """
-    path = check_suffix(path, (".ssp",), "an SSP archive")
+    path = check_suffix(path, (".ssp",), what="an SSP")
     why = "the body interface needs a mass (or use interface='force')"
     if interface == "body":
         joint = with_masses(joint, why)

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from .. import units
 from ..errors import DesignerError
-from ..files import atomic_path, atomic_write
+from ..files import atomic_path, atomic_write, check_suffix
 from ..joint import Joint
 from . import robot
 
@@ -176,7 +176,7 @@ def export_urdf(
     Raises:
         DesignerError: a wrong suffix, a missing mass, or an `into` problem.
     """
-    path = robot.check_suffix(path, (".urdf",), "a URDF file")
+    path = check_suffix(path, (".urdf",), what="a URDF")
     if into is not None:
         if joint_name is None:
             raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
@@ -196,7 +196,7 @@ def export_sdf(joint: Joint, path: str | Path) -> robot.RobotExport:
     Raises:
         DesignerError: a wrong suffix or a missing mass.
     """
-    path = robot.check_suffix(path, (".sdf",), "an SDFormat file")
+    path = check_suffix(path, (".sdf",), what="an SDFormat")
     text, advice = sdf_text(robot.with_masses(joint))
     with atomic_write(path) as fh:
         fh.write(text)
