@@ -64,6 +64,14 @@ FLAGS: tuple[tuple[str, str], ...] = (
     (r"\ballow_extrapolation=True\b", "--allow-extrapolation"),
     (r"\btop=", "--top "),
     (r"\bk= and/or c=", "--k and/or --c"),
+    # export mjcf/urdf/sdf/modelica/ssp
+    (r"\binto=", "--into "),
+    (r"\bjoint_name=", "--joint "),
+    (r"\baxis=", "--use-axis "),
+    (r"\bform=", "--form "),
+    (r"\bmsl=", "--msl "),
+    (r"\bmotor_inertia=", "--motor-inertia "),
+    (r"\bmotor_bandwidth=", "--motor-bandwidth "),
 )
 
 

@@ -110,7 +110,7 @@ class Servo:
         bandwidth = 10 * flex.natural_frequency if bandwidth is None else bandwidth
         if not (motor_inertia > 0 and bandwidth > 0):
             raise DesignerError(
-                f"motor_inertia = {motor_inertia:g} and motor_bandwidth = {bandwidth:g} must be positive",
+                f"motor_inertia={motor_inertia:g} and motor_bandwidth={bandwidth:g} must be positive",
                 "give positive numbers (SI inertia or mass, Hz)",
             )
         total = motor_inertia + carried
