@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -74,17 +75,26 @@ def test_ssp_refuses_wrong_suffix_and_mismatched_sets(tmp_path):
         export_ssp(JOINT, tmp_path / "j.ssp", parameter_sets={"a": theta})
 
 
-def test_read_ssv_refuses_a_non_si_unit(tmp_path):
-    p = tmp_path / "mm.ssv"
-    p.write_text(
-        '<ssv:ParameterSet xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues" '
-        'xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" version="1.0" name="p">'
-        '<ssv:Parameters><ssv:Parameter name="x.k"><ssv:Real value="0.8" unit="N/mm"/></ssv:Parameter>'
-        '</ssv:Parameters><ssv:Units><ssc:Unit name="N/mm"><ssc:BaseUnit kg="1" s="-2" factor="1000"/>'
-        "</ssc:Unit></ssv:Units></ssv:ParameterSet>"
-    )
-    with pytest.raises(DesignerError, match="not the SI unit N/m"):
-        read_ssv(p)
+def test_read_ssv_converts_declared_units_and_refuses_wrong_ones(tmp_path):
+    n_per_mm = '<ssc:Unit name="N/mm"><ssc:BaseUnit kg="1" s="-2" factor="1000"/></ssc:Unit>'
+
+    def ssv(name: str, unit: str) -> Path:
+        p = tmp_path / "p.ssv"
+        p.write_text(
+            '<ssv:ParameterSet xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues" '
+            'xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" version="1.0" name="p">'
+            f'<ssv:Parameters><ssv:Parameter name="{name}"><ssv:Real value="0.8" unit="{unit}"/>'
+            f"</ssv:Parameter></ssv:Parameters><ssv:Units>{n_per_mm}</ssv:Units></ssv:ParameterSet>"
+        )
+        return p
+
+    # N/mm as the file declares it: kg s-2 with factor 1000 (SSP: SI = factor * value + offset)
+    assert read_ssv(ssv("x.k", "N/mm"))["x.k"] == pytest.approx(800.0)
+    assert read_ssv(ssv("x.k", "N/m"))["x.k"] == 0.8
+    with pytest.raises(DesignerError, match="parameter x.c .* not a unit of N.s/m"):
+        read_ssv(ssv("x.c", "N/mm"))
+    with pytest.raises(DesignerError, match="not a unit of N/m"):
+        read_ssv(ssv("x.k", "lbf/in"))  # neither declared nor SI
 
 
 def test_cli_exports_every_candidate_as_a_parameter_set(tmp_path):

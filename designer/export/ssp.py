@@ -33,6 +33,8 @@ NS = {
 _XMLNS = " ".join(f'xmlns:{p}="{u}"' for p, u in NS.items())
 #: the joint coefficients an SSV carries, per axis
 SSV_QUANTITIES = ("m", "c", "k")
+#: the FMU parameters whose units read_ssv checks, and the quantity each is
+_CHECKED = {"m": "m", "c": "c", "k": "k", "offset": "r"}
 
 
 def _units(names: set[str]) -> list[str]:
@@ -221,9 +223,10 @@ def _fmu_bytes(joint: Joint, interface: str) -> bytes:
 def read_ssv(path: str | Path) -> dict[str, float]:
     """The Real parameters of an SSV file, converted to SI: {"theta.k": 0.05, ...}.
 
-    Units are read from each parameter's `unit` and the file's unit definitions; a unit whose
-    base-unit exponents differ from the SI unit of that quantity, or a factor/offset other than 1/0,
-    is refused rather than guessed.
+    Units are read from each parameter's `unit` and the file's unit definitions; a joint's m, c, k and
+    offset are converted to SI by their unit's factor and offset, and a unit whose base-unit exponents
+    are not the quantity's is refused rather than guessed. The keys match the FMU's parameter
+    names, so the result can serve as a co-simulation scenario's `parameters` overrides.
 
     Raises:
         DesignerError: the file is missing or not an SSV, or a unit is not the quantity's SI unit.
@@ -252,20 +255,21 @@ def read_ssv(path: str | Path) -> dict[str, float]:
 
 
 def _si_value(name: str, value: float, unit: str | None, base: dict | None, path: Path) -> float:
-    """`value` checked to be in the SI unit of the joint quantity `name` (axis.quantity) when known."""
-    axis, _, quantity = name.rpartition(".")
-    if axis not in units.AXES or quantity not in SSV_QUANTITIES or unit is None:
+    """`value` of joint parameter `name` ("axis.field") in SI, converted by its unit's factor and offset.
+
+    SSP units are SI base-unit exponents with SI = factor * value + offset. A unit that is not
+    declared must be the SI unit itself; one whose exponents are not the quantity's is refused.
+    """
+    axis, _, field = name.rpartition(".")
+    if axis not in units.AXES or field not in _CHECKED or unit is None:
         return value
-    si = units.si_unit(quantity, axis)
+    si = units.si_unit(_CHECKED[field], axis)
     want = {k: float(v) for k, v in fmu._BASE_UNITS[si].items()}
-    if base is not None:
-        factor, offset = base.pop("factor", 1.0), base.pop("offset", 0.0)
-        ok = base == want and factor == 1.0 and offset == 0.0
-    else:
-        ok = unit == si
-    if not ok:
+    exps = dict(base) if base is not None else (want if unit == si else None)
+    factor, offset = (exps.pop("factor", 1.0), exps.pop("offset", 0.0)) if exps is not None else (1.0, 0.0)
+    if exps != want:
         raise DesignerError(
-            f"parameter {name} in {path} has unit {unit!r}, not the SI unit {si}",
-            f"give {name} in {si}",
+            f"parameter {name} in {path} has unit {unit!r}, not a unit of {si}",
+            f"give {name} in {si}, or declare {unit!r} with the base units of {si} in the file",
         )
-    return value
+    return factor * value + offset
