@@ -282,9 +282,8 @@ def _ssp(joint, output, suggestion, *, interface):
 
     sets = None
     if suggestion is not None:
-        path, first = suggestion
-        sets = candidate_sets(path, first=first, axes=list(joint.axes), name=joint.name)
-    return export_ssp(joint, output, parameter_sets=sets, interface=interface)
+        sets = {joint.name: candidate_sets(suggestion[0], axes=list(joint.axes), name=joint.name)}
+    return export_ssp(joint, output, alternatives=sets, interface=interface)
 
 
 def _formats(snippet) -> None:

@@ -17,62 +17,81 @@ JOINT = Joint.from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}})
 STIFFER = Joint.from_coefficients({"x": {"k": 1.6, "c": 4e-3, "m": 0.01}})
 
 
+def constant(value: float):
+    """A load held at `value` from t = 0."""
+    return lambda t: value
+
+
 def analytic(t, k, c, m, load):
     w, z = math.sqrt(k / m), c / (2 * math.sqrt(k * m))
     wd = w * math.sqrt(1 - z * z)
     return load / k * (1 - np.exp(-z * w * t) * (np.cos(wd * t) + z / math.sqrt(1 - z * z) * np.sin(wd * t)))
 
 
-def test_ssd_runs_in_fmpy_like_the_fmu_and_candidates_are_parameter_sets(tmp_path):
+def test_ssd_runs_in_fmpy_like_the_fmus_and_alternatives_are_parameter_sets(tmp_path):
     from fmpy import simulate_fmu
     from fmpy.ssp.simulation import simulate_ssp
     from fmpy.ssp.ssd import ParameterSet, read_ssd
     from fmpy.ssp.ssd import read_ssv as fmpy_read_ssv
 
+    wrist = Joint.from_coefficients({"theta": {"k": 50.0, "c": 0.5, "m": 1e-5}}, name="Wrist")
     path = export_ssp(
-        JOINT, tmp_path / "joint.ssp", parameter_sets={"candidate_1": JOINT, "candidate_2": STIFFER}
+        [JOINT, wrist], tmp_path / "joints.ssp", alternatives={"FlexJoint": {"stiffer": STIFFER}}
     )
-    ssd = read_ssd(str(path))  # validates against the SSP 1.0 schemas FMPy ships
-    binding = ssd.system.elements[0].parameterBindings[0]
-    assert binding.source == "resources/candidate_1.ssv"
+    ssd = read_ssd(str(path))  # validates against the normative SSP 1.0 schemas FMPy ships
+    bound = {c.name: c.parameterBindings[0].source for c in ssd.system.elements}
+    assert bound == {"FlexJoint": "resources/FlexJoint.ssv", "Wrist": "resources/Wrist.ssv"}
     with zipfile.ZipFile(path) as z:
-        z.extract("resources/candidate_2.ssv", tmp_path)
-        z.extract("resources/FlexJoint.fmu", tmp_path)
-    assert read_ssv(tmp_path / "resources/candidate_2.ssv") == {"x.m": 0.01, "x.c": 4.0, "x.k": 1600.0}
-    load, h, stop = 2.0, 1e-4, 0.05
-    results = {}
-    for name, source in (("bound", binding.source), ("candidate_2", "resources/candidate_2.ssv")):
-        ps = ParameterSet(name=name)
-        ps.parameters = fmpy_read_ssv(str(path), resource=source).parameters
-        for p in ps.parameters:  # fmpy.ssp applies a set by component-prefixed names
-            p.name = "FlexJoint." + p.name
-        out = simulate_ssp(
-            str(path), stop_time=stop, step_size=h, parameter_set=ps, input={"FlexJoint_x.f": lambda t: load}
-        )
-        # fmpy.ssp passes connections after each step, so the load reaches the FMU one step late and
-        # the output recorded at t after stepping to t + h is the undelayed response at t
-        results[name] = (out["time"], out["FlexJoint_x.s"])
+        z.extractall(tmp_path / "ssp")
+    assert read_ssv(tmp_path / "ssp/resources/FlexJoint.stiffer.ssv") == {
+        "x.m": 0.01,
+        "x.c": 4.0,
+        "x.k": 1600.0,
+    }
+    assert read_ssv(tmp_path / "ssp/resources/Wrist.ssv") == {
+        "theta.m": 1e-5,
+        "theta.c": 5e-4,
+        "theta.k": 0.05,
+    }
+    h, stop, loads = 1e-4, 0.05, {"FlexJoint_x.f": 2.0, "Wrist_theta.f": 0.01}
+    runs = {}
+    for name, sources in (
+        ("bound", {"FlexJoint": "resources/FlexJoint.ssv", "Wrist": "resources/Wrist.ssv"}),
+        ("stiffer", {"FlexJoint": "resources/FlexJoint.stiffer.ssv", "Wrist": "resources/Wrist.ssv"}),
+    ):
+        ps = ParameterSet(name=name)  # fmpy.ssp applies one set, by component-prefixed names
+        for component, source in sources.items():
+            for p in fmpy_read_ssv(str(path), resource=source).parameters:
+                p.name = f"{component}.{p.name}"
+                ps.parameters.append(p)
+        inputs = {n: constant(v) for n, v in loads.items()}
+        runs[name] = simulate_ssp(str(path), stop_time=stop, step_size=h, parameter_set=ps, input=inputs)
+    # fmpy.ssp passes connections after each step, so a load reaches the FMU one step late and the
+    # output recorded at t after stepping to t + h is the undelayed response at t
+    t = runs["bound"]["time"]
     alone = simulate_fmu(
-        str(tmp_path / "resources/FlexJoint.fmu"),
+        str(tmp_path / "ssp/resources/FlexJoint.fmu"),
         stop_time=stop,
         step_size=h,
         output_interval=h,
-        input=np.array([(0.0, load), (stop, load)], dtype=[("time", float), ("x.f", float)]),
+        input=np.array([(0.0, 2.0), (stop, 2.0)], dtype=[("time", float), ("x.f", float)]),
         output=["x.s"],
     )
-    t, s = results["bound"]
-    assert np.allclose(s, np.interp(t, alone["time"], alone["x.s"]), rtol=0, atol=1e-9 * load / 800)
-    assert np.max(np.abs(s - analytic(t, 800.0, 2.0, 0.01, load))) < 1e-9
-    t2, s2 = results["candidate_2"]
-    assert np.max(np.abs(s2 - analytic(t2, 1600.0, 4.0, 0.01, load))) < 1e-9
+    x = runs["bound"]["FlexJoint_x.s"]
+    assert np.allclose(x, np.interp(t, alone["time"], alone["x.s"]), rtol=0, atol=1e-12)
+    assert np.max(np.abs(x - analytic(t, 800.0, 2.0, 0.01, 2.0))) < 1e-9
+    assert np.max(np.abs(runs["bound"]["Wrist_theta.s"] - analytic(t, 0.05, 5e-4, 1e-5, 0.01))) < 1e-9
+    assert np.max(np.abs(runs["stiffer"]["FlexJoint_x.s"] - analytic(t, 1600.0, 4.0, 0.01, 2.0))) < 1e-9
 
 
-def test_ssp_refuses_wrong_suffix_and_mismatched_sets(tmp_path):
+def test_ssp_refuses_wrong_suffix_and_foreign_alternatives(tmp_path):
     with pytest.raises(DesignerError, match="path="):
         export_ssp(JOINT, tmp_path / "j.zip")
     theta = Joint.from_coefficients({"theta": {"k": 50.0, "c": 0.5, "m": 1e-5}})
-    with pytest.raises(DesignerError, match="parameter_sets"):
-        export_ssp(JOINT, tmp_path / "j.ssp", parameter_sets={"a": theta})
+    with pytest.raises(DesignerError, match="alternatives"):
+        export_ssp(JOINT, tmp_path / "j.ssp", alternatives={"FlexJoint": {"a": theta}})
+    with pytest.raises(DesignerError, match="same name"):
+        export_ssp([JOINT, STIFFER], tmp_path / "j.ssp")
 
 
 def test_read_ssv_converts_declared_units_and_refuses_wrong_ones(tmp_path):
@@ -111,8 +130,8 @@ def test_cli_exports_every_candidate_as_a_parameter_set(tmp_path):
     with zipfile.ZipFile(out) as z:
         names = z.namelist()
         ssd = z.read("SystemStructure.ssd").decode()
-    assert {"resources/candidate_1.ssv", "resources/candidate_2.ssv"} <= set(names)
-    assert 'source="resources/candidate_2.ssv"' in ssd
+    assert {"resources/FlexJoint.candidate_1.ssv", "resources/FlexJoint.candidate_2.ssv"} <= set(names)
+    assert 'source="resources/FlexJoint.ssv"' in ssd
     r = subprocess.run(
         [sys.executable, "-I", "-c", cmd, "export", "ssp", "--k", "0.8", "--c", "2e-3", "-o", str(out)],
         capture_output=True,

@@ -2,11 +2,11 @@
 
 The archive holds `SystemStructure.ssd`: one FMI 2 co-simulation FMU component per joint (body
 interface by default: input load, outputs deflection, velocity, acceleration), its connectors exposed
-on the system as `<joint>_<variable>` and wired to them; `resources/<joint>.fmu`; and per parameter
-set an SSV file (`resources/<set>.ssv`) with the joints' m, c, k in SI units, declared with their
-base units. The SSD binds the first set to each component; the others (for example a suggestion's
-other candidates) sit beside it for a tool to bind instead. Element names and namespaces follow the
-SSP 1.0 standard and its XML schemas (as shipped with FMPy, which validates them when it reads the archive).
+on the system as `<joint>_<variable>` and wired to them; per joint `resources/<joint>.fmu` and the SSV
+`resources/<joint>.ssv` the SSD binds, with the joint's m, c, k in SI units declared with their base
+units; and alternative parameter sets (for example a suggestion's candidates) as
+`resources/<joint>.<set>.ssv` for a tool to bind instead. Element names and namespaces follow the SSP
+1.0 standard and its normative XML schemas (as shipped with FMPy, which validates them on reading).
 
 Parameter names inside an SSV are the FMU's own (`theta.k`), relative to the component it is bound to.
 """
@@ -14,7 +14,7 @@ Parameter names inside an SSV are the FMU's own (`theta.k`), relative to the com
 from __future__ import annotations
 
 import zipfile
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -94,7 +94,7 @@ def _connectors(joint: Joint, interface: str, pad: str) -> tuple[list[str], list
     return lines, wired, used
 
 
-def ssd_text(joints: list[Joint], parameter_set: str, interface: str) -> str:
+def ssd_text(joints: list[Joint], interface: str) -> str:
     """The SSD: one component per joint, its inputs and outputs exposed as `<joint>_<variable>`.
 
     (Not `<joint>.<variable>`: fmpy.ssp names results by dotted path, where that would clash with the
@@ -120,7 +120,7 @@ def ssd_text(joints: list[Joint], parameter_set: str, interface: str) -> str:
             "        </ssd:Connectors>",
             "        <ssd:ParameterBindings>",
             f'          <ssd:ParameterBinding type="application/x-ssp-parameter-set" '
-            f'source="resources/{parameter_set}.ssv"/>',
+            f'source="resources/{j.name}.ssv"/>',
             "        </ssd:ParameterBindings>",
             "      </ssd:Component>",
         ]
@@ -149,54 +149,63 @@ def ssd_text(joints: list[Joint], parameter_set: str, interface: str) -> str:
 
 
 def export_ssp(
-    joint: Joint,
+    joints: Joint | Sequence[Joint],
     path: str | Path,
     *,
-    parameter_sets: Mapping[str, Joint] | None = None,
+    alternatives: Mapping[str, Mapping[str, Joint]] | None = None,
     interface: str = "body",
 ) -> Path:
-    """Write an SSP archive at `path` (.ssp) with `joint`'s FMI 2 FMU, the SSD and SSV parameter sets.
+    """Write an SSP archive at `path` (.ssp): the SSD, per joint an FMI 2 FMU and an SSV, alternatives.
 
     Args:
-        joint: the joint; its numbers are the FMU's start values and the first parameter set.
-        parameter_sets: named alternatives (e.g. a suggestion's candidates) with the same axes, one SSV
-            each; None gives one set named after the joint. The SSD binds the first.
+        joints: one joint or several (distinct names); each is a component `<name>` whose FMU
+            (`resources/<name>.fmu`) carries its numbers as start values and whose SSV
+            (`resources/<name>.ssv`) the SSD binds.
+        alternatives: per joint name, named alternative parameter sets (e.g. a suggestion's candidates,
+            `{"FlexJoint": {"candidate_1": joint1, ...}}`) with that joint's axes, written as
+            `resources/<name>.<set>.ssv` for a tool to bind instead.
         interface: "body" (load in, motion out; needs masses, from geometry when a design) or "force".
 
     Raises:
-        DesignerError: a wrong suffix, a set whose axes differ from the joint's, or a missing mass.
+        DesignerError: a wrong suffix, repeated joint names, an alternative for no joint or with other
+            axes, or a missing mass.
     """
     path = check_suffix(path, (".ssp",), what="an SSP")
     why = "the body interface needs a mass (or use interface='force')"
+    joints = [joints] if isinstance(joints, Joint) else list(joints)
     if interface == "body":
-        joint = with_masses(joint, why)
-    sets = dict(parameter_sets) if parameter_sets else {joint.name: joint}
-    for set_name, other in sets.items():
-        if not set_name.isidentifier() or list(other.axes) != list(joint.axes):
-            raise DesignerError(
-                f"parameter_sets[{set_name!r}] is not a set for joint '{joint.name}'",
-                f"give identifier names and joints with the axes {', '.join(joint.axes)}",
-            )
-        if interface == "body":
-            sets[set_name] = with_masses(other, why)
-    entries = {f"resources/{n}.ssv": ssv_text(j, n).encode() for n, j in sets.items()}
-    entries["SystemStructure.ssd"] = ssd_text([joint], next(iter(sets)), interface).encode()
-    entries[f"resources/{joint.name}.fmu"] = _fmu_bytes(joint, interface)
+        joints = [with_masses(j, why) for j in joints]
+    by_name = {j.name: j for j in joints}
+    if len(by_name) != len(joints):
+        raise DesignerError("joints= has two joints of the same name", "give each joint its own name")
+    entries = {f"resources/{j.name}.ssv": ssv_text(j, j.name).encode() for j in joints}
+    for name, sets in (alternatives or {}).items():
+        for set_name, other in sets.items():
+            if (
+                name not in by_name
+                or not set_name.isidentifier()
+                or list(other.axes) != list(by_name[name].axes)
+            ):
+                raise DesignerError(
+                    f"alternatives[{name!r}][{set_name!r}] is not a parameter set of a joint given",
+                    "key it by one of the joints' names, name it as an identifier, keep the joint's axes",
+                )
+            other = with_masses(other, why) if interface == "body" else other
+            entries[f"resources/{name}.{set_name}.ssv"] = ssv_text(other, set_name).encode()
+    entries["SystemStructure.ssd"] = ssd_text(joints, interface).encode()
+    for j in joints:
+        entries[f"resources/{j.name}.fmu"] = _fmu_bytes(j, interface)
     with atomic_path(path) as tmp, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
         for name in sorted(entries):  # fixed dates: the same joints give the same bytes
             z.writestr(zipfile.ZipInfo(name, date_time=fmu._ZIP_DATE), entries[name], zipfile.ZIP_DEFLATED)
     return path
 
 
-def candidate_sets(
-    suggestion, *, first: int = 1, axes: list[str] | None = None, name: str = "FlexJoint"
-) -> dict[str, Joint]:
+def candidate_sets(suggestion, *, axes: list[str] | None = None, name: str = "FlexJoint") -> dict[str, Joint]:
     """Every candidate of a suggestion (object or saved JSON) as a parameter set `candidate_<i>`.
 
-    Candidate `first` comes first (export_ssp binds the first set); the others follow in rank order.
-
     Raises:
-        DesignerError: the suggestion cannot be read, has no candidates, or no candidate `first`.
+        DesignerError: the suggestion cannot be read or has no candidates.
     """
     from ..suggest import Suggestion
 
@@ -204,9 +213,9 @@ def candidate_sets(
         suggestion = Suggestion.load(suggestion)
     if not suggestion.candidates:
         raise DesignerError("the suggestion has no candidates", "run suggest with reachable targets")
-    order = [first] + [i for i in range(1, len(suggestion.candidates) + 1) if i != first]
     return {
-        f"candidate_{i}": Joint.from_suggestion(suggestion, candidate=i, axes=axes, name=name) for i in order
+        f"candidate_{i}": Joint.from_suggestion(suggestion, candidate=i, axes=axes, name=name)
+        for i in range(1, len(suggestion.candidates) + 1)
     }
 
 
