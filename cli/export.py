@@ -1,10 +1,14 @@
-"""`designer export fmu|modelica|mjcf|urdf`: a joint for simulators from numbers, a design or a suggestion."""
+"""`designer export fmu|modelica|mjcf|urdf|sdf|ssp`: a joint for simulators.
+
+The joint comes from numbers, a design or a suggestion.
+"""
 
 from __future__ import annotations
 
 import inspect
+from collections.abc import Callable
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
@@ -13,7 +17,7 @@ from designer.errors import DesignerError
 from .common import console, print_json, progress
 
 export_app = typer.Typer(
-    help="Export a joint: FMU (FMI 2/3), Modelica package, MJCF or URDF snippet.", no_args_is_help=True
+    help="Export a joint: FMU (FMI 2/3), Modelica, MJCF, URDF, SDF or SSP.", no_args_is_help=True
 )
 
 Floats = Annotated[list[float] | None, typer.Option(show_default=False)]  # noqa: UP007 (typer needs Optional)
@@ -80,7 +84,9 @@ def _print_joint(joint, what: str, path: Path) -> None:
 JOINT_HELP = "rig units: --k N/mm (N.mm/rad), --c N.s/mm (N.mm.s/rad), --m kg (kg.m^2)"
 
 
-def _snippet(fmt: str, suffix: str, title: str, write, example: str, extra: tuple = ()) -> None:
+def _snippet(
+    fmt: str, suffix: str, title: str, write: Callable[..., object], example: str, extra: tuple = ()
+) -> None:
     """Add `export FMT`: the joint options, `extra` options (inspect.Parameters) passed to `write`.
 
     `write(joint, output, (suggestion path, candidate) or None, **extra)` writes and returns the
@@ -232,7 +238,15 @@ def register(app: typer.Typer) -> None:
     app.add_typer(export_app, name="export")
 
 
-def _option(name: str, annotation, default) -> inspect.Parameter:
+#: where the joint came from when it is a suggestion's candidate: (suggestion file, candidate), else None
+Source = tuple[Path, int] | None  # noqa: UP007
+
+if TYPE_CHECKING:
+    from designer.joint import Joint
+
+
+def _option(name: str, annotation: object, default: object) -> inspect.Parameter:
+    """A keyword-only typer option for `_snippet`'s `extra`."""
     return inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=annotation)
 
 
@@ -248,7 +262,19 @@ AXIS_PICK = _option(
 )
 
 
-def _mjcf(joint, output, _from, *, into, joint_name, rest, axis_pick, form, motor_inertia, motor_bandwidth):
+def _mjcf(
+    joint: Joint,
+    output: Path,
+    _from: Source,
+    *,
+    into: Path | None,
+    joint_name: str | None,
+    rest: float,
+    axis_pick: str | None,
+    form: str,
+    motor_inertia: float | None,
+    motor_bandwidth: float | None,
+):
     from designer.export.mjcf import export_mjcf
 
     return export_mjcf(
@@ -264,19 +290,28 @@ def _mjcf(joint, output, _from, *, into, joint_name, rest, axis_pick, form, moto
     )
 
 
-def _urdf(joint, output, _from, *, into, joint_name, rest, axis_pick):
+def _urdf(
+    joint: Joint,
+    output: Path,
+    _from: Source,
+    *,
+    into: Path | None,
+    joint_name: str | None,
+    rest: float,
+    axis_pick: str | None,
+):
     from designer.export.urdf import export_urdf
 
     return export_urdf(joint, output, into=into, joint_name=joint_name, axis=axis_pick, rest=rest)
 
 
-def _sdf(joint, output, _from):
+def _sdf(joint: Joint, output: Path, _from: Source):
     from designer.export.urdf import export_sdf
 
     return export_sdf(joint, output)
 
 
-def _ssp(joint, output, suggestion, *, interface):
+def _ssp(joint: Joint, output: Path, suggestion: Source, *, interface: str) -> Path:
     """The SSP archive; from a suggestion, every candidate becomes an SSV parameter set."""
     from designer.export.ssp import candidate_sets, export_ssp
 
@@ -286,7 +321,7 @@ def _ssp(joint, output, suggestion, *, interface):
     return export_ssp(joint, output, alternatives=sets, interface=interface)
 
 
-def _formats(snippet) -> None:
+def _formats(snippet: Callable[..., None]) -> None:
     """The robot and Modelica sub-commands of `export`, each with its own options."""
     from designer.export.modelica import export_modelica
 
