@@ -117,8 +117,9 @@ def test_into_a_degree_robot_keeps_every_host_unit(tmp_path):
         joint, tmp_path / "robot_flex.xml", into=host_path, joint_name="elbow", rest=math.radians(10)
     )
     text = out.path.read_text()
-    assert 'range="-120 120"' in text and 'range="-90 90"' in text and 'euler="0 30 0"' in text
-    assert '<compiler angle="degree"/>' in text and 'springref="10.0"' in text
+    changed = [(a, b) for a, b in zip(HOST.splitlines(), text.splitlines(), strict=True) if a != b]
+    assert len(changed) == 1 and '<joint name="elbow"' in changed[0][1], "only the joint's tag changes"
+    assert 'springref="10.0"' in changed[0][1] and 'range="-120 120"' in changed[0][1]
     host = mujoco.MjModel.from_xml_path(str(host_path))
     flex = mujoco.MjModel.from_xml_path(str(out.path))
     assert np.array_equal(flex.jnt_range, host.jnt_range) and np.array_equal(flex.body_quat, host.body_quat)
@@ -209,6 +210,23 @@ def test_series_into_a_robot_inserts_a_motor_and_holds_the_link_by_the_flexure(t
         form="series",
     )
     assert set(out.advice) == {"elbow"} and '<motor name="m" joint="elbow_motor"/>' in out.path.read_text()
+
+
+@pytest.mark.parametrize("model, joint_name", [("humanoid.xml", "left_hip_z"), ("ant.xml", "hip_3")])
+def test_into_robots_others_wrote(tmp_path, model, joint_name):
+    """Hosts with default classes, degrees, several joints in a body and motors (pybullet's copies)."""
+    import shutil
+
+    pybullet_data = pytest.importorskip("pybullet_data")
+    host = tmp_path / model
+    shutil.copy(f"{pybullet_data.getDataPath()}/mjcf/{model}", host)
+    joint = Joint.from_coefficients(THETA)
+    for form in ("parallel", "series"):
+        out = export_mjcf(joint, tmp_path / f"{form}.xml", into=host, joint_name=joint_name, form=form)
+        assert set(out.advice) == {joint_name}, "the host's motor moves to the motor joint: no servo added"
+        model = mujoco.MjModel.from_xml_path(str(out.path))
+        assert model.joint(joint_name).stiffness[0] == 0.05
+    assert f'joint="{joint_name}_motor"' in out.path.read_text()
 
 
 def test_urdf_loads_in_mujoco_with_real_links_and_the_gazebo_spring(tmp_path):

@@ -1,8 +1,9 @@
 """Make one joint of the user's MJCF robot a flexible joint: in parallel (the joint itself becomes the
 spring-damper) or in series (motor -> flexure -> link: a motor body is inserted before the link).
 
-The host file is edited with lxml at the element level, so comments, layout, units and every other
-element stay as written; values go in the host's angle unit. The edited file is compiled by MuJoCo
+In parallel only the joint's start tag changes in the file's text (every other byte stays as
+written); in series the file is restructured with lxml (same content; quoting and whitespace inside
+tags normalised). Values go in the host's angle unit. The edited file is compiled by MuJoCo
 from beside the output (relative asset paths must still resolve) and checked against the host's own
 compiled model before it replaces the output: in parallel, only that joint's numbers and what MuJoCo
 derives from the mass matrix may differ; in series, every host body keeps its world pose at the
@@ -13,7 +14,9 @@ from __future__ import annotations
 
 import copy
 import math
+import re
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -49,10 +52,12 @@ class _Host:
         return math.degrees(value) if self.hinge and self.spec.compiler.degree else value
 
     def bytes(self) -> bytes:
+        """The edited tree as a file (lxml normalises quoting and whitespace inside tags)."""
         from lxml import etree
 
-        declared = self.path.read_bytes().lstrip().startswith(b"<?xml")
-        return etree.tostring(self.tree, xml_declaration=declared, encoding="utf-8")
+        raw = self.path.read_bytes()
+        data = etree.tostring(self.tree, xml_declaration=raw.lstrip().startswith(b"<?xml"), encoding="utf-8")
+        return data + b"\n" if raw.endswith(b"\n") else data
 
 
 def _open(host: str | Path, joint_name: str) -> _Host:
@@ -101,12 +106,13 @@ def _axis(joint: Joint, axis: str | None, host: _Host, joint_name: str) -> str:
     return a
 
 
-def _write_checked(host: _Host, path: Path, check) -> object:
-    """Write the edited tree beside `path`, compile it there, run `check(model)`, then rename."""
+def _write_checked(host: _Host, path: Path, check, data: bytes | None = None) -> object:
+    """Write `data` (default: the edited tree) beside `path`, compile it there, run `check(model)`,
+    then rename it to `path`."""
     import mujoco
 
     with atomic_path(path) as tmp:
-        tmp.write_bytes(host.bytes())
+        tmp.write_bytes(host.bytes() if data is None else data)
         try:
             after = mujoco.MjModel.from_xml_path(str(tmp))
         except ValueError as exc:
@@ -151,14 +157,42 @@ def _compare_parallel(before, after, joint_name: str) -> None:
         raise RuntimeError(f"editing one joint changed the compiled model's {', '.join(changed)}")
 
 
-def _flexure(host: _Host, joint: Joint, a: str, rest: float) -> None:
-    """Set the joint element's stiffness, damping, armature (moving inertia, if known) and springref."""
+def _flexure(host: _Host, joint: Joint, a: str, rest: float) -> dict[str, str]:
+    """Set the joint element's stiffness, damping, armature (moving inertia, if known) and springref;
+    return them as written."""
     si = joint.axes[a].si()
     values = {"stiffness": si["k"], "damping": si["c"], "springref": host.angle(rest)}
     if si["m"] is not None:
         values["armature"] = si["m"]
+    values = {attr: robot.num(v) for attr, v in values.items()}
     for attr, v in values.items():
-        host.element.set(attr, robot.num(v))
+        host.element.set(attr, v)
+    return values
+
+
+def _retag(text: str, joint_name: str, values: dict[str, str]) -> str:
+    """`text` with only the start tag of joint `joint_name` changed: `values` set, all else as written.
+
+    Raises:
+        DesignerError: the tag cannot be found exactly once outside comments.
+    """
+    comments = [m.span() for m in re.finditer(r"<!--.*?-->", text, re.S)]
+    tag_re = re.compile(r"<joint\b[^>]*?\sname\s*=\s*(['\"])" + re.escape(joint_name) + r"\1[^>]*>", re.S)
+    found = [m for m in tag_re.finditer(text) if not any(a <= m.start() < b for a, b in comments)]
+    if len(found) != 1:
+        raise DesignerError(
+            f"cannot find joint {joint_name!r}'s tag once in the file's text ({len(found)} found)",
+            "write the joint as one <joint name=...> element outside comments",
+        )
+    tag = found[0].group(0)
+    for attr, value in values.items():
+        attr_re = re.compile(r"(\s" + attr + r"\s*=\s*)(['\"]).*?\2", re.S)
+        if attr_re.search(tag):
+            tag = attr_re.sub(lambda m: f"{m.group(1)}{m.group(2)}{value}{m.group(2)}", tag, count=1)  # noqa: B023
+        else:
+            end = re.search(r"\s*/?>$", tag).start()
+            tag = f'{tag[:end]} {attr}="{value}"{tag[end:]}'
+    return text[: found[0].start()] + tag + text[found[0].end() :]
 
 
 def into_parallel(
@@ -175,8 +209,11 @@ def into_parallel(
     """
     h = _open(host, joint_name)
     a = _axis(joint, axis, h, joint_name)
-    _flexure(h, joint, a, rest)
-    after = _write_checked(h, path, lambda m: _compare_parallel(h.model, m, joint_name))
+    raw = h.path.read_bytes()
+    encoding = h.tree.docinfo.encoding or "utf-8"
+    text = _retag(raw.decode(encoding), joint_name, _flexure(h, joint, a, rest))
+    check = partial(_compare_parallel, h.model, joint_name=joint_name)
+    after = _write_checked(h, path, check, text.encode(encoding))
     si = joint.axes[a].si()
     return {
         joint_name: step_advice(si["k"], si["c"], _mass_diagonal(after)[after.joint(joint_name).dofadr[0]])
@@ -188,7 +225,8 @@ def _insert_motor(host: _Host, joint_name: str, motor: robot.Sphere, servo: robo
 
     The motor body (inertial `motor`) takes the link body's place and frame attributes; the link sits
     in it at the identity. The motor joint is a copy of the host joint (type, axis, range...) with the
-    servo's armature. Actuators
+    servo's armature; joints written before the host joint in its body move with it, so the joints
+    still act in the host's order. Actuators
     on the host joint now drive the motor joint; without any, `servo` is added as a position actuator
     (its derivative gain as the motor joint's damping).
     """
@@ -205,7 +243,14 @@ def _insert_motor(host: _Host, joint_name: str, motor: robot.Sphere, servo: robo
     motor_joint.set("name", f"{joint_name}_motor")
     motor_joint.set("armature", robot.num(servo.motor_inertia))
     comment = etree.Comment(f" flexjoint designer: the motor of series-elastic joint {joint_name} ")
-    for child in (comment, etree.fromstring(robot.inertial_xml(motor)), motor_joint, link):
+    # joints before this one in its body act before it: they move to the motor body, in order
+    before = []
+    for e in link:
+        if e is host.element:
+            break
+        if e.tag in ("joint", "freejoint"):
+            before.append(e)
+    for child in (comment, etree.fromstring(robot.inertial_xml(motor)), *before, motor_joint, link):
         body.append(child)
     body.tail, link.tail = link.tail, None
     etree.indent(body, space="  ", level=len(list(body.iterancestors())))
@@ -311,7 +356,7 @@ def into_series(
     _flexure(h, joint, a, rest)
     for attr, value in (("ref", "0"), ("limited", "false")):
         h.element.set(attr, value)
-    after = _write_checked(h, path, lambda m: _compare_series(h.model, m, joint_name))
+    after = _write_checked(h, path, partial(_compare_series, h.model, joint_name=joint_name))
     diag = _mass_diagonal(after)
     flex_dof, motor_dof = after.joint(joint_name).dofadr[0], after.joint(f"{joint_name}_motor").dofadr[0]
     advice = {joint_name: step_advice(si["k"], si["c"], diag[flex_dof])}
