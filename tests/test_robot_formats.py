@@ -288,6 +288,38 @@ def test_urdf_into_a_robot_sets_damping_and_the_spring_extension(tmp_path):
     assert mujoco.MjModel.from_xml_path(str(out.path)).dof_damping[0] == 5e-4
 
 
+def test_urdf_into_a_robot_others_wrote_loads_in_pybullet(tmp_path):
+    """Franka Panda (pybullet's copy, meshes beside it): two text edits, pybullet reads the damping."""
+    import difflib
+    import shutil
+
+    p = pytest.importorskip("pybullet")
+    pybullet_data = pytest.importorskip("pybullet_data")
+    folder = shutil.copytree(f"{pybullet_data.getDataPath()}/franka_panda", tmp_path / "panda")
+    out = export_urdf(
+        Joint.from_coefficients(THETA),
+        folder / "flex.urdf",
+        into=folder / "panda.urdf",
+        joint_name="panda_joint4",
+    )
+    before, after = (f.read_text().splitlines() for f in (folder / "panda.urdf", out.path))
+    added = [line[2:].strip() for line in difflib.ndiff(before, after) if line.startswith("+ ")]
+    assert added[0] == '<dynamics damping="0.0005"/>' and "<springStiffness>0.05</springStiffness>" in added
+    removed = [line for line in difflib.ndiff(before, after) if line.startswith("- ")]
+    assert all(not line[2:].strip() for line in removed), "nothing of the host is lost"
+    client = p.connect(p.DIRECT)
+    try:
+        body = p.loadURDF(str(out.path), useFixedBase=True, physicsClientId=client)
+        names = [
+            p.getJointInfo(body, i, physicsClientId=client)[1]
+            for i in range(p.getNumJoints(body, physicsClientId=client))
+        ]
+        info = p.getJointInfo(body, names.index(b"panda_joint4"), physicsClientId=client)
+    finally:
+        p.disconnect(client)
+    assert info[6] == 5e-4  # jointDamping
+
+
 def test_sdf_spring_becomes_a_drake_revolute_spring(tmp_path):
     out = export_sdf(Joint.from_coefficients(THETA), tmp_path / "j.sdf")
     dyn = ET.parse(out.path).getroot().find("model/joint[@name='FlexJoint_theta']/axis/dynamics")

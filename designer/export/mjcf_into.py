@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import copy
 import math
-import re
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
@@ -25,7 +24,7 @@ from .. import units
 from ..errors import DesignerError
 from ..files import atomic_path
 from ..joint import Joint
-from . import robot
+from . import robot, xmltext
 from .stability import StepAdvice, step_advice
 
 #: compiled-model arrays that follow from the mass matrix, so they change with a joint's armature
@@ -171,28 +170,9 @@ def _flexure(host: _Host, joint: Joint, a: str, rest: float) -> dict[str, str]:
 
 
 def _retag(text: str, joint_name: str, values: dict[str, str]) -> str:
-    """`text` with only the start tag of joint `joint_name` changed: `values` set, all else as written.
-
-    Raises:
-        DesignerError: the tag cannot be found exactly once outside comments.
-    """
-    comments = [m.span() for m in re.finditer(r"<!--.*?-->", text, re.S)]
-    tag_re = re.compile(r"<joint\b[^>]*?\sname\s*=\s*(['\"])" + re.escape(joint_name) + r"\1[^>]*>", re.S)
-    found = [m for m in tag_re.finditer(text) if not any(a <= m.start() < b for a, b in comments)]
-    if len(found) != 1:
-        raise DesignerError(
-            f"cannot find joint {joint_name!r}'s tag once in the file's text ({len(found)} found)",
-            "write the joint as one <joint name=...> element outside comments",
-        )
-    tag = found[0].group(0)
-    for attr, value in values.items():
-        attr_re = re.compile(r"(\s" + attr + r"\s*=\s*)(['\"]).*?\2", re.S)
-        if attr_re.search(tag):
-            tag = attr_re.sub(lambda m: f"{m.group(1)}{m.group(2)}{value}{m.group(2)}", tag, count=1)  # noqa: B023
-        else:
-            end = re.search(r"\s*/?>$", tag).start()
-            tag = f'{tag[:end]} {attr}="{value}"{tag[end:]}'
-    return text[: found[0].start()] + tag + text[found[0].end() :]
+    """`text` with only the start tag of joint `joint_name` changed: `values` set, all else as written."""
+    m = xmltext.find_one(text, "joint", "name", joint_name)
+    return text[: m.start()] + xmltext.set_attributes(m.group(0), values) + text[m.end() :]
 
 
 def into_parallel(

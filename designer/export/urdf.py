@@ -10,13 +10,14 @@ default of recomputing inertia from collision shapes gives the same number.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from .. import units
 from ..errors import DesignerError
 from ..files import atomic_path, atomic_write, check_suffix
 from ..joint import Joint
-from . import robot
+from . import robot, xmltext
 
 #: a prismatic URDF joint needs limits; these (m) are wide enough never to act on a flexure
 PRISMATIC_LIMIT = 1.0
@@ -117,7 +118,7 @@ def sdf_text(joint: Joint) -> tuple[str, dict[str, robot.StepAdvice]]:
 
 
 def _into_urdf(joint: Joint, host: Path, *, joint_name: str, axis: str | None, rest: float) -> bytes:
-    """The host URDF with `joint_name`'s damping set and its Gazebo spring extension (re)written."""
+    """The host URDF's bytes with `joint_name`'s damping and Gazebo spring set; the rest as written."""
     from lxml import etree
 
     if not host.is_file():
@@ -143,18 +144,49 @@ def _into_urdf(joint: Joint, host: Path, *, joint_name: str, axis: str | None, r
             "give an axis of the same kind as the robot joint",
         )
     si = joint.axes[a].si()
-    dynamics = found[0].find("dynamics")
-    if dynamics is None:
-        dynamics = etree.SubElement(found[0], "dynamics")
-    dynamics.set("damping", robot.num(si["c"]))
-    for old in root.xpath("/robot/gazebo[@reference=$n]", n=joint_name):
-        for tag in ("springStiffness", "springReference"):
-            for e in old.findall(tag):
-                old.remove(e)
-    gz = etree.fromstring("\n".join(_gazebo(joint_name, si["k"], rest)))
-    gz.tail = "\n"
-    root.append(gz)
-    return etree.tostring(tree, xml_declaration=True, encoding="utf-8")
+    encoding = tree.docinfo.encoding or "utf-8"
+    text = _set_damping(host.read_bytes().decode(encoding), joint_name, robot.num(si["c"]))
+    return _set_spring(text, joint_name, si["k"], rest).encode(encoding)
+
+
+def _set_damping(text: str, joint_name: str, damping: str) -> str:
+    """The joint element's `<dynamics damping>` set (a `<dynamics>` line added when it has none)."""
+    element = xmltext.find_one(text, "joint", "name", joint_name, whole=True)
+    body = element.group(0)
+    dynamics = re.search(r"<dynamics\b[^>]*>", body)
+    if dynamics:
+        body = (
+            body[: dynamics.start()]
+            + xmltext.set_attributes(dynamics.group(0), {"damping": damping})
+            + body[dynamics.end() :]
+        )
+    else:
+        close = body.rindex("</joint")
+        pad = xmltext.indent_before(text, element.start())
+        body = f'{body[:close].rstrip()}\n{pad}  <dynamics damping="{damping}"/>\n{pad}{body[close:]}'
+    return text[: element.start()] + body + text[element.end() :]
+
+
+def _set_spring(text: str, joint_name: str, k: float, rest: float) -> str:
+    """The Gazebo extension's springStiffness/springReference set: in the joint's block, or a new block."""
+    try:
+        block = xmltext.find_one(text, "gazebo", "reference", joint_name, whole=True)
+    except DesignerError:
+        block = None
+    values = {"springStiffness": robot.num(k), "springReference": robot.num(rest)}
+    if block is not None and all(f"<{tag}>" in block.group(0) for tag in values):
+        body = block.group(0)
+        for tag, value in values.items():
+            body = re.sub(rf"<{tag}>.*?</{tag}>", f"<{tag}>{value}</{tag}>", body, count=1, flags=re.S)
+        return text[: block.start()] + body + text[block.end() :]
+    if block is not None and any(f"<{tag}>" in block.group(0) for tag in values):
+        raise DesignerError(
+            f"the robot's <gazebo reference='{joint_name}'> has one of springStiffness/springReference",
+            "give both or neither",
+        )
+    end = text.rindex("</robot")
+    lines = "\n".join(_gazebo(joint_name, k, rest))
+    return f"{text[:end].rstrip()}\n{lines}\n{text[end:]}"
 
 
 def export_urdf(
