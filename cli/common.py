@@ -67,8 +67,8 @@ FLAGS: tuple[tuple[str, str], ...] = (
     # export mjcf/urdf/sdf/modelica/ssp
     (r"\binto=", "--into "),
     (r"\bjoint_name=", "--joint "),
-    (r"\baxis=", "--use-axis "),
-    (r"\bform=", "--form "),
+    (r"\baxis=(?='\w+'(, or| is | does ))", "--use-axis "),
+    (r"\bform=(?='\w*' is not a form)", "--form "),
     (r"\bmsl=", "--msl "),
     (r"\bmotor_inertia=", "--motor-inertia "),
     (r"\bmotor_bandwidth=", "--motor-bandwidth "),

@@ -68,10 +68,18 @@ def pick_axis(joint: Joint, axis: str | None, rotational: bool | None = None) ->
     if axis is not None:
         return joint.axis(axis).axis
     fits = [a for a in joint.axes if rotational is None or units.is_rotational(a) == rotational]
+    if not fits:
+        kind, names = (
+            ("rotational", units.ROTATIONAL) if rotational else ("translational", units.TRANSLATIONAL)
+        )
+        raise DesignerError(
+            f"joint '{joint.name}' has no {kind} axis for this {'hinge' if rotational else 'slide'}",
+            f"build the joint with a {kind} axis ({', '.join(names)})",
+        )
     if len(fits) != 1:
         raise DesignerError(
             f"joint '{joint.name}' has axes {', '.join(joint.axes)}; cannot tell which one to export",
-            "give axis= one of them",
+            f"pass axis={fits[0]!r}, or another of them",
         )
     return fits[0]
 
