@@ -137,10 +137,8 @@ def _snippet(
         result = write(joint, output, (from_, candidate) if from_ else None, **options)
         advice = getattr(result, "advice", {})
         if json_out:
-            print_json(
-                {"path": str(output), "format": fmt, "joint": joint.to_dict()}
-                | ({"advice": {n: a.to_dict() for n, a in advice.items()}} if advice else {})
-            )
+            written = result.to_dict() if hasattr(result, "to_dict") else {"path": str(result)}
+            print_json({"format": fmt, "joint": joint.to_dict()} | written)
             return
         _print_joint(joint, title, output)
         for n, a in advice.items():
