@@ -71,6 +71,7 @@ class Context:
 
 def check_dataset(ctx: Context) -> CheckResult:
     """The table holds the six factors at tested values and positive coefficients, with no gaps."""
+    from .plots.common import save_figure
     from .plots.heatmap import plot_heatmap
 
     t = ctx.table
@@ -103,7 +104,7 @@ def check_dataset(ctx: Context) -> CheckResult:
                 "runs per level": f"median {v.median():.4g}, CV {v.std() / v.mean():.0%}",
             }
         )
-    fig = plot_heatmap(t, coefs, ctx.figures / "dataset_heatmap.png")
+    fig = save_figure(plot_heatmap(t, responses=coefs), ctx.figures / "dataset_heatmap.png")
     summary = (
         f"{len(t)} runs from the {ctx.source} (sha256 {table_hash(t)[:12]}), responses {', '.join(coefs)}"
         + ("; " + "; ".join(problems) if problems else "; every factor within its tested range")
@@ -130,6 +131,7 @@ SIGNIFICANT_K_X = ("width", "height", "layer")
 
 def check_main_effects(ctx: Context) -> CheckResult:
     """Medians move as the study's effect plots say, for each factor its Table 4 finds significant."""
+    from .plots.common import save_figure
     from .plots.effects import main_effects, plot_effects
 
     responses = [r for r in ("c_x", "k_x") if r in ctx.table.columns]
@@ -159,7 +161,7 @@ def check_main_effects(ctx: Context) -> CheckResult:
         )
     table = pd.DataFrame(rows)
     binding = table[table["counts"] == "yes"]
-    fig = plot_effects(ctx.table, responses, ctx.figures / "main_effects.png")
+    fig = save_figure(plot_effects(ctx.table, responses=responses), ctx.figures / "main_effects.png")
     summary = (
         f"{int(binding.agrees.sum())} of {len(binding)} directions the study finds significant agree; "
         f"{int(table.agrees.sum())} of {len(table)} stated directions agree in all"
@@ -177,6 +179,7 @@ def check_surrogate_loo(ctx: Context) -> CheckResult:
     """Leave-one-out metrics per response, and whether its 95 % PIs cover as often as they claim."""
     from scipy.stats import binom
 
+    from .plots.common import save_figure
     from .plots.loo import loo_table, plot_loo
 
     sur = ctx.surrogate
@@ -200,7 +203,7 @@ def check_surrogate_loo(ctx: Context) -> CheckResult:
             }
         )
     table = pd.DataFrame(rows)
-    fig = plot_loo(sur, sur.responses, ctx.figures / "surrogate_loo.png")
+    fig = save_figure(plot_loo(sur), ctx.figures / "surrogate_loo.png")
     summary = "; ".join(
         f"{r['response']}: {r['form']}, Q2 {r['Q2']:.2f}, 95 % PI covers {r['PI coverage']}" for r in rows
     )
@@ -212,12 +215,13 @@ def check_surrogate_loo(ctx: Context) -> CheckResult:
 def check_table4(ctx: Context) -> CheckResult:
     """Our type III ANOVA of k_x against the study's Table 4: F and p side by side."""
     from .plots.checks import plot_table4
+    from .plots.common import save_figure
     from .stats import TABLE4_NOTE, compare_table4
 
     if "k_x" not in ctx.table.columns:
         raise DesignerError("the table has no k_x column", "Table 4 is the ANOVA of k_x: give c_x, k_x")
     cmp = compare_table4(ctx.table)
-    fig = plot_table4(cmp, ctx.figures / "table4.png")
+    fig = save_figure(plot_table4(cmp), ctx.figures / "table4.png")
     ours = {s for s, sig in zip(cmp.source, cmp.significant, strict=True) if sig}
     summary = (
         f"{int(cmp.agrees.sum())} of {len(cmp)} sources agree (F within 10 % where the paper's F > 1, same "
@@ -280,6 +284,7 @@ def check_fmu(ctx: Context) -> CheckResult:
 
     from .export.fmu import export_fmu
     from .joint import from_coefficients
+    from .plots.common import save_figure
     from .plots.timeseries import plot_timeseries
 
     joint = from_coefficients({"x": FMU_JOINT}, name="report_joint")
@@ -341,10 +346,9 @@ def check_fmu(ctx: Context) -> CheckResult:
     frame = pd.DataFrame({"t": t, "analytic": exact, **curves})
     errors = {f"{name} error": curves[name] - exact for name in curves}
     frame = frame.assign(**errors)
-    fig = plot_timeseries(
-        frame,
+    fig = save_figure(
+        plot_timeseries(frame, panels={"x.s (m)": ["analytic", *curves], "error (m)": list(errors)}),
         ctx.figures / "fmu_step_response.png",
-        panels={"x.s (m)": ["analytic", *curves], "error (m)": list(errors)},
     )
     table = pd.DataFrame(rows)
     summary = (
@@ -371,6 +375,7 @@ IDENTIFY_TOLERANCE_PCT = 1.0
 def check_identification(ctx: Context) -> CheckResult:
     """The virtual rig's log (1 % force noise, dropouts), identified, gives back k and c within 1 %."""
     from .plots.checks import plot_identification
+    from .plots.common import save_figure
     from .rig.identify import identify
     from .rig.logs import validate_frame
     from .rig.simulate import simulate
@@ -394,7 +399,9 @@ def check_identification(ctx: Context) -> CheckResult:
             }
         )
     table = pd.DataFrame(rows)
-    fig = plot_identification(table, IDENTIFY_TOLERANCE_PCT, ctx.figures / "identification.png")
+    fig = save_figure(
+        plot_identification(table, tolerance_pct=IDENTIFY_TOLERANCE_PCT), ctx.figures / "identification.png"
+    )
     worst = table[["k error %", "c error %"]].abs().max()
     summary = (
         f"{int(table.within.sum())} of {len(table)} sets within {IDENTIFY_TOLERANCE_PCT:g} % on "
@@ -428,6 +435,7 @@ def check_cosim(ctx: Context) -> CheckResult:
     from .cosim.scenario import JointSource, Scenario
     from .joint import from_coefficients
     from .plots.checks import plot_convergence
+    from .plots.common import save_figure
     from .plots.timeseries import plot_timeseries
 
     joint = JointSource(axis="theta", joint=from_coefficients({"theta": {"k": 330.0, "c": 0.83}}))
@@ -454,21 +462,25 @@ def check_cosim(ctx: Context) -> CheckResult:
         and (steps["order"].iloc[1:] >= COSIM_ORDER).all()
     )
     figs = [
-        plot_convergence(
-            steps[["step", "max_error", "max_error_same_step"]].rename(
-                columns={
-                    "max_error": f"against RK4 at {min(COSIM_STEPS) / 4:g} s",
-                    "max_error_same_step": "against MuJoCo in-engine",
-                }
+        save_figure(
+            plot_convergence(
+                steps[["step", "max_error", "max_error_same_step"]].rename(
+                    columns={
+                        "max_error": f"against RK4 at {min(COSIM_STEPS) / 4:g} s",
+                        "max_error_same_step": "against MuJoCo in-engine",
+                    }
+                ),
+                unit="rad",
             ),
             ctx.figures / "cosim_convergence.png",
-            "rad",
         ),
-        plot_timeseries(
-            cosim,
+        save_figure(
+            plot_timeseries(
+                cosim,
+                columns=["robot.j1.q", "robot.j2.q", "j1.theta.f", "j2.theta.f"],
+                reference=reference,
+            ),
             ctx.figures / "cosim_arm.png",
-            ["robot.j1.q", "robot.j2.q", "j1.theta.f", "j2.theta.f"],
-            reference=reference,
         ),
     ]
     summary = (

@@ -243,12 +243,14 @@ def write_outputs(sc: Scenario, out: Path, frame: pd.DataFrame, summary: dict) -
 
 def plot(frame: pd.DataFrame, path: Path) -> Path:
     """Angles (or coordinate and hub) and loads against time, one panel each."""
+    from ..plots.common import save_figure
     from ..plots.timeseries import plot_timeseries
 
     angles = [c for c in frame.columns if c.endswith((".q", ".motor", ".s"))]
     loads = [c for c in frame.columns if c.endswith((".f", ".tau"))]
     panels = {"angle [rad] / coordinate [SI]": angles, "torque [N.m] / force [N]": loads}
-    return plot_timeseries(frame, path, panels={label: cols for label, cols in panels.items() if cols})
+    fig = plot_timeseries(frame, panels={label: cols for label, cols in panels.items() if cols})
+    return save_figure(fig, path)
 
 
 def simulate(sc: Scenario, out: Path, with_validation: bool = False, progress: Progress = None) -> dict:
