@@ -60,7 +60,9 @@ class Browser:
                 raise RuntimeError(f"{exe} did not open its DevTools port")
             time.sleep(0.05)
         port, path = port_file.read_text().splitlines()[:2]
-        self.ws = websocket.create_connection(f"ws://127.0.0.1:{port}{path}", timeout=60, suppress_origin=True)
+        self.ws = websocket.create_connection(
+            f"ws://127.0.0.1:{port}{path}", timeout=60, suppress_origin=True
+        )
         self._id = 0
         self.events: list[dict[str, Any]] = []
         self.size = (width, height)
@@ -158,8 +160,9 @@ class Page:
     def box(self, selector: str) -> dict[str, float]:
         """The element's bounding box in CSS pixels, scrolled into view."""
         return self.js(
-            f"(() => {{ const e = document.querySelector({json.dumps(selector)}); e.scrollIntoView({{block: 'center'}});"
-            " const r = e.getBoundingClientRect(); return {x: r.x, y: r.y, w: r.width, h: r.height}; })()"
+            f"(() => {{ const e = document.querySelector({json.dumps(selector)});"
+            " e.scrollIntoView({block: 'center'}); const r = e.getBoundingClientRect();"
+            " return {x: r.x, y: r.y, w: r.width, h: r.height}; })()"
         )
 
     def click_at(self, x: float, y: float) -> None:
