@@ -62,8 +62,13 @@ def decimals_for(step: float) -> int:
 class _StepFormatter(Formatter):
     """Tick labels with as many decimals as the tick spacing needs (c in N.s/mm reads 0.0015, not 0.0)."""
 
+    ticks: tuple[float, ...] = ()
+
+    def set_locs(self, locs) -> None:
+        self.ticks = tuple(locs)
+
     def __call__(self, x: float, pos: int | None = None) -> str:
-        step = abs(self.locs[1] - self.locs[0]) if len(self.locs) > 1 else abs(x)
+        step = abs(self.ticks[1] - self.ticks[0]) if len(self.ticks) > 1 else abs(x)
         return "0" if step and abs(x) < 1e-9 * step else f"{x:.{decimals_for(step)}f}"
 
 

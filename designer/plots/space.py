@@ -198,7 +198,7 @@ def render(view: SpaceView, *, window: tuple[int, int] = WINDOW):
     if hi - lo <= 1e-9 * abs(hi):  # a constant response: the scale spans the plotted PI instead
         lo, hi = view.scene.axis_ranges[2]
     _colorbar(plotter, view.response, lo, hi)
-    left = min(0.68 * window[0], window[0] - 20 - 11.5 * max(len(layer.name) for layer in layers))
+    left = min(0.68 * window[0], window[0] - 24 - 13 * max(len(layer.name) for layer in layers))
     for i, layer in enumerate(layers):  # the legend: each name in its layer's colour, fixed size
         pos = (int(left), int(window[1] - 64 - 24 * i))
         plotter.add_text(layer.name, position=pos, font_size=12, color=layer.color)
