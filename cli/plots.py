@@ -98,7 +98,7 @@ Surrogate = Annotated[
 def _surrogate(path: Path | None):
     from designer.surrogate import Surrogate as _S
 
-    return _S.load_default() if path is None else _S.load(path)
+    return _S.load() if path is None else _S.load(path)
 
 
 def _fixed(pairs: list[str], flag: str = "--fix", example: str = "density=60") -> dict[str, float]:
@@ -274,7 +274,7 @@ def validate_cmd(
     from designer.report import validate
 
     with progress_bar("validating") as bar:
-        results, page, md, seconds = validate(output, table, progress=bar)
+        results, page, md, seconds = validate(output, table=table, progress=bar)
     failed = [r for r in results if not r.passed]
     if as_json:
         print_json(
@@ -330,8 +330,13 @@ def profile_cmd(
     Example: designer profile --target k=0.8 -o profiler.html
     """
     from designer import space
+    from designer.errors import DesignerError
     from designer.plots import profile
 
+    if not 0 < tolerance < 100:
+        raise DesignerError(
+            f"--tolerance {tolerance:g} is not a percentage in (0, 100)", "give e.g. --tolerance 10"
+        )
     sur = _surrogate(surrogate)
     targets = _fixed(target or [], "--target", "k=0.8")
     start = _fixed(design or [], "--design", "width=3.5")
@@ -346,10 +351,7 @@ def profile_cmd(
             {
                 "page": str(path),
                 "design": opened,
-                "predicted": {
-                    r: {"value": float(p.value[0]), "low": float(p.lo[0]), "high": float(p.hi[0])}
-                    for r, p in preds.items()
-                },
+                "predicted": {r: p.at(0).to_dict() for r, p in preds.items()},
                 "accuracy": {r["name"]: r["accuracy"] for r in page.data["responses"]},
                 "suggestions": len(page.data["suggestions"]),
             }

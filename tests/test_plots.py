@@ -151,7 +151,7 @@ def test_importing_and_plotting_leave_the_process_alone(tmp_path):
         "assert dict.__getitem__(matplotlib.rcParams, 'backend') is backend, 'backend switched'\n"
         "assert 'matplotlib.pyplot' not in sys.modules, 'pyplot imported'\n"
         "from designer.surrogate import Surrogate\n"
-        "view = designer.plots.space.surface_view(Surrogate.load_default(), 'k_x', resolution=5)\n"
+        "view = designer.plots.space.surface_view(Surrogate.load(), 'k_x', resolution=5)\n"
         "designer.plots.space.render(view, window=(200, 150)).close()\n"
         "assert dict(os.environ) == env, 'environment edited'\n"
         "print('clean')\n"

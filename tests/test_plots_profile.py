@@ -19,7 +19,7 @@ from designer.surrogate import FORMS, Surrogate, design_matrix
 
 @pytest.fixture(scope="module")
 def sur():
-    return Surrogate.load_default()
+    return Surrogate.load()
 
 
 def _evaluate(node, x):

@@ -16,7 +16,7 @@ from designer.surrogate import Surrogate
 
 @pytest.fixture(scope="module")
 def sur():
-    return Surrogate.load_default()
+    return Surrogate.load()
 
 
 def assert_margins_clear(rgb: np.ndarray, px: int = 4) -> None:

@@ -30,7 +30,7 @@ RTOL = 1e-9
 
 @pytest.fixture(scope="module")
 def sur():
-    return Surrogate.load_default()
+    return Surrogate.load()
 
 
 @pytest.fixture(scope="module")
@@ -88,7 +88,7 @@ def _check(page, sur) -> dict[str, float]:
     lib = sur.predict(design, ["k_x", "c_x"])
     for name, p in lib.items():
         got = shown[name]
-        want = [float(p.value[0]), float(p.lo[0]), float(p.hi[0])]
+        want = [float(p.value[0]), float(p.low[0]), float(p.high[0])]
         np.testing.assert_allclose(
             [got["value"], got["low"], got["high"]], want, rtol=RTOL, atol=0, err_msg=name
         )
@@ -102,7 +102,7 @@ def _check(page, sur) -> dict[str, float]:
     # the target on k: probability within 10 % from scipy's t, desirability as suggest's Target says
     m, k = sur.model("k_x"), lib["k_x"]
     mean = np.log(k.value[0])
-    scale = (np.log(k.hi[0]) - mean) / m.t95
+    scale = (np.log(k.high[0]) - mean) / m.t95
     want_p = stats.t.cdf((np.log(0.88) - mean) / scale, m.dof) - stats.t.cdf(
         (np.log(0.72) - mean) / scale, m.dof
     )

@@ -131,8 +131,8 @@ def _value_range(model: ResponseSurface, observed: np.ndarray, target: float | N
     axes += [np.asarray(f.levels, float) for f in space.CATEGORICAL]
     grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, len(space.FACTORS))
     pred = model.predict(pd.DataFrame(grid, columns=list(space.FACTOR_NAMES)))
-    lo = min(float(np.min(pred.lo)), float(np.min(observed)), target if target is not None else math.inf)
-    hi = max(float(np.max(pred.hi)), float(np.max(observed)), target if target is not None else -math.inf)
+    lo = min(float(np.min(pred.low)), float(np.min(observed)), target if target is not None else math.inf)
+    hi = max(float(np.max(pred.high)), float(np.max(observed)), target if target is not None else -math.inf)
     pad = 0.04 * (hi - lo)
     return [max(lo - pad, 0.0) if lo >= 0 else lo - pad, hi + pad]
 
@@ -251,9 +251,7 @@ def build_profiler(
     targets = dict(targets or {})
     for q in targets:
         if q not in ("k", "c"):
-            raise DesignerError(
-                f"targets has unknown quantity '{q}'", "give targets for k or c, e.g. {'k': 0.8}"
-            )
+            raise DesignerError(f"targets has unknown quantity '{q}'", "give targets={'k': 0.8}, for k or c")
     if not (isinstance(tolerance, int | float) and 0 < tolerance < 1):
         raise DesignerError(
             f"tolerance={tolerance!r} is not a fraction between 0 and 1", "give e.g. tolerance=0.1"

@@ -38,7 +38,7 @@ def plot_timeseries(
         )
     if len(panels) > MAX_PANELS:
         raise DesignerError(
-            f"{len(panels)} signals is too many for one figure", f"pick at most {MAX_PANELS} with --columns"
+            f"{len(panels)} signals is too many for one figure", f"pick at most {MAX_PANELS} with columns="
         )
     fig = new_figure(figsize=(9, 1.9 * len(panels) + 0.8))
     axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)

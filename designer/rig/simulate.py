@@ -84,7 +84,7 @@ def simulate(
         raise DesignerError("no axis to simulate", "give m, c, k for at least one axis")
     n = int(round(duration * rate)) + 1
     if n < 3 * STUCK_SAMPLES:
-        raise DesignerError(f"{n} samples is too short a run", "raise --duration or --rate")
+        raise DesignerError(f"{n} samples is too short a run", "raise duration or rate")
     rng = np.random.default_rng(seed)
     t = np.arange(n) / rate
     q, dq, ddq = Chirp(f0, f1, duration)(t)
