@@ -346,7 +346,7 @@ def profile_cmd(
     path = profile.write_profiler(page, output)
     opened = page.data["design"]
     if as_json:
-        preds = sur.predict(opened, [r["name"] for r in page.data["responses"]])
+        preds = sur.predict(opened, responses=[r["name"] for r in page.data["responses"]])
         print_json(
             {
                 "page": str(path),

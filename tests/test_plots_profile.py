@@ -112,7 +112,7 @@ def test_cli_profile(sur, tmp_path):
     assert run.returncode == 0, run.stderr
     out = json.loads(run.stdout)
     assert out["design"]["raster"] == 45.0 and (tmp_path / "p.html").is_file()
-    want = sur.predict(out["design"], ["k_x"])["k_x"]
+    want = sur.predict(out["design"], responses=["k_x"])["k_x"]
     assert out["predicted"]["k_x"]["value"] == pytest.approx(float(want.value[0]), rel=1e-12)
     for bad, message in (
         (["--design", "width=3", "--design", "width=4"], "twice"),

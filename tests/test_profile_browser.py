@@ -85,7 +85,7 @@ def _check(page, sur) -> dict[str, float]:
         "  text: e.textContent, pi: document.getElementById('pi-' + r.name).textContent,"
         "  p: t.dataset.probability, d: t.dataset.desirability}; } return o; })()"
     )
-    lib = sur.predict(design, ["k_x", "c_x"])
+    lib = sur.predict(design, responses=["k_x", "c_x"])
     for name, p in lib.items():
         got = shown[name]
         want = [float(p.value[0]), float(p.low[0]), float(p.high[0])]
