@@ -44,7 +44,19 @@ def made(tmp_path_factory):
     assert sug.returncode == 0, sug.stderr
     (folder / "sug.json").write_text(sug.stdout)
     run = subprocess.run(
-        [str(exe), "profile", "--target", "k=0.8", "--suggestion", "sug.json", "-o", "p.html", "--json"],
+        [
+            str(exe),
+            "profile",
+            "--target",
+            "k=0.8",
+            "--target",
+            "c=2e-3",
+            "--suggestion",
+            "sug.json",
+            "-o",
+            "p.html",
+        ]
+        + ["--json"],
         capture_output=True,
         text=True,
         cwd=folder,
@@ -99,16 +111,21 @@ def _check(page, sur) -> dict[str, float]:
         assert float(low_txt) == pytest.approx(want[1], rel=6e-3) and float(high_txt) == pytest.approx(
             want[2], rel=6e-3
         )
-    # the target on k: probability within 10 % from scipy's t, desirability as suggest's Target says
-    m, k = sur.model("k_x"), lib["k_x"]
-    mean = np.log(k.value[0])
-    scale = (np.log(k.high[0]) - mean) / m.t95
-    want_p = stats.t.cdf((np.log(0.88) - mean) / scale, m.dof) - stats.t.cdf(
-        (np.log(0.72) - mean) / scale, m.dof
-    )
-    assert float(shown["k_x"]["p"]) == pytest.approx(want_p, abs=1e-9)
-    target = make_target(sur, "k", "x", 0.8)
-    assert float(shown["k_x"]["d"]) == pytest.approx(target.desirability(k.value[0]), abs=1e-12)
+    # targets: probability within 10 % from scipy's Student t (in the form's fit space, log for k),
+    # desirability as suggest's Target says; the composite over the predictable responses (k only)
+    for q, goal in (("k", 0.8), ("c", 2e-3)):
+        m, p = sur.model(f"{q}_x"), lib[f"{q}_x"]
+        tr = np.log if m.transform == "log" else (lambda v: v)
+        mean = tr(p.value[0])
+        scale = (tr(p.high[0]) - mean) / m.t95
+        cdf = [stats.t.cdf((tr(goal * f) - mean) / scale, m.dof) for f in (1.1, 0.9)]
+        assert float(shown[f"{q}_x"]["p"]) == pytest.approx(cdf[0] - cdf[1], abs=1e-9), q
+        d = make_target(sur, q, "x", goal).desirability(float(p.value[0]))
+        assert float(shown[f"{q}_x"]["d"]) == pytest.approx(d, abs=1e-12), q
+        if q == "k":
+            assert float(page.js("document.getElementById('overall').dataset.desirability")) == pytest.approx(
+                d
+            )
     return design
 
 
