@@ -43,10 +43,16 @@ def assert_inside(fig) -> None:
     assert drawn.x1 <= canvas.x1 + 0.01 and drawn.y1 <= canvas.y1 + 0.01, (drawn, canvas)
 
 
-def tick_labels(ax, which: str = "y") -> list[str]:
+def tick_labels(ax) -> list[str]:
+    """The y tick labels as drawn; each must read back as its tick's value (no rounding away)."""
     ax.figure.canvas.draw()
-    ticks = ax.get_yticklabels() if which == "y" else ax.get_xticklabels()
-    return [t.get_text() for t in ticks if t.get_text()]
+    lo, hi = ax.get_ylim()
+    shown = [
+        (t.get_text(), t.get_position()[1]) for t in ax.get_yticklabels() if lo <= t.get_position()[1] <= hi
+    ]
+    for text, value in shown:
+        assert float(text.replace("\u2212", "-")) == pytest.approx(value, rel=1e-9, abs=1e-12), (text, value)
+    return [text for text, _ in shown]
 
 
 def test_effects_png(table, tmp_path):
@@ -55,6 +61,7 @@ def test_effects_png(table, tmp_path):
     # c in N.s/mm: tick labels distinct and readable (0.001, 0.002 ...), never all "0.0"
     labels = tick_labels(fig.axes[0])
     assert len(set(labels)) == len(labels) >= 3 and "0.0" not in labels, labels
+    tick_labels(fig.axes[len(space.FACTORS)])  # k_x: 0.25 reads 0.25, not 0.2
     assert all(t.get_fontsize() >= 9 for t in fig.axes[0].get_yticklabels())
     path = common.save_figure(fig, tmp_path / "effects.png")
     rgb = assert_picture(path, min_size=(1200, 500))

@@ -54,22 +54,29 @@ def check_image_path(path: str | Path) -> Path:
     return p
 
 
-def decimals_for(step: float) -> int:
-    """Decimals that show values spaced `step` apart: 0.5 -> 1, 0.0005 -> 4, 20 -> 0."""
-    return max(0, -math.floor(math.log10(abs(step)) + 1e-9)) if step else 0
+def decimals_for(ticks: tuple[float, ...]) -> int:
+    """The fewest decimals that print every tick exactly: (0.5, 1) -> 1, (0.25, 0.5) -> 2, (0.0005,) -> 4."""
+    step = min((abs(b - a) for a, b in zip(ticks, ticks[1:], strict=False)), default=0.0) or max(
+        (abs(t) for t in ticks), default=1.0
+    )
+    d = max(0, -math.floor(math.log10(step) + 1e-9)) if step else 0
+    while d < 12 and any(abs(round(t, d) - t) > 1e-6 * step for t in ticks):
+        d += 1
+    return d
 
 
 class _StepFormatter(Formatter):
-    """Tick labels with as many decimals as the tick spacing needs (c in N.s/mm reads 0.0015, not 0.0)."""
+    """Tick labels with the decimals the ticks need: c in N.s/mm reads 0.0015 (not 0.0), k 0.25 (not 0.2)."""
 
     ticks: tuple[float, ...] = ()
 
     def set_locs(self, locs) -> None:
-        self.ticks = tuple(locs)
+        self.ticks = tuple(float(v) for v in locs)
 
     def __call__(self, x: float, pos: int | None = None) -> str:
-        step = abs(self.ticks[1] - self.ticks[0]) if len(self.ticks) > 1 else abs(x)
-        return "0" if step and abs(x) < 1e-9 * step else f"{x:.{decimals_for(step)}f}"
+        ticks = self.ticks or (float(x),)
+        step = abs(ticks[1] - ticks[0]) if len(ticks) > 1 else abs(x)
+        return "0" if step and abs(x) < 1e-9 * step else f"{x:.{decimals_for(ticks)}f}"
 
 
 def value_formatter() -> Formatter:
