@@ -221,6 +221,32 @@ def save_screenshot(plotter, path: str | Path) -> Path:
     return p
 
 
+def _run_layers(points: np.ndarray, near: np.ndarray) -> list[Layer]:
+    """The measured runs (unit-cube points): those at the held values in black, the others grey."""
+    import pyvista as pv
+
+    layers = []
+    if near.any():
+        layers.append(
+            Layer(
+                f"runs at the held values ({int(near.sum())})",
+                pv.PolyData(points[near]),
+                color=(0, 0, 0),
+                size=4,
+            )
+        )
+    if (~near).any():
+        layers.append(
+            Layer(
+                f"other runs ({int((~near).sum())})",
+                pv.PolyData(points[~near]),
+                color=(0.55, 0.55, 0.55),
+                size=2.5,
+            )
+        )
+    return layers
+
+
 def surface_view(
     surrogate,
     response: str,
@@ -275,28 +301,10 @@ def surface_view(
         Layer("95 % PI lower", grid(pred.low), color=PI_COLOR, opacity=0.25),
         Layer("95 % PI upper", grid(pred.high), color=PI_COLOR, opacity=0.25),
     ]
-    near = _runs_near(table, held)
     runs = np.c_[
         _unit(table[x], fx.low, fx.high), _unit(table[y], fy.low, fy.high), _unit(observed, zlo, zhi)
     ]
-    if near.any():
-        layers.append(
-            Layer(
-                f"runs at the held values ({int(near.sum())})",
-                pv.PolyData(runs[near]),
-                color=(0, 0, 0),
-                size=4,
-            )
-        )
-    if (~near).any():
-        layers.append(
-            Layer(
-                f"other runs ({int((~near).sum())})",
-                pv.PolyData(runs[~near]),
-                color=(0.55, 0.55, 0.55),
-                size=2.5,
-            )
-        )
+    layers += _run_layers(runs, _runs_near(table, held))
     share = None
     if target is not None:
         mid.point_data["value"] = pred.value
