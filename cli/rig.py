@@ -69,10 +69,10 @@ def identify(
 
 
 def _write_csv(df, path: Path) -> None:
-    from designer.files import atomic_write
+    """A table written atomically, Parquet for .parquet/.pq, else CSV."""
+    from designer.data import write_frame
 
-    with atomic_write(path, newline="") as fh:
-        df.to_csv(fh, index=False)
+    write_frame(df, path)
 
 
 @rig_app.command("simulate")
@@ -143,13 +143,14 @@ def clean(
 
     Example: designer clean table.csv -o clean.csv
     """
-    import pandas as pd
 
     from designer.rig.clean import clean as run
 
     if not table.exists():
         raise DesignerError(f"no such table: {table}", "give the path of a CSV or Parquet table")
-    raw = pd.read_parquet(table) if table.suffix.lower() in (".parquet", ".pq") else pd.read_csv(table)
+    from designer.data import read_frame
+
+    raw = read_frame(table)
     res = run(raw, eps=eps, min_samples=min_samples, source=table.name)
     if output is not None:
         _write_csv(res.table, output)

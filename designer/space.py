@@ -83,7 +83,7 @@ def check_value(name: str, value: float, allow_extrapolation: bool = False) -> f
     return v
 
 
-def validate(params: Mapping[str, float], allow_extrapolation: bool = False) -> dict[str, float]:
+def check_design(params: Mapping[str, float], allow_extrapolation: bool = False) -> dict[str, float]:
     """Check a complete design (all six factors) and return it as floats in factor order."""
     unknown = [k for k in params if k not in BY_NAME]
     if unknown:

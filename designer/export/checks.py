@@ -93,7 +93,7 @@ def _libcosim_row(body: Path, t: np.ndarray, exact: np.ndarray) -> dict:
     return _row("libcosimpy step response FMI 2 CoSimulation", err, FMU_TOLERANCE["CoSimulation"])
 
 
-def check_fmu(ctx: Context) -> CheckResult:
+def check_fmus(ctx: Context) -> CheckResult:
     """FMI 2 and 3 archives pass validate_fmu; the body step response matches the analytic one in fmpy
     (co-simulation and model exchange) and in libcosimpy."""
     import tempfile
