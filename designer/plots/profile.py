@@ -201,7 +201,7 @@ def _suggestions(suggestion: Any) -> list[dict[str, Any]]:
                 "pass a Suggestion, its to_dict() or such a JSON file",
             ) from None
         try:
-            space.validate(params)
+            space.check_design(params)
             inside = True
         except DesignerError:
             inside = False  # extrapolated: listed, but the sliders cannot reach it
@@ -256,7 +256,7 @@ def build_profiler(
         raise DesignerError(
             f"tolerance={tolerance!r} is not a fraction between 0 and 1", "give e.g. tolerance=0.1"
         )
-    start = space.validate(DEFAULT_DESIGN | dict(design or {}))
+    start = space.check_design(DEFAULT_DESIGN | dict(design or {}))
     from ..suggest import predictability
 
     info = predictability(surrogate, axis)
