@@ -152,6 +152,25 @@ def test_page_opens_fast_offline_and_at_the_default_design(page, made, sur):
     assert "leave-one-out" in text and "Q2 0.43" in text
 
 
+def test_panels_show_the_runs_near_the_setting(page, sur):
+    """Per panel, the runs whose other factors lie within 25 % of their range (same levels) as points."""
+    design = _design(page)
+    runs = sur.table
+    counts = page.js(
+        "(() => { const o = {}; for (const s of document.querySelectorAll('svg[data-response]'))"
+        " o[s.dataset.response + '/' + s.dataset.factor] = s.querySelectorAll('circle.run').length;"
+        " return o; })()"
+    )
+    for f in space.FACTORS:
+        near = np.ones(len(runs), bool)
+        for g in space.FACTORS:
+            if g.name != f.name:
+                tol = 1e-9 if g.categorical else 0.25 * (g.high - g.low) + 1e-9
+                near &= np.abs(runs[g.name].to_numpy() - design[g.name]) <= tol
+        assert counts[f"k_x/{f.name}"] == counts[f"c_x/{f.name}"] == int(near.sum()), f.name
+    assert sum(counts.values()) > 0
+
+
 def test_every_slider_and_level_matches_the_library(page, sur):
     seen = {f.name: set() for f in space.FACTORS}
     for f in space.CONTINUOUS:
