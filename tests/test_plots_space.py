@@ -67,7 +67,11 @@ def test_small_values_get_readable_ticks(sur, tmp_path):
     view = space.surface_view(sur, "c_x", resolution=9)
     plotter = space.render(view, window=(600, 450))
     z = axis_labels(plotter, 2)
+    cube = plotter.renderer.cube_axes_actor
+    sizes = [cube.GetLabelTextProperty(i).GetFontSize() for i in range(3)]
+    sizes += [cube.GetTitleTextProperty(i).GetFontSize() for i in range(3)]
     plotter.close()
+    assert min(sizes) >= 14, sizes  # readable ticks and titles (they were 10)
     assert len(set(z)) == len(z) >= 3 and all(float(t) > 0 for t in z[1:]), z
     fig = loo.plot_loo(sur, responses=["c_x"])
     fig.canvas.draw()
