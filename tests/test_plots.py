@@ -79,6 +79,15 @@ def test_correlations_are_pearson(table):
     assert np.allclose(np.diag(corr), 1.0)
 
 
+def test_plots_draw_into_a_given_empty_figure(table):
+    from matplotlib.figure import Figure
+
+    mine = Figure(figsize=(5, 4))
+    assert heatmap.plot_heatmap(table, responses=["k_x"], fig=mine) is mine and mine.axes
+    with pytest.raises(DesignerError, match="fig= already holds axes"):
+        effects.plot_effects(table, responses=["k_x"], fig=mine)
+
+
 def test_heatmap_png_and_svg(table, tmp_path):
     fig = heatmap.plot_heatmap(table, responses=["c_x", "k_x"])
     assert_inside(fig)

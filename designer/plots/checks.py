@@ -9,10 +9,10 @@ from matplotlib.figure import Figure
 from .common import new_figure
 
 
-def plot_table4(compare: pd.DataFrame) -> Figure:
+def plot_table4(compare: pd.DataFrame, *, fig: Figure | None = None) -> Figure:
     """F of each source, the paper's Table 4 beside ours (`stats.compare_table4`), log scale."""
     x = np.arange(len(compare))
-    fig = new_figure(figsize=(8, 4))
+    fig = new_figure(figsize=(8, 4), fig=fig)
     ax = fig.subplots()
     ax.bar(x - 0.2, compare["F_paper"], 0.4, label="paper's Table 4", color="0.6")
     ax.bar(x + 0.2, compare["F"], 0.4, label="ours (bundled Table 3)", color="tab:blue")
@@ -27,10 +27,10 @@ def plot_table4(compare: pd.DataFrame) -> Figure:
     return fig
 
 
-def plot_identification(rows: pd.DataFrame, *, tolerance_pct: float) -> Figure:
+def plot_identification(rows: pd.DataFrame, *, tolerance_pct: float, fig: Figure | None = None) -> Figure:
     """Relative error of identified k and c per coefficient set, with the tolerance band (%)."""
     x = np.arange(len(rows))
-    fig = new_figure(figsize=(8, 3.8))
+    fig = new_figure(figsize=(8, 3.8), fig=fig)
     ax = fig.subplots()
     ax.axhspan(-tolerance_pct, tolerance_pct, color="tab:green", alpha=0.12, label=f"+/- {tolerance_pct:g} %")
     ax.plot(x - 0.1, rows["k error %"], "o", label="k")
@@ -44,9 +44,9 @@ def plot_identification(rows: pd.DataFrame, *, tolerance_pct: float) -> Figure:
     return fig
 
 
-def plot_convergence(steps: pd.DataFrame, *, unit: str) -> Figure:
+def plot_convergence(steps: pd.DataFrame, *, unit: str, fig: Figure | None = None) -> Figure:
     """Error (in `unit`) against macro step (s), log-log, every column of `steps` but "step" a line."""
-    fig = new_figure(figsize=(6, 4.2))
+    fig = new_figure(figsize=(6, 4.2), fig=fig)
     ax = fig.subplots()
     h = steps["step"].to_numpy()
     for col in steps.columns.drop("step"):

@@ -84,8 +84,18 @@ def value_formatter() -> Formatter:
     return _StepFormatter()
 
 
-def new_figure(*, figsize: tuple[float, float]) -> Figure:
-    """A figure (inches) with its own Agg canvas and constrained layout: legends and labels stay inside."""
+def new_figure(*, figsize: tuple[float, float], fig: Figure | None = None) -> Figure:
+    """The caller's empty figure `fig`, or a new one of `figsize` inches with its own Agg canvas, in
+    constrained layout (legends and labels stay inside).
+
+    Raises:
+        DesignerError: `fig` already holds axes.
+    """
+    if fig is not None:
+        if fig.axes:
+            raise DesignerError("fig= already holds axes", "pass an empty Figure, or none for a new one")
+        fig.set_layout_engine("constrained")
+        return fig
     fig = Figure(figsize=figsize, layout="constrained")
     FigureCanvasAgg(fig)
     return fig

@@ -28,10 +28,10 @@ def main_effects(table: pd.DataFrame, responses: list[str]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def plot_effects(table: pd.DataFrame, *, responses: list[str]) -> Figure:
+def plot_effects(table: pd.DataFrame, *, responses: list[str], fig: Figure | None = None) -> Figure:
     """One row of boxplots per response (rig units), one panel per factor; red lines are the medians."""
     ncol = len(space.FACTORS)
-    fig = new_figure(figsize=(2.5 * ncol, 2.9 * len(responses) + 0.4))
+    fig = new_figure(figsize=(2.5 * ncol, 2.9 * len(responses) + 0.4), fig=fig)
     axes = fig.subplots(len(responses), ncol, squeeze=False, sharey="row")
     rng = np.random.default_rng(0)  # fixed jitter: the same table gives the same picture
     for i, resp in enumerate(responses):

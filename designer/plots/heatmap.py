@@ -10,11 +10,11 @@ from ..stats import correlation
 from .common import new_figure
 
 
-def plot_heatmap(table: pd.DataFrame, *, responses: list[str]) -> Figure:
+def plot_heatmap(table: pd.DataFrame, *, responses: list[str], fig: Figure | None = None) -> Figure:
     """Annotated heat map of the Pearson correlations of factors and responses, -1 (blue) to 1 (red)."""
     corr = correlation(table, responses)
     n = len(corr)
-    fig = new_figure(figsize=(0.75 * n + 2.5, 0.75 * n + 1.5))
+    fig = new_figure(figsize=(0.75 * n + 2.5, 0.75 * n + 1.5), fig=fig)
     ax = fig.subplots()
     im = ax.imshow(corr.to_numpy(), cmap="coolwarm", vmin=-1, vmax=1)
     ax.set_xticks(range(n), corr.columns, rotation=45, ha="right")

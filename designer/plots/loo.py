@@ -24,10 +24,10 @@ def loo_table(surrogate, response: str) -> pd.DataFrame:
     ).assign(covered=lambda d: (d.observed >= d.lo) & (d.observed <= d.hi))
 
 
-def plot_loo(surrogate, *, responses: list[str] | None = None) -> Figure:
+def plot_loo(surrogate, *, responses: list[str] | None = None, fig: Figure | None = None) -> Figure:
     """One panel per response (default: all): LOO predictions with PI bars against the measurements."""
     responses = surrogate.responses if responses is None else responses
-    fig = new_figure(figsize=(5.2 * len(responses), 4.8))
+    fig = new_figure(figsize=(5.2 * len(responses), 4.8), fig=fig)
     axes = fig.subplots(1, len(responses), squeeze=False)
     for ax, resp in zip(axes[0], responses, strict=True):
         model = surrogate.model(resp)

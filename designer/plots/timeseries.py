@@ -21,6 +21,7 @@ def plot_timeseries(
     time: str = "t",
     reference: pd.DataFrame | None = None,
     panels: Mapping[str, list[str]] | None = None,
+    fig: Figure | None = None,
 ) -> Figure:
     """Columns of `frame` against `time` (s), one panel each (or grouped: `panels` maps a label to its
     columns); the same column of `reference` dashed, where it has one."""
@@ -40,7 +41,7 @@ def plot_timeseries(
         raise DesignerError(
             f"{len(panels)} signals is too many for one figure", f"pick at most {MAX_PANELS} with columns="
         )
-    fig = new_figure(figsize=(9, 1.9 * len(panels) + 0.8))
+    fig = new_figure(figsize=(9, 1.9 * len(panels) + 0.8), fig=fig)
     axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)
     for ax, (label, cols) in zip(axes[:, 0], panels.items(), strict=True):
         for col in cols:
