@@ -205,7 +205,9 @@ def _suggestions(suggestion: Any) -> list[dict[str, Any]]:
             inside = True
         except DesignerError:
             inside = False  # extrapolated: listed, but the sliders cannot reach it
-        out.append({"rank": i, "params": params, "inside": inside})
+        # factors without effect on this design (suggest's "any", e.g. density at 2 mm width)
+        free = [n for n in c.get("any", []) if n in space.FACTOR_NAMES]
+        out.append({"rank": i, "params": params, "inside": inside, "any": free})
     return out
 
 
