@@ -199,6 +199,16 @@ def test_suggestions_set_the_sliders(page, made, sur):
     assert design == pytest.approx(candidates[0]["params"], rel=1e-12)
     shown_k = float(page.js("document.getElementById('pred-k_x').dataset.value"))
     assert shown_k == pytest.approx(candidates[0]["predicted"]["k"]["value"], rel=1e-6)
+    # and `designer predict` at the page's design prints what the page prints, to 1e-9
+    exe = Path(sys.executable).with_name("designer")
+    flags = [a for name, v in design.items() for a in (f"--{name}", repr(v))]
+    run = subprocess.run([str(exe), "predict", *flags, "--json"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    printed = json.loads(run.stdout)["predicted"]
+    for q in ("k", "c"):
+        shown = page.js(f"Object.assign({{}}, document.getElementById('pred-{q}_x').dataset)")
+        for key in ("value", "low", "high"):
+            assert float(shown[key]) == pytest.approx(printed[q][key], rel=RTOL, abs=0), (q, key)
 
 
 def test_screenshot_is_a_picture(page, made):
