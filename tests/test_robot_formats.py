@@ -129,6 +129,13 @@ def test_into_a_degree_robot_keeps_every_host_unit(tmp_path):
         0.174533, 1e-6
     )
     assert flex.dof_damping[0] == host.dof_damping[0] == 0.01
+    # stepped: a torque on the elbow settles at springref + tau / k
+    flex.opt.gravity[:] = 0
+    data = mujoco.MjData(flex)
+    for _ in range(6000):
+        data.qfrc_applied[j.dofadr[0]] = 1e-3
+        mujoco.mj_step(flex, data)
+    assert data.qpos[j.qposadr[0]] == pytest.approx(math.radians(10) + 1e-3 / 0.05, rel=1e-3)
     with pytest.raises(DesignerError, match="joint_name='wrist'"):
         export_mjcf(joint, tmp_path / "x.xml", into=host_path, joint_name="wrist")
     slide = Joint.from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}})
