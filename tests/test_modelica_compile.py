@@ -13,13 +13,12 @@ touch (heat ports, supports, state selection, icons). The response is compared w
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 
 from designer import Joint
 from designer.errors import DesignerError
+from designer.export.checks import step_response
 from designer.export.modelica import export_modelica
 
 rumoca = pytest.importorskip("rumoca")
@@ -142,12 +141,6 @@ end Test;
 """
 
 
-def closed_form(t, k, c, m, load):
-    w, z = math.sqrt(k / m), c / (2 * math.sqrt(k * m))
-    wd = w * math.sqrt(1 - z * z)
-    return load / k * (1 - np.exp(-z * w * t) * (np.cos(wd * t) + z / math.sqrt(1 - z * z) * np.sin(wd * t)))
-
-
 @pytest.mark.parametrize("msl", ["4.0.0", "3.2.3"])
 def test_package_compiles_and_steps_like_the_closed_form(tmp_path, msl):
     (tmp_path / "Modelica").mkdir()
@@ -165,8 +158,8 @@ def test_package_compiles_and_steps_like_the_closed_form(tmp_path, msl):
     t = frame.index.to_numpy() if "time" not in frame else frame["time"].to_numpy()
     x = frame["joint.mass_x.s"].to_numpy()
     theta = frame["joint.inertia_theta.phi"].to_numpy()
-    assert np.max(np.abs(x - closed_form(t, 800.0, 2.0, 0.01, 2.0))) < 1e-8 * 2.0 / 800.0
-    assert np.max(np.abs(theta - closed_form(t, 0.05, 5e-4, 1e-5, 0.01))) < 1e-8 * 0.01 / 0.05
+    assert np.max(np.abs(x - step_response(0.01, 2.0, 800.0, 2.0, t))) < 1e-8 * 2.0 / 800.0
+    assert np.max(np.abs(theta - step_response(1e-5, 5e-4, 0.05, 0.01, t))) < 1e-8 * 0.01 / 0.05
 
 
 def test_modelica_refuses_unknown_msl_and_suffix(tmp_path):

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from designer.errors import DesignerError
+from designer.export.checks import step_response
 from designer.export.mjcf import export_mjcf
 from designer.export.stability import step_advice
 from designer.export.urdf import export_sdf, export_urdf
@@ -40,15 +41,6 @@ HOST = """<mujoco model="host">
   <actuator><position joint="shoulder" kp="5" ctrlrange="-90 90"/></actuator>
 </mujoco>
 """
-
-
-def step_response(t, k, c, inertia, load):
-    """Closed form of inertia q'' + c q' + k q = load from rest (underdamped)."""
-    w = math.sqrt(k / inertia)
-    z = c / (2 * math.sqrt(k * inertia))
-    wd = w * math.sqrt(1 - z * z)
-    decay = np.exp(-z * w * t)
-    return load / k * (1 - decay * (np.cos(wd * t) + z / math.sqrt(1 - z * z) * np.sin(wd * t)))
 
 
 def run_mujoco(model, steps, load=0.0, q0=0.0):
@@ -101,7 +93,7 @@ def test_snippet_has_nothing_global_and_steps_with_the_stated_k_and_c(tmp_path):
     spec.option.timestep, spec.option.gravity = 1e-5, [0, 0, 0]
     q, _ = run_mujoco(spec.compile(), 20000, load=0.01)
     t = 1e-5 * np.arange(1, 20001)
-    ref = step_response(t, 0.05, 5e-4, 1e-5, 0.01)
+    ref = step_response(1e-5, 5e-4, 0.05, 0.01, t)
     assert np.max(np.abs(q - ref)) < 2e-3 * 0.2
     assert out.advice["FlexJoint_theta"].natural_frequency == pytest.approx(
         math.sqrt(0.05 / 1e-5) / 2 / math.pi
@@ -249,7 +241,7 @@ def test_urdf_loads_in_mujoco_with_real_links_and_the_gazebo_spring(tmp_path):
     spec.joint("FlexJoint_theta").stiffness = [k, 0, 0]  # MuJoCo reads no URDF spring
     spec.option.timestep = 1e-4
     q, _ = run_mujoco(spec.compile(), 5000, load=0.01)
-    ref = step_response(1e-4 * np.arange(1, 5001), 0.05, 5e-4, 1e-5, 0.01)
+    ref = step_response(1e-5, 5e-4, 0.05, 0.01, 1e-4 * np.arange(1, 5001))
     assert np.max(np.abs(q - ref)) < 5e-3 * 0.2
 
 
@@ -275,7 +267,7 @@ def test_urdf_steps_in_pybullet_with_default_flags(tmp_path):
             q[i] = p.getJointState(body, 0, physicsClientId=client)[0]
     finally:
         p.disconnect(client)
-    ref = step_response(1e-4 * np.arange(1, 5001), 0.05, 5e-4, 1e-5, 0.01)
+    ref = step_response(1e-5, 5e-4, 0.05, 0.01, 1e-4 * np.arange(1, 5001))
     assert np.max(np.abs(q - ref)) < 1e-2 * 0.2
 
 

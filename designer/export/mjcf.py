@@ -42,8 +42,7 @@ def parallel_text(joint: Joint) -> tuple[str, dict[str, StepAdvice]]:
 
     The joint must carry masses (see `robot.with_masses`).
     """
-    bodies = robot.links(joint)
-    advice = {f"{joint.name}_{a}": adv for a, adv in robot.chain_advice(joint, bodies).items()}
+    bodies, advice = robot.chain(joint)
     notes = ["no compiler, option or default here: including this file changes nothing global"]
     opening, closing = [], []
     for depth, a in enumerate(joint.axes, start=2):

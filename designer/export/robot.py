@@ -190,21 +190,23 @@ def links(joint: Joint) -> dict[str, Sphere]:
     return out
 
 
-def chain_advice(joint: Joint, bodies: dict[str, Sphere]) -> dict[str, StepAdvice]:
-    """Step advice per axis of the joint's chain of links (each axis moves its link and those after it).
+def chain(joint: Joint) -> tuple[dict[str, Sphere], dict[str, StepAdvice]]:
+    """The joint's links per axis, and the step advice per exported joint name (`<joint>_<axis>`).
 
-    All links sit on the joint origin, so an axis sees the sum of the masses (translational) or of the
-    inertias (rotational) of its own and the following links, the other axes held: on a joint with
-    several axes that is more than the axis' own m, and the advice (which states it) uses it.
+    The links form a chain, one per axis, all on the joint origin, so an axis sees the sum of the
+    masses (translational) or of the inertias (rotational) of its own and the following links, the
+    other axes held: on a joint with several axes that is more than the axis' own m, and the advice
+    (which states it) uses it. The joint must carry masses (see `with_masses`).
     """
+    bodies = links(joint)
     order = list(joint.axes)
-    out = {}
+    advice = {}
     for i, a in enumerate(order):
         after = [bodies[b] for b in order[i:]]
         inertia = sum(s.inertia if units.is_rotational(a) else s.mass for s in after)
         si = joint.axes[a].si()
-        out[a] = step_advice(si["k"], si["c"], inertia)
-    return out
+        advice[f"{joint.name}_{a}"] = step_advice(si["k"], si["c"], inertia)
+    return bodies, advice
 
 
 def provenance_comment(joint: Joint) -> str:

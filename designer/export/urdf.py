@@ -34,8 +34,7 @@ def _gazebo(name: str, k: float, rest: float) -> list[str]:
 
 def urdf_text(joint: Joint) -> tuple[str, dict[str, robot.StepAdvice]]:
     """A fixed base link and one moving link per axis, chained; damping declared, spring in extensions."""
-    bodies = robot.links(joint)
-    advice = {f"{joint.name}_{a}": adv for a, adv in robot.chain_advice(joint, bodies).items()}
+    bodies, advice = robot.chain(joint)
     lines = ['<?xml version="1.0"?>', robot.provenance_comment(joint), f'<robot name="{joint.name}">']
     lines += [
         f'  <link name="{joint.name}_base">',
@@ -80,8 +79,7 @@ def urdf_text(joint: Joint) -> tuple[str, dict[str, robot.StepAdvice]]:
 
 def sdf_text(joint: Joint) -> tuple[str, dict[str, robot.StepAdvice]]:
     """SDFormat 1.7: the same chain, fixed to the world, with spring_stiffness/spring_reference/damping."""
-    bodies = robot.links(joint)
-    advice = {f"{joint.name}_{a}": adv for a, adv in robot.chain_advice(joint, bodies).items()}
+    bodies, advice = robot.chain(joint)
     lines = ['<?xml version="1.0"?>', robot.provenance_comment(joint), '<sdf version="1.7">']
     lines += [f'  <model name="{joint.name}">', f'    <link name="{joint.name}_base"/>']
     lines += [
