@@ -3,9 +3,10 @@
 A robot format needs real bodies, never placeholder masses: a moving body without mass breaks MuJoCo
 ("mass and inertia of moving bodies must be larger than mjMINVAL") and pybullet silently makes it 1 kg
 or recomputes its inertia from the collision shape. Each axis of a joint therefore gets a link that
-carries that axis' moving mass (translational axes) or moving inertia (rotational axes), modelled as a
-solid sphere centred on the joint origin: its inertia is isotropic, so importers that recompute inertia
-from a collision sphere of that radius (pybullet by default) get the same number.
+carries that axis' moving mass (translational axes) or moving inertia (rotational axes, with a mass
+from the design or from the pseudo-rigid-body model, see `links`), modelled as a sphere centred on the
+joint origin: its inertia is isotropic, so importers that recompute inertia from a collision sphere of
+that radius (pybullet by default) get the same number.
 """
 
 from __future__ import annotations
@@ -41,11 +42,8 @@ def sphere_with_mass(mass: float, basis: str) -> Sphere:
     return Sphere(mass, 0.4 * mass * r * r, r, basis)
 
 
-def sphere_with_inertia(inertia: float, mass: float | None, basis: str) -> Sphere:
-    """A sphere of `inertia` kg.m^2: of `mass` kg when given, else solid TPU (both from the density)."""
-    if mass is None:
-        r = (15 * inertia / (8 * math.pi * units.TPU_DENSITY)) ** (1 / 5)
-        mass = units.TPU_DENSITY * 4 / 3 * math.pi * r**3
+def sphere_with_inertia(inertia: float, mass: float, basis: str) -> Sphere:
+    """The sphere of `mass` kg with `inertia` kg.m^2 about its centre (radius from 2/5 m r^2)."""
     return Sphere(mass, inertia, math.sqrt(2.5 * inertia / mass), basis)
 
 
@@ -60,6 +58,7 @@ class RobotExport:
         return str(self.path)
 
     def to_dict(self) -> dict[str, object]:
+        """Plain data for JSON: the path and each joint's step advice."""
         return {"path": str(self.path), "advice": {n: a.to_dict() for n, a in self.advice.items()}}
 
 
