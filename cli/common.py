@@ -71,6 +71,7 @@ FLAGS: tuple[tuple[str, str], ...] = (
     (r"\baxis=(?='\w+'(, or| is | does ))", "--use-axis "),
     (r"\bform=(?='\w*' is not a form)", "--form "),
     (r"\bmsl=", "--msl "),
+    (r"\brest=(?=\S+ is for exports into)", "--rest "),
     (r"\bmotor_inertia=", "--motor-inertia "),
     (r"\bmotor_bandwidth=", "--motor-bandwidth "),
 )

@@ -355,6 +355,10 @@ def test_robot_writers_refuse_other_suffixes_naming_path(tmp_path):
     ):
         with pytest.raises(DesignerError, match="path="):
             writer(joint, tmp_path / bad)
+    with pytest.raises(DesignerError, match="rest=0.1 is for exports into a robot"):
+        export_mjcf(joint, tmp_path / "j.xml", rest=0.1)  # a snippet's springref would read as degrees
+    text = export_urdf(joint, tmp_path / "j.urdf", rest=0.1).path.read_text()
+    assert "<springReference>0.1</springReference>" in text
     with pytest.raises(DesignerError, match="m for every axis"):
         export_urdf(Joint.from_coefficients({"theta": {"k": 50.0, "c": 0.5}}), tmp_path / "j.urdf")
 

@@ -156,6 +156,12 @@ def export_mjcf(
         else:
             advice = into_parallel(joint, into, path, joint_name=joint_name, axis=axis, rest=rest)
         return robot.RobotExport(path, advice)
+    if rest != 0.0:
+        raise DesignerError(
+            f"rest={rest:g} is for exports into a robot (into=...): a standalone snippet cannot know its "
+            "host's angle unit",
+            "leave rest at 0 (the snippet's springref), or export into the robot",
+        )
     joint = robot.with_masses(joint)
     if form == "series":
         a = robot.pick_axis(joint, axis)

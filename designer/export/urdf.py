@@ -32,8 +32,9 @@ def _gazebo(name: str, k: float, rest: float) -> list[str]:
     ]
 
 
-def urdf_text(joint: Joint) -> tuple[str, dict[str, robot.StepAdvice]]:
-    """A fixed base link and one moving link per axis, chained; damping declared, spring in extensions."""
+def urdf_text(joint: Joint, *, rest: float = 0.0) -> tuple[str, dict[str, robot.StepAdvice]]:
+    """A fixed base link and one moving link per axis, chained; damping declared, spring in extensions
+    (springReference `rest`, rad or m)."""
     bodies, advice = robot.chain(joint)
     lines = ['<?xml version="1.0"?>', robot.provenance_comment(joint), f'<robot name="{joint.name}">']
     lines += [
@@ -62,7 +63,7 @@ def urdf_text(joint: Joint) -> tuple[str, dict[str, robot.StepAdvice]]:
             f'    <axis xyz="{robot.AXIS_VECTORS[a]}"/>{limit}',
             f'    <dynamics damping="{robot.num(si["c"])}" friction="0"/>',
             "  </joint>",
-            *_gazebo(name, si["k"], 0.0),
+            *_gazebo(name, si["k"], rest),
             f'  <link name="{name}_link">',
             "    " + robot.xml_comment(s.basis + "; the collision sphere has the same inertia"),
             "    <inertial>",
@@ -198,7 +199,8 @@ def export_urdf(
 ) -> robot.RobotExport:
     """Write `joint` as URDF at `path` (.urdf) and return the path and the stated step advice.
 
-    Standalone: a chain of links with real masses (see `urdf_text`). With `into` (a URDF file) and
+    Standalone: a chain of links with real masses (see `urdf_text`), every spring at `rest`. With
+    `into` (a URDF file) and
     `joint_name`: a copy of that robot with the joint's damping set and a Gazebo spring extension
     (stiffness, and `rest` in rad or m as springReference); its links are left as they are (URDF has
     no armature, so the flexure's own moving inertia is not added), and no step advice is given.
@@ -214,7 +216,7 @@ def export_urdf(
         with atomic_path(path) as tmp:
             tmp.write_bytes(data)
         return robot.RobotExport(path, {})
-    text, advice = urdf_text(robot.with_masses(joint))
+    text, advice = urdf_text(robot.with_masses(joint), rest=rest)
     with atomic_write(path) as fh:
         fh.write(text)
     return robot.RobotExport(path, advice)
