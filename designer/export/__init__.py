@@ -1,7 +1,8 @@
-"""Exporters of a Joint: FMU (FMI 2/3), Modelica package, MJCF and URDF.
+"""Exporters of a Joint: FMU (FMI 2/3), Modelica package, MJCF, URDF, SDF and SSP.
 
 Each writer takes a `designer.Joint` and a path, writes atomically, refuses a suffix that is not its
-format, and returns the path written.
+format, and returns the path written (the robot formats a `RobotExport`: the path, usable as one, and
+the step advice the file states).
 """
 
 from __future__ import annotations
