@@ -237,6 +237,9 @@ def test_urdf_loads_in_mujoco_with_real_links_and_the_gazebo_spring(tmp_path):
     assert (k, rest) == (0.05, 0.0)
     masses = [float(e.get("value")) for e in root.iter("mass")]
     assert masses[0] == 0.0 and masses[1] > 1e-3, "a fixed base and a real moving link"
+    from designer.export.urdf_inertia import moved_inertia
+
+    assert moved_inertia(root, "FlexJoint_theta") == pytest.approx(out.advice["FlexJoint_theta"].inertia)
     spec = mujoco.MjSpec.from_file(str(out.path))
     spec.joint("FlexJoint_theta").stiffness = [k, 0, 0]  # MuJoCo reads no URDF spring
     spec.option.timestep = 1e-4
@@ -285,6 +288,7 @@ def test_urdf_into_a_robot_sets_damping_and_the_spring_extension(tmp_path):
     assert root.find("gazebo[@reference='j1']/springStiffness").text == "0.05"
     assert root.find("joint/limit").get("upper") == "1.5"
     assert mujoco.MjModel.from_xml_path(str(out.path)).dof_damping[0] == 5e-4
+    assert out.advice["j1"].inertia == pytest.approx(1e-4)  # l1's inertia about y, from its <inertial>
 
 
 def test_urdf_into_a_robot_others_wrote_loads_in_pybullet(tmp_path):
@@ -314,9 +318,21 @@ def test_urdf_into_a_robot_others_wrote_loads_in_pybullet(tmp_path):
             for i in range(p.getNumJoints(body, physicsClientId=client))
         ]
         info = p.getJointInfo(body, names.index(b"panda_joint4"), physicsClientId=client)
+        # the advice's inertia against pybullet's mass matrix, the links' inertia as the file states it
+        body = p.loadURDF(
+            str(out.path), useFixedBase=True, flags=p.URDF_USE_INERTIA_FROM_FILE, physicsClientId=client
+        )
+        movable = [
+            n
+            for i, n in enumerate(names)
+            if p.getJointInfo(body, i, physicsClientId=client)[2] != p.JOINT_FIXED
+        ]
+        mass_matrix = np.array(p.calculateMassMatrix(body, [0.0] * len(movable), physicsClientId=client))
     finally:
         p.disconnect(client)
     assert info[6] == 5e-4  # jointDamping
+    k = movable.index(b"panda_joint4")
+    assert out.advice["panda_joint4"].inertia == pytest.approx(mass_matrix[k, k], rel=1e-12)
 
 
 def test_sdf_spring_becomes_a_drake_revolute_spring(tmp_path):

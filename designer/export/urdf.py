@@ -18,6 +18,8 @@ from ..errors import DesignerError
 from ..files import atomic_path, atomic_write, check_suffix
 from ..joint import Joint
 from . import robot, xmltext
+from .stability import step_advice
+from .urdf_inertia import moved_inertia
 
 #: a prismatic URDF joint needs limits; these (m) are wide enough never to act on a flexure
 PRISMATIC_LIMIT = 1.0
@@ -116,8 +118,11 @@ def sdf_text(joint: Joint) -> tuple[str, dict[str, robot.StepAdvice]]:
     return "\n".join([*lines, "  </model>", "</sdf>", ""]), advice
 
 
-def _into_urdf(joint: Joint, host: Path, *, joint_name: str, axis: str | None, rest: float) -> bytes:
-    """The host URDF's bytes with `joint_name`'s damping and Gazebo spring set; the rest as written."""
+def _into_urdf(
+    joint: Joint, host: Path, *, joint_name: str, axis: str | None, rest: float
+) -> tuple[bytes, dict[str, robot.StepAdvice]]:
+    """The host URDF's bytes with `joint_name`'s damping and Gazebo spring set, the rest as written;
+    and the joint's step advice (none when the links it moves declare no inertia)."""
     from lxml import etree
 
     if not host.is_file():
@@ -145,7 +150,9 @@ def _into_urdf(joint: Joint, host: Path, *, joint_name: str, axis: str | None, r
     si = joint.axes[a].si()
     encoding = tree.docinfo.encoding or "utf-8"
     text = _set_damping(host.read_bytes().decode(encoding), joint_name, robot.num(si["c"]))
-    return _set_spring(text, joint_name, si["k"], rest).encode(encoding)
+    moved = moved_inertia(root, joint_name)
+    advice = {joint_name: step_advice(si["k"], si["c"], moved)} if moved > 0 else {}
+    return _set_spring(text, joint_name, si["k"], rest).encode(encoding), advice
 
 
 def _set_damping(text: str, joint_name: str, damping: str) -> str:
@@ -203,7 +210,8 @@ def export_urdf(
     `into` (a URDF file) and
     `joint_name`: a copy of that robot with the joint's damping set and a Gazebo spring extension
     (stiffness, and `rest` in rad or m as springReference); its links are left as they are (URDF has
-    no armature, so the flexure's own moving inertia is not added), and no step advice is given.
+    no armature, so the flexure's own moving inertia is not added). The advice uses the inertia the
+    joint moves according to the links' `<inertial>` (see `urdf_inertia`).
 
     Raises:
         DesignerError: a wrong suffix, a missing mass, or an `into` problem.
@@ -212,10 +220,10 @@ def export_urdf(
     if into is not None:
         if joint_name is None:
             raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
-        data = _into_urdf(joint, Path(into), joint_name=joint_name, axis=axis, rest=rest)
+        data, advice = _into_urdf(joint, Path(into), joint_name=joint_name, axis=axis, rest=rest)
         with atomic_path(path) as tmp:
             tmp.write_bytes(data)
-        return robot.RobotExport(path, {})
+        return robot.RobotExport(path, advice)
     text, advice = urdf_text(robot.with_masses(joint), rest=rest)
     with atomic_write(path) as fh:
         fh.write(text)
