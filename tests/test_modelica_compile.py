@@ -1,14 +1,15 @@
 """The exported Modelica package compiled and simulated by a real compiler (Rumoca, `rumoca` on PyPI).
 
 The Modelica Standard Library is not on PyPI, so the test compiles against a minimal stand-in library
-written here from the MSL documentation: the MSL 4.0 class paths the export uses
-(Modelica.Mechanics.{Translational,Rotational}.{Interfaces.Flange_a, Interfaces.Flange_b,
-Components.SpringDamper, Components.Mass / Components.Inertia, Components.Fixed,
-Sources.ConstantForce / Sources.ConstantTorque}), their connectors (s/f, phi/tau), parameter names
-(c, d, s_rel0 / phi_rel0, m / J, f_constant / tau_constant), sign conventions, and the SI types in
-Modelica.Units.SI (MSL 4) or Modelica.SIunits (MSL 3.2.3). It leaves out what the export does not
-touch (heat ports, supports, state selection, icons). The response is compared with the closed form
-(measured: within 5e-10 of the static deflection on x, 2e-12 on theta).
+written here from the MSL documentation and class definitions (read in the MSL repository, not
+copied): the MSL 4.0 class paths the export uses (Modelica.Mechanics.{Translational,Rotational}.
+{Interfaces.Flange_a, Interfaces.Flange_b, Components.SpringDamper, Components.Mass /
+Components.Inertia, Components.Fixed, Sources.ConstantForce / Sources.ConstantTorque}), their
+connectors (s/f, phi/tau), parameter names (c, d, s_rel0 / phi_rel0, m / J, f_constant /
+tau_constant), sign conventions, and the SI types in Modelica.Units.SI (MSL 4) or Modelica.SIunits
+(MSL 3.2.3). It leaves out what the export does not touch (heat ports, supports, state selection,
+icons). The response is compared with the closed form (measured: within 5e-10 of the static
+deflection on x, 2e-12 on theta).
 """
 
 from __future__ import annotations
