@@ -16,6 +16,7 @@ import typer
 from rich.console import Console
 
 from designer.errors import DesignerError
+from designer.space import FACTOR_NAMES
 
 # the options many commands share, spelled once: -o/--output, --data, --json, --surrogate, --fix
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print machine-readable JSON only.")]
@@ -46,43 +47,50 @@ def quiet_mujoco() -> None:
     mujoco.set_mju_user_warning(lambda message: None)
 
 
-def parse_fix(items: list[str] | None) -> dict[str, float]:
-    """['width=4.5', 'raster=0'] -> {'width': 4.5, 'raster': 0.0}; names checked, each factor once.
+def parse_fix(
+    items: list[str] | None,
+    *,
+    flag: str = "--fix",
+    example: str = "width=4.5",
+    names: tuple[str, ...] | None = FACTOR_NAMES,
+) -> dict[str, float]:
+    """['width=4.5', 'raster=0'] -> {'width': 4.5, 'raster': 0.0}: NAME=VALUE pairs of `flag`.
+
+    `names` are the accepted names (default: the six factors; None accepts any name).
 
     Raises:
-        DesignerError: not NAME=VALUE, an unknown factor (with the closest name), a factor given twice,
-            or a value that is not a number (with the factor's unit).
+        DesignerError: not NAME=VALUE, an unknown name (with the closest one), a name given twice, or a
+            value that is not a number (with the factor's unit and range).
     """
     import difflib
 
     from designer import space
 
-    fixed: dict[str, float] = {}
+    pairs: dict[str, float] = {}
     for item in items or []:
         name, sep, value = item.partition("=")
         name = name.strip()
         if not sep or not name:
             raise DesignerError(
-                f"--fix '{item}' is not NAME=VALUE", "write it as, for example, --fix width=4.5"
+                f"{flag} '{item}' is not NAME=VALUE", f"write it as, for example, {flag} {example}"
             )
-        if name not in space.BY_NAME:
-            close = difflib.get_close_matches(name, space.FACTOR_NAMES, n=1)
+        if names is not None and name not in names:
+            close = difflib.get_close_matches(name, names, n=1)
             hint = f"did you mean '{close[0]}'? " if close else ""
             raise DesignerError(
-                f"unknown factor '{name}' in --fix {item}",
-                f"{hint}factors: {', '.join(space.FACTOR_NAMES)}",
+                f"unknown factor '{name}' in {flag} {item}", f"{hint}factors: {', '.join(names)}"
             )
-        if name in fixed:
-            raise DesignerError(f"--fix {name} is given twice", f"give each factor once (--fix {name}=VALUE)")
+        if name in pairs:
+            raise DesignerError(f"{flag} {name} is given twice", f"give each name once ({flag} {name}=VALUE)")
         try:
-            fixed[name] = float(value)
+            pairs[name] = float(value)
         except ValueError:
-            f = space.BY_NAME[name]
-            raise DesignerError(
-                f"--fix {item}: '{value.strip()}' is not a number",
-                f"give {name} as a number, {f.describe_range()}",
-            ) from None
-    return fixed
+            f = space.BY_NAME.get(name)
+            wanted = (
+                f"give {name} as a number, {f.describe_range()}" if f else f"write it as {flag} {example}"
+            )
+            raise DesignerError(f"{flag} {item}: '{value.strip()}' is not a number", wanted) from None
+    return pairs
 
 
 # piped output is not cut at rich's 80-column default: numbers must never be truncated
@@ -137,6 +145,16 @@ FLAGS: tuple[tuple[str, str], ...] = (
     (r"\ballow_extrapolation=True\b", "--allow-extrapolation"),
     (r"\btop=", "--top "),
     (r"\bk= and/or c=", "--k and/or --c"),
+    (r"\btargets=\{'k': 0\.8\}", "--target k=0.8"),
+    # export mjcf/urdf/sdf/modelica/ssp
+    (r"\binto=", "--into "),
+    (r"\bjoint_name=", "--joint "),
+    (r"\baxis=(?='\w+'(, or| is | does ))", "--use-axis "),
+    (r"\bform=(?='\w*' is not a form)", "--form "),
+    (r"\bmsl=", "--msl "),
+    (r"\brest=(?=\S+ is for exports into)", "--rest "),
+    (r"\bmotor_inertia=", "--motor-inertia "),
+    (r"\bmotor_bandwidth=", "--motor-bandwidth "),
 )
 
 

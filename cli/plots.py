@@ -58,7 +58,7 @@ def effects_cmd(
     _image_out(output)
     t = load_table(table)
     responses = common.responses_for(t, _quantities(response), axis)
-    path = effects.plot_effects(t, responses, output)
+    path = common.save_figure(effects.plot_effects(t, responses=responses), output)
     if as_json:
         print_json({"figure": str(path), "medians": effects.main_effects(t, responses).to_dict("records")})
     else:
@@ -86,7 +86,7 @@ def heatmap_cmd(
     _image_out(output)
     t = load_table(table)
     responses = common.responses_for(t, None, axis)
-    path = heatmap.plot_heatmap(t, responses, output)
+    path = common.save_figure(heatmap.plot_heatmap(t, responses=responses), output)
     if as_json:
         print_json({"figure": str(path), "correlations": correlation(t, responses).to_dict()})
     else:
@@ -127,7 +127,7 @@ def space_cmd(
     Example: designer plot space --x width --y height --response k --target 0.8 -o space.png --html space.html
     """
     from designer.errors import DesignerError
-    from designer.plots import space
+    from designer.plots import html3d, space
 
     _image_out(output)
     if target is not None and not target > 0:
@@ -135,21 +135,27 @@ def space_cmd(
     if html is not None:
         from designer.files import check_output
 
-        check_output(html, suffixes=[".html"])
+        check_output(html, suffixes=[".html", ".htm"])
     sur = _surrogate(surrogate)
     resp = f"{response}_{axis}"
+    fixed = parse_fix(fix)
     with progress_bar("rendering") as bar:
         if volume:
             if z is None:
                 raise DesignerError("--volume needs a third factor", "add --z, e.g. --z density")
-            view = space.plot_volume(sur, resp, [x, y, z], output, parse_fix(fix), target, html)
+            view = space.volume_view(sur, resp, factors=[x, y, z], fixed=fixed, target=target)
         else:
             if z is not None:
                 raise DesignerError("--z draws only with --volume", "add --volume or drop --z")
-            view = space.plot_surface(sur, resp, x, y, output, parse_fix(fix), target, html)
+            view = space.surface_view(sur, resp, x=x, y=y, fixed=fixed, target=target)
+        plotter = space.render(view)
+        files = [space.save_screenshot(plotter, output)]
+        plotter.close()
+        if html is not None:
+            files.append(html3d.write_scene(view.scene, html))
         bar(1.0)
     if as_json:
-        print_json(view.to_dict())
+        print_json(view.to_dict() | {"files": [str(f) for f in files]})
         return
     held = ", ".join(f"{k} {v:g}" for k, v in view.held.items())
     console.print(
@@ -159,7 +165,7 @@ def space_cmd(
         console.print(
             f"target {target:g} {view.unit} lies inside the 95 % PI over {view.target_in_pi:.0%} of the plot"
         )
-    for f in view.files:
+    for f in files:
         _saved(f)
 
 
@@ -175,7 +181,7 @@ def loo_cmd(
     Example: designer plot loo -o loo.png
     """
     from designer.errors import DesignerError
-    from designer.plots import loo
+    from designer.plots import common, loo
 
     _image_out(output)
     sur = _surrogate(surrogate)
@@ -184,7 +190,7 @@ def loo_cmd(
         raise DesignerError(
             f"the surrogate has no response on axis {axis}", f"it has {', '.join(sur.responses)}"
         )
-    path = loo.plot_loo(sur, responses, output)
+    path = common.save_figure(loo.plot_loo(sur, responses=responses), output)
     metrics = {r: dict(sur.model(r).loo, form=sur.model(r).form) for r in responses}
     if as_json:
         print_json({"figure": str(path), "loo": metrics})
@@ -214,13 +220,13 @@ def timeseries_cmd(
 
     Example: designer plot timeseries results/timeseries.csv --columns joint.x.s,joint.x.f -o ts.png
     """
-    from designer.plots import timeseries
+    from designer.plots import common, timeseries
 
     _image_out(output)
     frame = _read_series(series)
     ref = None if reference is None else _read_series(reference)
     cols = None if columns is None else [c.strip() for c in columns.split(",") if c.strip()]
-    path = timeseries.plot_timeseries(frame, output, cols, reference=ref)
+    path = common.save_figure(timeseries.plot_timeseries(frame, columns=cols, reference=ref), output)
     if as_json:
         shown = cols or [c for c in frame.columns if c != "t"]
         print_json(
@@ -295,7 +301,73 @@ def validate_cmd(
         raise typer.Exit(1)
 
 
+def profile_cmd(
+    output: Annotated[Path, typer.Option("-o", "--output", help="page to write (.html)")] = Path(
+        "profiler.html"
+    ),
+    surrogate: Surrogate = None,
+    axis: Axis = "x",
+    target: Annotated[
+        list[str] | None,
+        typer.Option("--target", help="target in rig units, QUANTITY=VALUE (repeat): k=0.8, c=2e-3"),
+    ] = None,
+    tolerance: Annotated[
+        float, typer.Option("--tolerance", help="a joint meets its target within this many %")
+    ] = 10.0,
+    suggestion: Annotated[
+        Path | None,
+        typer.Option("--suggestion", help="output of designer suggest --json: candidates to click"),
+    ] = None,
+    design: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--design", help="open at NAME=VALUE (repeat); default 60 %, 24, 4.5, 9, 0.16 mm, 0 deg"
+        ),
+    ] = None,
+    as_json: Json = False,
+) -> None:
+    """An interactive prediction profiler: one self-contained HTML page (no server, no network).
+
+    Sliders per factor, per response the prediction and its 95 % PI against each factor, targets with
+    the probability of meeting them, suggestions to click.
+
+    Example: designer profile --target k=0.8 -o profiler.html
+    """
+    from designer import space
+    from designer.errors import DesignerError
+    from designer.plots import profile
+
+    if not 0 < tolerance < 100:
+        raise DesignerError(
+            f"--tolerance {tolerance:g} is not a percentage in (0, 100)", "give e.g. --tolerance 10"
+        )
+    sur = _surrogate(surrogate)
+    targets = parse_fix(target, flag="--target", example="k=0.8", names=None)
+    start = parse_fix(design, flag="--design", example="width=3.5")
+    page = profile.build_profiler(
+        sur, axis=axis, targets=targets, tolerance=tolerance / 100, suggestion=suggestion, design=start
+    )
+    path = profile.write_profiler(page, output)
+    opened = page.data["design"]
+    if as_json:
+        preds = sur.predict(opened, responses=[r["name"] for r in page.data["responses"]])
+        print_json(
+            {
+                "page": str(path),
+                "design": opened,
+                "predicted": {r: p.at(0).to_dict() for r, p in preds.items()},
+                "accuracy": {r["name"]: r["accuracy"] for r in page.data["responses"]},
+                "suggestions": len(page.data["suggestions"]),
+            }
+        )
+        return
+    _saved(path)
+    at = ", ".join(f"{k} {v:g} {space.factor(k).unit}" for k, v in opened.items())
+    console.print(f"open it in a browser; it starts at {at}")
+
+
 def register(app: typer.Typer) -> None:
-    """Add `designer plot` to the main app."""
+    """Add `designer plot` and `designer profile` to the main app."""
     app.add_typer(plot_app, name="plot")
     app.command("validate")(validate_cmd)
+    app.command("profile")(profile_cmd)
