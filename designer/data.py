@@ -138,6 +138,12 @@ def normalise(raw: pd.DataFrame, source: str = "table") -> pd.DataFrame:
                 + ("it must be positive" if q in ("k", "m") else "it must not be negative"),
                 "check the identification of that run or remove it",
             )
+    for f in space.CONTINUOUS:  # physically possible (positive, infill at most 100 %); ranges may extend
+        for row, v in enumerate(out[f.name]):
+            try:
+                space.check_value(f.name, v, allow_extrapolation=True)
+            except DesignerError as exc:
+                raise DesignerError(f"{source}: row {row + 1}: {exc.problem}", exc.fix) from None
     for f in space.CATEGORICAL:
         levels = np.asarray(f.levels)
         off = ~np.isclose(out[f.name].to_numpy()[:, None], levels[None, :]).any(axis=1)

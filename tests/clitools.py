@@ -83,6 +83,7 @@ def make_inputs(folder: Path) -> None:
         "nocol.csv": lambda t: t.drop(columns=["height"]),
         "badunit.csv": lambda t: t.rename(columns={k: "k_x [N/m]"}),
         "levels.csv": lambda t: t.assign(layer=0.3),
+        "density500.csv": lambda t: t.assign(density=t["density"].where(t.index != 5, 500)),
     }
     for name, change in variants.items():
         change(good.copy()).to_csv(folder / name, index=False)

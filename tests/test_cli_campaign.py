@@ -51,6 +51,7 @@ BAD_TABLES = [
     "nocol.csv",
     "badunit.csv",
     "levels.csv",
+    "density500.csv",
     "missing.csv",
 ]
 TABLE_COMMANDS = {
@@ -280,6 +281,7 @@ def test_messages_name_the_problem(workdir, capsys):
         ("export", "fmu", "--from", "in/sug_typo.json"): "did you mean 'candidates'",
         ("export", "fmu", "--from", "in/sug_range.json"): "density = 500 % is more than solid",
         ("plot", "heatmap", "--data", "in/onerun.csv"): "a correlation needs at least 3 runs",
+        ("fit", "--data", "in/density500.csv"): "row 6: density = 500 % is more than solid",
         ("export", "mjcf", "--k", "1e300", "--c", "1"): "beyond any physical joint",
         ("identify", "in/side_typo.csv"): "did you mean 'load_delay_s'",
         ("rig", "simulate", *K, "--duration", "1e9", "-o", "big.csv"): "TiB",
