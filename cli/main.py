@@ -35,7 +35,9 @@ except ImportError:  # pragma: no cover - older typer on click
 REPORT_HINT = "this is a bug in designer: rerun with --debug and report the traceback"
 
 app = typer.Typer(
-    help="Design 3D-printed TPU flexible joints: predict and choose stiffness and damping, export FMUs.",
+    help="Design 3D-printed TPU flexible joints: predict and choose stiffness and damping, export FMUs.\n\n"
+    "Exit codes: 0 success, 1 negative answer (a check failed, no design meets the target), 2 bad input "
+    "or environment, 3 internal error; 130, 143, 129 when stopped by Ctrl-C, SIGTERM, SIGHUP.",
     no_args_is_help=True,
     pretty_exceptions_enable=False,
     add_completion=False,
@@ -60,8 +62,7 @@ def _options(
         bool, typer.Option("--debug", help="On an internal error, show the traceback (any position).")
     ] = False,
 ) -> None:
-    """Exit codes: 0 success, 1 negative answer (a check failed, no design meets the target), 2 bad input
-    or environment, 3 internal error; 130/143/129 when stopped by Ctrl-C, SIGTERM or SIGHUP."""
+    """Options of the `designer` command itself (--debug is also accepted after a sub-command)."""
 
 
 design.register(app)
