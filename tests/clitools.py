@@ -97,6 +97,10 @@ def make_inputs(folder: Path) -> None:
         'coefficients = { k = 330, c = 0.83 }\nreference = { type = "step", amplitude = 0.3, at = 0.1 }\n'
     )
     (folder / "binary.toml").write_bytes(bytes(range(256)))
+    arm = '[robot]\nmodel = "arm"\n[joints.j1]\naxis = "theta"\ncoefficients = { k = 330, c = 0.83 }\n'
+    (folder / "typo.toml").write_text("[simulation]\nduraton = 5\nstep = 1e-3\n" + arm)
+    (folder / "huge.toml").write_text("[simulation]\nduration = 1e9\nstep = 1e-3\n" + arm)
+    (folder / "stifness.toml").write_text(arm.replace("coefficients", "stifness"))
 
 
 FACTORS = {"density": 60, "length": 24, "width": 4.5, "height": 9, "layer": 0.16, "raster": 0}
