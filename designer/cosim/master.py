@@ -163,7 +163,7 @@ class Master:
             if not np.all(np.isfinite(values[i])):
                 raise DesignerError(
                     f"the co-simulation diverged at t = {i * step:g} s",
-                    "use a smaller step (and algorithm = \"gauss-seidel\" if the scenario uses jacobi)",
+                    'use a smaller step (and algorithm = "gauss-seidel" if the scenario uses jacobi)',
                 )
             if progress is not None and i % every == 0:
                 progress(i / n)

@@ -174,7 +174,7 @@ class Robot:
         if self._bad.number:
             raise DesignerError(
                 f"the robot diverged at t = {self.time:g} s (MuJoCo reset it)",
-                "use a smaller step (and algorithm = \"gauss-seidel\" if the scenario uses jacobi)",
+                'use a smaller step (and algorithm = "gauss-seidel" if the scenario uses jacobi)',
             )
         self._steps += 1
         self.time = self._steps * h
