@@ -249,15 +249,16 @@ def check_table_file(path: str | Path, *, parquet: bool) -> None:
     if not p.exists():
         raise DesignerError(f"no such file: {p}", "check the path")
     if p.is_dir():
-        raise DesignerError(f"{p} is a folder", "give a CSV or Parquet file")
+        raise DesignerError(f"cannot read {p}: it is a folder", "give a CSV or Parquet file")
     with open(p, "rb") as fh:
         head = fh.read(4096)
     if not head:
-        raise DesignerError(f"{p} is empty", "give a table with a header row and data rows")
+        raise DesignerError(f"cannot read {p}: it is empty", "give a table with a header row and data rows")
     if parquet != head.startswith(b"PAR1"):
         kind = "a Parquet file" if head.startswith(b"PAR1") else "not a Parquet file"
         raise DesignerError(
-            f"{p} is {kind}", "name Parquet files .parquet or .pq, and CSV files anything else"
+            f"cannot read {p}: it is {kind}",
+            "name Parquet files .parquet or .pq, and CSV files anything else",
         )
     if parquet:
         return
@@ -268,13 +269,14 @@ def check_table_file(path: str | Path, *, parquet: bool) -> None:
         text = "\0"
     if "\0" in text or b"\0" in head:
         raise DesignerError(
-            f"{p} is not a text CSV file (it holds binary data)", "give a CSV or Parquet table"
+            f"cannot read {p}: it is not a text CSV file (it holds binary data)",
+            "give a CSV or Parquet table",
         )
     if "," not in text:
         used = [name for d, name in _DELIMITERS.items() if d in text]
         if used:
             raise DesignerError(
-                f"{p} is separated by {used[0]}, not commas",
+                f"cannot read {p}: it is separated by {used[0]}, not commas",
                 "save it as comma-separated CSV (decimal point '.'), or as Parquet",
             )
 
