@@ -1,0 +1,136 @@
+"""Evaluate a batch of cases in one worker: the FMU co-simulation path, or the in-engine fast path.
+
+A task is plain data (the scenario, the path, the cases), so it pickles to any process or Dask
+worker; the worker builds its own FMU instances and MuJoCo model. A failing case becomes a row
+with status "failed" and its message; it does not stop the batch.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from .. import units
+from ..cosim.metrics import joint_metrics
+from ..cosim.scenario import JointSource, Scenario
+from ..errors import DesignerError
+from .cases import Case
+
+
+@dataclass(frozen=True)
+class Task:
+    """A batch for one worker: the scenario, the evaluation path ("fmu" | "engine") and the cases."""
+
+    scenario: Scenario
+    path: str
+    cases: tuple[Case, ...]
+
+
+@dataclass(frozen=True)
+class Trace:
+    """One case's joint angles, motor angles and deflection rates (rad, rad/s), rows at t = 0, h, ..."""
+
+    time: np.ndarray
+    q: dict[str, np.ndarray]
+    motor: dict[str, np.ndarray]
+    v: dict[str, np.ndarray]
+
+
+def si_law(src: JointSource, coefficients: dict[str, float]) -> dict[str, float]:
+    """The SI k and c of a case's joint (rig units in, on the joint's axis)."""
+    return {q: units.to_si(q, src.axis, coefficients[q]) for q in ("k", "c")}
+
+
+def metrics(sc: Scenario, trace: Trace, c_si: dict[str, float]) -> dict[str, dict]:
+    """Per-joint metrics as `designer cosim` computes them (designer.cosim.metrics.joint_metrics)."""
+    return {
+        j: joint_metrics(trace.time, trace.q[j], trace.motor[j], trace.v[j], c_si[j], sc.motors[j])
+        for j in sc.joints
+    }
+
+
+def fmu_trace(sc: Scenario, fmus: dict[str, Path], case: Case) -> tuple[Trace, dict[str, float]]:
+    """Co-simulate one case with the joint FMUs (k and c set as FMU parameters); its trace and SI c."""
+    from ..cosim.run import law, robot_run
+
+    joints = {}
+    for j, src in sc.joints.items():
+        params = dict(src.parameters)
+        params |= {f"{src.axis}.{q}": v for q, v in si_law(src, case.coefficients[j]).items()}
+        joints[j] = JointSource(axis=src.axis, fmu=fmus[j], fmi_version=src.fmi_version, parameters=params)
+    run_sc = replace(sc, joints=joints)
+    res = robot_run(run_sc, fmus, sc.step, sc.duration, sc.algorithm)
+    trace = Trace(
+        res.time,
+        {j: res.column(f"robot.{j}.q") for j in joints},
+        {j: res.column(f"robot.{j}.motor") for j in joints},
+        {j: res.column(f"robot.{j}.v") for j in joints},
+    )
+    return trace, {j: law(src, fmus[j])["c"] for j, src in joints.items()}
+
+
+def case_row(case: Case, outcome: dict | Exception, wall: float) -> dict:
+    """One table row: case number and key, inputs, k and c per joint, metrics, status, message, wall time."""
+    row: dict = {"case": case.index, "key": case.key, **case.inputs}
+    for j, coef in case.coefficients.items():
+        row.update({f"{j}.{q}": v for q, v in coef.items()})
+    if isinstance(outcome, Exception):
+        row.update({"status": "failed", "message": str(outcome)})
+    else:
+        for j, m in outcome.items():
+            row.update({f"{j}.{name}": (np.nan if v is None else v) for name, v in m.items()})
+        row.update({"status": "ok", "message": ""})
+    row["wall_s"] = wall
+    return row
+
+
+def _failure(exc: Exception) -> Exception:
+    return exc if isinstance(exc, DesignerError) else RuntimeError(f"{type(exc).__name__}: {exc}")
+
+
+def _fmu_batch(task: Task) -> list[dict]:
+    from ..cosim.run import joint_fmus
+
+    rows = []
+    with joint_fmus(task.scenario) as fmus:
+        for case in task.cases:
+            start = time.perf_counter()
+            try:
+                trace, c_si = fmu_trace(task.scenario, fmus, case)
+                outcome: dict | Exception = metrics(task.scenario, trace, c_si)
+            except Exception as exc:  # a failed case is recorded, never fatal to the sweep
+                outcome = _failure(exc)
+            rows.append(case_row(case, outcome, time.perf_counter() - start))
+    return rows
+
+
+def _engine_batch(task: Task) -> list[dict]:
+    from .engine import rollout_traces
+
+    start = time.perf_counter()
+    try:
+        outcomes = rollout_traces(task.scenario, task.cases)
+    except Exception as exc:  # e.g. a model MuJoCo cannot compile: every case of the batch fails
+        outcomes = [_failure(exc)] * len(task.cases)
+    wall = (time.perf_counter() - start) / max(len(task.cases), 1)
+    rows = []
+    for case, out in zip(task.cases, outcomes, strict=True):
+        if not isinstance(out, Exception):
+            c_si = {j: si_law(src, case.coefficients[j])["c"] for j, src in task.scenario.joints.items()}
+            out = metrics(task.scenario, out, c_si)
+        rows.append(case_row(case, out, wall))
+    return rows
+
+
+def evaluate(task: Task) -> list[dict]:
+    """The rows of a batch, in case order (the function an executor runs)."""
+    return _engine_batch(task) if task.path == "engine" else _fmu_batch(task)
+
+
+def batches(scenario: Scenario, path: str, cases: Sequence[Case], size: int) -> list[Task]:
+    """Cases split into tasks of at most `size`."""
+    return [Task(scenario, path, tuple(cases[i : i + size])) for i in range(0, len(cases), size)]
