@@ -98,7 +98,7 @@ Surrogate = Annotated[
 def _surrogate(path: Path | None):
     from designer.surrogate import Surrogate as _S
 
-    return _S.load_default() if path is None else _S.load(path)
+    return _S.load() if path is None else _S.load(path)
 
 
 def _fixed(pairs: list[str]) -> dict[str, float]:

@@ -59,7 +59,7 @@ class Context:
         if self._surrogate is None:
             from .surrogate import Surrogate
 
-            sur = Surrogate.load_default()
+            sur = Surrogate.load()
             if sur.table_hash != table_hash(self.table):
                 sur = Surrogate().fit(self.table)
             self._surrogate = sur
@@ -279,10 +279,10 @@ def check_fmu(ctx: Context) -> CheckResult:
     from fmpy.validation import validate_fmu
 
     from .export.fmu import export_fmu
-    from .joint import from_coefficients
+    from .joint import Joint
     from .plots.timeseries import plot_timeseries
 
-    joint = from_coefficients({"x": FMU_JOINT}, name="report_joint")
+    joint = Joint.from_coefficients({"x": FMU_JOINT}, name="report_joint")
     m, c, k = (joint.axes["x"].si()[q] for q in ("m", "c", "k"))
     rows, curves = [], {}
     t = np.linspace(0.0, FMU_STOP, int(round(FMU_STOP / 1e-3)) + 1)
@@ -426,11 +426,11 @@ def check_cosim(ctx: Context) -> CheckResult:
     from .cosim import run
     from .cosim.references import Sine, Step
     from .cosim.scenario import JointSource, Scenario
-    from .joint import from_coefficients
+    from .joint import Joint
     from .plots.checks import plot_convergence
     from .plots.timeseries import plot_timeseries
 
-    joint = JointSource(axis="theta", joint=from_coefficients({"theta": {"k": 330.0, "c": 0.83}}))
+    joint = JointSource(axis="theta", joint=Joint.from_coefficients({"theta": {"k": 330.0, "c": 0.83}}))
     sc = Scenario(
         path=Path("two-link arm (report)"),
         kind="robot",

@@ -157,20 +157,20 @@ def _suggestion(tmp_path):
     from designer.suggest import suggest
     from designer.surrogate import Surrogate
 
-    doc = suggest(Surrogate.load_default(), k=0.8, fixed={"length": 24}, top=2).to_dict()
+    doc = suggest(Surrogate.load(), k=0.8, fixed={"length": 24}, top=2).to_dict()
     (tmp_path / "s.json").write_text(json.dumps(doc))
     return doc
 
 
 def test_joints_from_a_design_and_a_suggestion_run_through_the_surrogate(tmp_path):
-    from designer.export import sources
+    from designer import Joint
 
     doc = _suggestion(tmp_path)
     text = ARM.format(duration=0.3, step=1e-3, joint2='suggestion = "s.json"\ncandidate = 2')
     sc = load(write(tmp_path, text.replace("coefficients = { k = 330, c = 0.83 }", DESIGN_TOML)))
     expect = {
-        "j1": sources.from_design(DESIGN, ["theta"]).axes["theta"],
-        "j2": sources.from_suggestion(tmp_path / "s.json", 2, ["theta"]).axes["theta"],
+        "j1": Joint.from_design(DESIGN, axes=["theta"]).axes["theta"],
+        "j2": Joint.from_suggestion(tmp_path / "s.json", candidate=2, axes=["theta"]).axes["theta"],
     }
     # the suggestion's k on x (N/mm) taken to theta with the PRB model: K = k (0.85 L)^2
     k2 = doc["candidates"][1]["predicted"]["k"]["value"] * (0.85 * 24) ** 2

@@ -19,7 +19,7 @@ else:
 
 from .. import units
 from ..errors import DesignerError
-from ..joint import Joint, from_coefficients
+from ..joint import Joint
 from .master import ALGORITHMS
 from .references import Chirp, Reference, Sine, Step, Trajectory
 from .robot import ARM_LENGTHS, ARM_MASSES, INTEGRATORS
@@ -175,16 +175,14 @@ def _joint_source(spec: Any, key: str, path: Path, default_axis: str, name: str)
 
 def _joint(spec: dict, key: str, path: Path, axis: str, name: str) -> Joint:
     """The joint of a coefficients, design (through the default surrogate) or suggestion source."""
-    from ..export import sources
-
     if "suggestion" in spec:
         candidate = spec.get("candidate", 1)
         if isinstance(candidate, bool) or not isinstance(candidate, int):
             raise DesignerError(
                 f"{_where(path, key)}.candidate = {candidate!r} is not a whole number", "1 = best"
             )
-        return sources.from_suggestion(
-            _file(spec["suggestion"], f"{key}.suggestion", path), candidate, [axis], name
+        return Joint.from_suggestion(
+            _file(spec["suggestion"], f"{key}.suggestion", path), candidate=candidate, axes=[axis], name=name
         )
     if "design" in spec:
         design = spec["design"]
@@ -193,14 +191,14 @@ def _joint(spec: dict, key: str, path: Path, axis: str, name: str) -> Joint:
                 f"{_where(path, key)}.design must be a table of the six print settings",
                 "e.g. {density = 60, length = 24, width = 4.5, height = 9, layer = 0.16, raster = 45}",
             )
-        return sources.from_design(design, [axis], name)
+        return Joint.from_design(design, axes=[axis], name=name)
     coef = spec["coefficients"]
     if not isinstance(coef, dict) or not {"k", "c"} <= set(coef):
         raise DesignerError(
             f"{_where(path, key)}.coefficients needs k and c (rig units)", "e.g. {k = 300, c = 0.8, m = 2e-6}"
         )
     coef = {q: _number(coef, q, path, positive=q != "c") for q in coef}
-    return from_coefficients({axis: coef}, name=name)
+    return Joint.from_coefficients({axis: coef}, name=name)
 
 
 def load(path: str | Path) -> Scenario:
