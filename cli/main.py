@@ -8,7 +8,7 @@ import typer
 
 from designer.errors import DesignerError
 
-from . import cosim, design, export, plots, rig
+from . import cosim, design, export, plots, rig, sweep
 
 app = typer.Typer(
     help="Design 3D-printed TPU flexible joints: predict and choose stiffness and damping, export FMUs.",
@@ -22,6 +22,7 @@ rig.register(app)
 export.register(app)
 cosim.register(app)
 plots.register(app)
+sweep.register(app)
 
 
 def main() -> None:

@@ -50,7 +50,9 @@ def finish(cases: list[Case], spec: Spec) -> list[Case]:
     for case in cases:
         coefficients = {j: case.coefficients.get(j, base[j]) for j in spec.scenario.joints}
         payload = json.dumps({"c": coefficients, "ctx": context}, sort_keys=True)
-        out.append(replace(case, coefficients=coefficients, key=hashlib.sha256(payload.encode()).hexdigest()[:20]))
+        out.append(
+            replace(case, coefficients=coefficients, key=hashlib.sha256(payload.encode()).hexdigest()[:20])
+        )
     return out
 
 
@@ -85,13 +87,15 @@ def design_of(spec: Spec, joint: str) -> dict[str, float]:
 
 
 def load_surrogate(spec: Spec) -> Surrogate:
-    return Surrogate.load(spec.surrogate) if spec.surrogate is not None else Surrogate.load_default()
+    return Surrogate.load(spec.surrogate)
 
 
 def _predicted(surrogate: Surrogate, design: dict[str, float], axis: str) -> dict[str, float]:
     src = source_axis(surrogate, axis)
-    pred = surrogate.predict({k: [v] for k, v in design.items()}, [f"k_{src}", f"c_{src}"])
-    k, c = on_axis(float(pred[f"k_{src}"].value[0]), float(pred[f"c_{src}"].value[0]), src, axis, design["length"])
+    pred = surrogate.predict(design, responses=[f"k_{src}", f"c_{src}"])
+    k, c = on_axis(
+        float(pred[f"k_{src}"].value[0]), float(pred[f"c_{src}"].value[0]), src, axis, design["length"]
+    )
     return {"k": k, "c": c}
 
 
@@ -129,13 +133,15 @@ def grid(spec: Spec) -> list[Case]:
 
 def suggestion(spec: Spec) -> list[Case]:
     """One case per combination of suggestion candidates over the sweep's joints."""
-    from ..export.sources import from_suggestion
+    from ..joint import Joint
 
     path: Path = spec.cases.file
     try:
         n = len(json.loads(path.read_text())["candidates"])
     except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise DesignerError(f"cannot read a suggestion from {path}: {exc}", "give 'designer suggest --json' output") from None
+        raise DesignerError(
+            f"cannot read a suggestion from {path}: {exc}", "give 'designer suggest --json' output"
+        ) from None
     numbers = spec.cases.candidates or tuple(range(1, n + 1))
     joints = list(spec.cases.joints)
     cases = []
@@ -143,7 +149,7 @@ def suggestion(spec: Spec) -> list[Case]:
         coefficients, inputs = {}, {}
         for j, cand in zip(joints, combo, strict=True):
             src = spec.scenario.joints[j]
-            joint = from_suggestion(path, cand, [src.axis], f"joint_{j}")
+            joint = Joint.from_suggestion(path, candidate=cand, axes=[src.axis], name=f"joint_{j}")
             ac = joint.axis(src.axis)
             coefficients[j] = {"k": ac.k, "c": ac.c}
             inputs[f"{j}.candidate"] = float(cand)
@@ -163,7 +169,9 @@ def montecarlo(spec: Spec) -> list[Case]:
     cases = []
     for i in range(n):
         coefficients = {j: {"k": float(d["k"][i]), "c": float(d["c"][i])} for j, d in draws.items()}
-        inputs = {f"{j}.{q}": float(v[i]) for j, d in draws.items() for q, v in d.items() if q not in ("k", "c")}
+        inputs = {
+            f"{j}.{q}": float(v[i]) for j, d in draws.items() for q, v in d.items() if q not in ("k", "c")
+        }
         cases.append(Case(i, coefficients, inputs))
     return cases
 

@@ -45,7 +45,9 @@ def rollout_traces(sc: Scenario, cases: Sequence[Case]) -> list[Trace | Exceptio
     offsets = _offsets(sc)
     laws = [{j: si_law(sc.joints[j], case.coefficients[j]) for j in joints} for case in cases]
     first = {j: SpringDamper(laws[0][j]["k"], laws[0][j]["c"], offsets[j]) for j in joints}
-    robot = Robot(load_spec(sc.model, sc.lengths, sc.masses), sc.motors, sc.step, sc.integrator, in_engine=first)
+    robot = Robot(
+        load_spec(sc.model, sc.lengths, sc.masses), sc.motors, sc.step, sc.integrator, in_engine=first
+    )
     base = robot.model
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     state0 = np.empty(mujoco.mj_stateSize(base, spec))

@@ -60,7 +60,8 @@ def _cluster(cluster: Mapping[str, Any]) -> Any:
         from dask_jobqueue import SLURMCluster
     except ImportError:
         raise DesignerError(
-            "a SLURM cluster needs dask-jobqueue", 'install it: pip install "flexjoint-designer[cluster]" dask-jobqueue'
+            "a SLURM cluster needs dask-jobqueue",
+            'install it: pip install "flexjoint-designer[cluster]" dask-jobqueue',
         ) from None
     settings = dict(cluster["slurm"])
     jobs = int(settings.pop("jobs", 1))
@@ -101,5 +102,7 @@ def executor(
         try:
             client = stack.enter_context(distributed.Client(address, timeout="20s"))
         except OSError as exc:
-            raise DesignerError(f"cannot reach the Dask scheduler at {address}: {exc}", "check the address") from None
+            raise DesignerError(
+                f"cannot reach the Dask scheduler at {address}: {exc}", "check the address"
+            ) from None
         yield client.get_executor()

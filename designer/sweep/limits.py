@@ -16,6 +16,8 @@ METRICS: dict[str, tuple[str, str]] = {
     "overshoot": ("overshoot_pct", "%"),
     "settling_time": ("settling_time_s", "s"),
 }
+#: metrics defined only for a joint whose motor reference is a step
+STEP_METRICS = ("overshoot_pct", "settling_time_s")
 _LIMIT = re.compile(r"^\s*([a-z_]+)\s*(<=|>=)\s*([-+0-9.eE]+)\s*([a-zA-Z%]*)\s*$")
 
 
@@ -25,6 +27,13 @@ def metric(name: str) -> str:
         if name in (short, column):
             return column
     raise DesignerError(f"unknown metric '{name}'", f"use one of: {', '.join(METRICS)}")
+
+
+def applies(column: str, reference: object) -> bool:
+    """Whether a metric is defined for a joint with this motor reference (step metrics need a step)."""
+    from ..cosim.references import Step
+
+    return column not in STEP_METRICS or isinstance(reference, Step)
 
 
 def unit(column: str) -> str:
@@ -70,7 +79,9 @@ def parse_limit(text: str) -> Limit:
     column = metric(name)
     expected = unit(column)
     if given_unit and given_unit != expected:
-        raise DesignerError(f"limit {text!r}: {name} is in {expected}, not {given_unit}", f"write it in {expected}")
+        raise DesignerError(
+            f"limit {text!r}: {name} is in {expected}, not {given_unit}", f"write it in {expected}"
+        )
     try:
         number = float(value)
     except ValueError:

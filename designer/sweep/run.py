@@ -91,9 +91,10 @@ def evaluate_cases(
     resumed = len(cases) - len(todo)
     new: dict[str, dict] = {}
     if todo:
-        from .executors import local_workers
+        from .executors import SerialExecutor, local_workers
 
-        size = _batch_size(spec, len(todo), local_workers(spec.workers))
+        workers = 1 if isinstance(executor, SerialExecutor) else local_workers(spec.workers)
+        size = _batch_size(spec, len(todo), workers)
         tasks = batches(spec.scenario, spec.path, todo, size)
         log = open(journal, "a") if journal is not None else contextlib.nullcontext()  # noqa: SIM115
         with _default_executor(spec, executor) as ex, log as fh:

@@ -107,16 +107,22 @@ def _values(spec: Any, key: str, path: Path) -> list[float]:
 def _cases(doc: dict, path: Path, scenario: Scenario) -> Cases:
     table = doc.get("cases")
     if not isinstance(table, dict) or table.get("type") not in CASE_TYPES:
-        raise DesignerError(f"{path.name} needs a [cases] table with a type", f"type = one of {', '.join(CASE_TYPES)}")
+        raise DesignerError(
+            f"{path.name} needs a [cases] table with a type", f"type = one of {', '.join(CASE_TYPES)}"
+        )
     kind = table["type"]
     joints = table.get("joints", list(scenario.joints) if kind != "grid" else None)
     if kind == "grid":
         if not isinstance(joints, dict) or not joints:
-            raise DesignerError(f"{_where(path, 'cases.joints')} must map joints to grid axes", "see the README")
+            raise DesignerError(
+                f"{_where(path, 'cases.joints')} must map joints to grid axes", "see the README"
+            )
         grid = {}
         for j, axes in joints.items():
             if not isinstance(axes, dict) or not axes:
-                raise DesignerError(f"{_where(path, 'cases.joints.' + j)} must be a table of axes", "e.g. {k = [..]}")
+                raise DesignerError(
+                    f"{_where(path, 'cases.joints.' + j)} must be a table of axes", "e.g. {k = [..]}"
+                )
             grid[j] = {q: _values(v, f"cases.joints.{j}.{q}", path) for q, v in axes.items()}
         return Cases(type=kind, joints=grid)
     if not isinstance(joints, list) or not all(isinstance(j, str) for j in joints):
@@ -127,11 +133,15 @@ def _cases(doc: dict, path: Path, scenario: Scenario) -> Cases:
         file = (path.parent / table["file"]).resolve()
         cands = table.get("candidates", [])
         if not isinstance(cands, list) or not all(isinstance(c, int) and c >= 1 for c in cands):
-            raise DesignerError(f"{_where(path, 'cases.candidates')} must list numbers >= 1", "e.g. [1, 2, 3]")
+            raise DesignerError(
+                f"{_where(path, 'cases.candidates')} must list numbers >= 1", "e.g. [1, 2, 3]"
+            )
         return Cases(type=kind, joints={j: None for j in joints}, file=file, candidates=tuple(cands))
     designs = table.get("designs", {})
     if not isinstance(designs, dict) or not all(isinstance(d, dict) for d in designs.values()):
-        raise DesignerError(f"{_where(path, 'cases.designs')} must map joints to print settings", "see the README")
+        raise DesignerError(
+            f"{_where(path, 'cases.designs')} must map joints to print settings", "see the README"
+        )
     return Cases(
         type=kind,
         joints={j: None for j in joints},
@@ -151,7 +161,9 @@ def _cluster(doc: dict, path: Path) -> dict[str, Any]:
     if "workers" in cluster:
         _count(cluster, "workers", path, None)
     if "slurm" in cluster and not isinstance(cluster["slurm"], dict):
-        raise DesignerError(f"{_where(path, 'cluster.slurm')} must be a table", "e.g. {cores = 4, memory = '8GB'}")
+        raise DesignerError(
+            f"{_where(path, 'cluster.slurm')} must be a table", "e.g. {cores = 4, memory = '8GB'}"
+        )
     return dict(cluster)
 
 
@@ -216,10 +228,14 @@ def check(spec: Spec) -> Spec:
     if spec.path not in PATHS:
         raise DesignerError(f"path={spec.path!r} is not allowed", "use path='fmu' or path='engine'")
     if spec.cases.type not in CASE_TYPES:
-        raise DesignerError(f"cases type {spec.cases.type!r} is unknown", f"use one of {', '.join(CASE_TYPES)}")
+        raise DesignerError(
+            f"cases type {spec.cases.type!r} is unknown", f"use one of {', '.join(CASE_TYPES)}"
+        )
     for j in spec.cases.joints:
         if j not in sc.joints:
-            raise DesignerError(f"the sweep varies joint '{j}' the scenario lacks", f"it has {', '.join(sc.joints)}")
+            raise DesignerError(
+                f"the sweep varies joint '{j}' the scenario lacks", f"it has {', '.join(sc.joints)}"
+            )
     if spec.cases.type == "montecarlo" and not spec.cases.n:
         raise DesignerError("a Monte Carlo sweep needs a number of draws", "give n (e.g. n = 200)")
     return spec

@@ -1,4 +1,4 @@
-"""A sweep's summary (percentiles, share meeting the task limits, the engine path's check), its files and plots."""
+"""A sweep's summary (percentiles, share meeting the limits, the engine path's check), its files, its plot."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import pandas as pd
 from .. import space, units
 from ..files import atomic_path, atomic_write
 from .cases import Case
-from .limits import METRICS
+from .limits import METRICS, applies
 from .spec import Spec
 
 PERCENTILES = (5, 50, 95)
@@ -57,7 +57,8 @@ def percentiles(frame: pd.DataFrame, columns: Sequence[str]) -> dict[str, dict]:
 
 
 def limit_shares(spec: Spec, frame: pd.DataFrame) -> dict:
-    """Share of all cases meeting each limit at every joint, and all limits at once (failed cases do not)."""
+    """Share of all cases meeting each limit at every joint it applies to (step metrics: joints with a
+    step reference), and all limits at once; failed cases meet none."""
     if not spec.limits or frame.empty:
         return {}
     ok = (frame["status"] == "ok").to_numpy()
@@ -66,6 +67,8 @@ def limit_shares(spec: Spec, frame: pd.DataFrame) -> dict:
     for limit in spec.limits:
         met = ok.copy()
         for j in spec.scenario.joints:
+            if not applies(limit.metric, spec.scenario.motors[j]):
+                continue
             col = f"{j}.{limit.metric}"
             values = frame[col].to_numpy(dtype=float) if col in frame else np.full(len(frame), np.nan)
             met &= np.array([limit.met(v) for v in values])
@@ -86,7 +89,9 @@ def engine_check(spec: Spec, cases: Sequence[Case], frame: pd.DataFrame) -> dict
     finished = [c for c in cases if c.key in ok]
     if not finished:
         return None
-    picks = [finished[i] for i in np.unique(np.linspace(0, len(finished) - 1, spec.check).round().astype(int))]
+    picks = [
+        finished[i] for i in np.unique(np.linspace(0, len(finished) - 1, spec.check).round().astype(int))
+    ]
     sc = spec.scenario
     engine = rollout_traces(sc, picks)
     angle, metric_diff = 0.0, {}
@@ -150,9 +155,9 @@ def write_results(result, folder: str | Path, *, plot: bool = True) -> list[Path
 
 def plot_metrics(result, path: str | Path) -> Path:
     """One histogram per metric column with its 5/50/95 % percentiles (dashed) and the task limits (red)."""
-    from ..plots.common import save_figure
-
     import matplotlib.pyplot as plt
+
+    from ..plots.common import save_figure
 
     pct = result.summary["percentiles"]
     cols = [c for c, p in pct.items() if p["n"]]

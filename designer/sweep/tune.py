@@ -28,7 +28,7 @@ from ..errors import DesignerError
 from ..surrogate import Surrogate
 from .cases import Case, finish
 from .draws import on_axis, source_axis
-from .limits import Limit, metric
+from .limits import Limit, applies, metric
 from .run import evaluate_cases
 from .spec import Cases, Spec
 
@@ -83,35 +83,29 @@ def reachable(surrogate: Surrogate, axis: str) -> dict[str, tuple[float, float]]
     """
     src = source_axis(surrogate, axis)
     grid = _level_grid()
-    pred = surrogate.predict(grid, [f"k_{src}", f"c_{src}"])
+    pred = surrogate.predict(grid, responses=[f"k_{src}", f"c_{src}"])
     out = {}
     for q in ("k", "c"):
         p = pred[f"{q}_{src}"]
-        lo, hi = (p.value, p.value) if surrogate.model(f"{q}_{src}").predictable else (_low(p), _high(p))
+        lo, hi = (p.value, p.value) if surrogate.model(f"{q}_{src}").predictable else (p.low, p.high)
         scale = np.array([on_axis(1.0, 1.0, src, axis, length)[0] for length in grid["length"]])
         out[q] = (float(np.min(lo * scale)), float(np.max(hi * scale)))
     return out
 
 
-def _low(p):  # Prediction fields were lo/hi, then low/high
-    return getattr(p, "low", None) if hasattr(p, "low") else p.lo
-
-
-def _high(p):
-    return getattr(p, "high", None) if hasattr(p, "high") else p.hi
-
-
-def score(row: Mapping, joints: Sequence[str], objective: str, limits: Sequence[Limit]) -> float:
-    """The minimised score of one evaluated case (see the module's docstring)."""
+def score(row: Mapping, sc: Scenario, objective: str, limits: Sequence[Limit]) -> float:
+    """The minimised score of one evaluated case (see the module's docstring); step metrics count
+    at the joints with a step reference only."""
     if row.get("status") != "ok":
         return FAILED
     excess = 0.0
     for limit in limits:
-        for j in joints:
-            excess += min(limit.excess(_value(row, f"{j}.{limit.metric}")), 1e3)
+        for j in sc.joints:
+            if applies(limit.metric, sc.motors[j]):
+                excess += min(limit.excess(_value(row, f"{j}.{limit.metric}")), 1e3)
     if excess > 0:
         return INFEASIBLE * (1.0 + excess)
-    values = [_value(row, f"{j}.{objective}") for j in joints]
+    values = [_value(row, f"{j}.{objective}") for j in sc.joints if applies(objective, sc.motors[j])]
     if any(v is None for v in values):
         return MISSING
     return float(sum(values))
@@ -130,14 +124,18 @@ def _bounds(
         reach = None
         for q in ("k", "c"):
             if f"{j}.{q}" not in given:
-                reach = reach or reachable(surrogate or Surrogate.load_default(), sc.joints[j].axis)
+                reach = reach or reachable(surrogate or Surrogate.load(), sc.joints[j].axis)
         out[j] = {q: tuple(map(float, given.get(f"{j}.{q}") or reach[q])) for q in ("k", "c")}
         for q, (lo, hi) in out[j].items():
             if not 0 < lo <= hi or not math.isfinite(hi):
-                raise DesignerError(f"bounds of {j}.{q} ({lo:g} to {hi:g}) are not usable", "give 0 < low <= high")
+                raise DesignerError(
+                    f"bounds of {j}.{q} ({lo:g} to {hi:g}) are not usable", "give 0 < low <= high"
+                )
     for key in given:
         if key.partition(".")[0] not in joints:
-            raise DesignerError(f"bounds given for {key}, not a tuned joint", f"tuned joints: {', '.join(joints)}")
+            raise DesignerError(
+                f"bounds given for {key}, not a tuned joint", f"tuned joints: {', '.join(joints)}"
+            )
     return out
 
 
@@ -184,10 +182,14 @@ def tune(
     objective = metric(objective)
     if scenario.kind != "robot":
         raise DesignerError("tune needs a robot scenario", "give a scenario with [robot] and [joints]")
+    if not any(applies(objective, ref) for ref in scenario.motors.values()):
+        raise DesignerError(f"no joint of the scenario has {objective}", "give a joint a step reference")
     joints = list(joints or scenario.joints)
     unknown = [j for j in joints if j not in scenario.joints]
     if unknown:
-        raise DesignerError(f"the scenario has no joint {', '.join(unknown)}", f"it has {', '.join(scenario.joints)}")
+        raise DesignerError(
+            f"the scenario has no joint {', '.join(unknown)}", f"it has {', '.join(scenario.joints)}"
+        )
     box = _bounds(scenario, joints, dict(bounds or {}), surrogate)
     spec = Spec(scenario=scenario, cases=Cases(type="grid"), path=path, limits=tuple(limits), check=0)
     keys = [(j, q) for j in joints for q in ("k", "c")]
@@ -206,7 +208,7 @@ def tune(
             cases = finish([Case(next(count), coefficients(x)) for x in xs.T], spec)
             rows, _ = evaluate_cases(spec, cases, executor=ex)
             evaluations[0] += len(rows)
-            return np.array([score(r, list(scenario.joints), objective, limits) for r in rows])
+            return np.array([score(r, scenario, objective, limits) for r in rows])
 
         generation = itertools.count(1)
         result = differential_evolution(
@@ -218,7 +220,9 @@ def tune(
             polish=False,
             updating="deferred",
             vectorized=True,
-            callback=None if progress is None else (lambda *a, **k: progress(next(generation) / (maxiter + 1))),
+            callback=None
+            if progress is None
+            else (lambda *a, **k: progress(next(generation) / (maxiter + 1))),
         )
         best = coefficients(result.x)
         tuned = TuneResult(
@@ -232,7 +236,7 @@ def tune(
         )
         _confirm(tuned, spec, best, ex)
         if surrogate is not None or robustness:
-            _designs(tuned, spec, surrogate or Surrogate.load_default(), robustness, seed, ex)
+            _designs(tuned, spec, surrogate or Surrogate.load(), robustness, seed, ex)
     if progress is not None:
         progress(1.0)
     return tuned
@@ -251,13 +255,20 @@ def _confirm(tuned: TuneResult, spec: Spec, best: dict, ex: Executor) -> None:
         diffs = {
             k: abs(v - fmu_rows[0][k])
             for k, v in rows[0].items()
-            if k in fmu_rows[0] and isinstance(v, float) and k.count(".") and math.isfinite(v)
-            and isinstance(fmu_rows[0][k], float) and math.isfinite(fmu_rows[0][k]) and k.split(".")[1] not in ("k", "c")
+            if k in fmu_rows[0]
+            and isinstance(v, float)
+            and k.count(".")
+            and math.isfinite(v)
+            and isinstance(fmu_rows[0][k], float)
+            and math.isfinite(fmu_rows[0][k])
+            and k.split(".")[1] not in ("k", "c")
         }
         tuned.fmu_check = {"status": fmu_rows[0]["status"], "max_metric_difference": diffs}
 
 
-def _designs(tuned: TuneResult, spec: Spec, surrogate: Surrogate, draws: int, seed: int, ex: Executor) -> None:
+def _designs(
+    tuned: TuneResult, spec: Spec, surrogate: Surrogate, draws: int, seed: int, ex: Executor
+) -> None:
     """Suggest designs for each tuned joint, then a Monte Carlo sweep over the best designs' PIs."""
     from ..suggest import suggest
     from .cases import make_cases
@@ -283,7 +294,9 @@ def _designs(tuned: TuneResult, spec: Spec, surrogate: Surrogate, draws: int, se
         return
     from dataclasses import replace
 
-    mc = replace(spec, cases=Cases(type="montecarlo", joints=dict.fromkeys(chosen), n=draws, seed=seed, designs=chosen))
+    mc = replace(
+        spec, cases=Cases(type="montecarlo", joints=dict.fromkeys(chosen), n=draws, seed=seed, designs=chosen)
+    )
     cases = make_cases(mc)
     rows, _ = evaluate_cases(mc, cases, executor=ex)
     summary = summarize(mc, table(rows), cases)
