@@ -166,15 +166,16 @@ def tune(
 
     if path not in ("fmu", "engine"):
         raise DesignerError(f"--path {path} is not allowed", "use --path engine or --path fmu")
-    sc = cosim.load(scenario)
     limits = [parse_limit(x) for x in limit or []]
+    box = _parse_bounds(bounds or [])
+    sc = cosim.load(scenario)
     with executor(workers=workers, scheduler=scheduler) as ex:
         with progress(f"tuning {scenario.name}", enabled=not json_out) as bar:
             result = run_tune(
                 sc,
                 objective=objective,
                 limits=limits,
-                bounds=_parse_bounds(bounds or []),
+                bounds=box,
                 path=path,
                 executor=ex,
                 robustness=robustness,

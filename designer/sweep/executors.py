@@ -105,4 +105,4 @@ def executor(
             raise DesignerError(
                 f"cannot reach the Dask scheduler at {address}: {exc}", "check the address"
             ) from None
-        yield client.get_executor()
+        yield client.get_executor(pure=False)

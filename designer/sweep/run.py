@@ -9,6 +9,7 @@ from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Executor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import IO
 
 import pandas as pd
 
@@ -76,6 +77,19 @@ def _failed_rows(task: Task, exc: BaseException) -> list[dict]:
     return [case_row(case, message, math.nan) for case in task.cases]
 
 
+@contextlib.contextmanager
+def _journal(path: Path | None) -> Iterator[IO | None]:
+    """The journal opened for appending, after the newline an interrupted run may not have written."""
+    if path is None:
+        yield None
+        return
+    torn = path.is_file() and path.stat().st_size > 0 and not path.read_bytes().endswith(b"\n")
+    with open(path, "a") as fh:
+        if torn:
+            fh.write("\n")
+        yield fh
+
+
 def evaluate_cases(
     spec: Spec,
     cases: Sequence[Case],
@@ -96,8 +110,7 @@ def evaluate_cases(
         workers = 1 if isinstance(executor, SerialExecutor) else local_workers(spec.workers)
         size = _batch_size(spec, len(todo), workers)
         tasks = batches(spec.scenario, spec.path, todo, size)
-        log = open(journal, "a") if journal is not None else contextlib.nullcontext()  # noqa: SIM115
-        with _default_executor(spec, executor) as ex, log as fh:
+        with _default_executor(spec, executor) as ex, _journal(journal) as fh:
             futures = {ex.submit(evaluate, task): task for task in tasks}
             finished = 0
             for future in as_completed(futures):

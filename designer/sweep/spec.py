@@ -111,6 +111,12 @@ def _cases(doc: dict, path: Path, scenario: Scenario) -> Cases:
             f"{path.name} needs a [cases] table with a type", f"type = one of {', '.join(CASE_TYPES)}"
         )
     kind = table["type"]
+    designs = table.get("designs", {})
+    if not isinstance(designs, dict) or not all(isinstance(d, dict) for d in designs.values()):
+        raise DesignerError(
+            f"{_where(path, 'cases.designs')} must map joints to print settings", "see the README"
+        )
+    designs = {j: dict(d) for j, d in designs.items()}
     joints = table.get("joints", list(scenario.joints) if kind != "grid" else None)
     if kind == "grid":
         if not isinstance(joints, dict) or not joints:
@@ -124,7 +130,7 @@ def _cases(doc: dict, path: Path, scenario: Scenario) -> Cases:
                     f"{_where(path, 'cases.joints.' + j)} must be a table of axes", "e.g. {k = [..]}"
                 )
             grid[j] = {q: _values(v, f"cases.joints.{j}.{q}", path) for q, v in axes.items()}
-        return Cases(type=kind, joints=grid)
+        return Cases(type=kind, joints=grid, designs=designs)
     if not isinstance(joints, list) or not all(isinstance(j, str) for j in joints):
         raise DesignerError(f"{_where(path, 'cases.joints')} must list joint names", 'e.g. ["j1", "j2"]')
     if kind == "suggestion":
@@ -137,17 +143,12 @@ def _cases(doc: dict, path: Path, scenario: Scenario) -> Cases:
                 f"{_where(path, 'cases.candidates')} must list numbers >= 1", "e.g. [1, 2, 3]"
             )
         return Cases(type=kind, joints={j: None for j in joints}, file=file, candidates=tuple(cands))
-    designs = table.get("designs", {})
-    if not isinstance(designs, dict) or not all(isinstance(d, dict) for d in designs.values()):
-        raise DesignerError(
-            f"{_where(path, 'cases.designs')} must map joints to print settings", "see the README"
-        )
     return Cases(
         type=kind,
         joints={j: None for j in joints},
         n=_count(table, "n", path, None),
         seed=_count(table, "seed", path, 0, minimum=0),
-        designs={j: dict(d) for j, d in designs.items()},
+        designs=designs,
     )
 
 

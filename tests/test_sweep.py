@@ -1,0 +1,209 @@
+"""Design sweeps: predictive draws, specs, limits, FMU vs in-engine paths against physics, resume."""
+
+import dataclasses
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from designer import DesignerError, Surrogate, cosim, sweep
+from designer.sweep.draws import draw
+from designer.sweep.executors import SerialExecutor
+from designer.sweep.limits import parse_limit
+from designer.sweep.spec import Cases, Spec, with_duration
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+DESIGN = {"density": 60, "length": 24, "width": 4.5, "height": 9, "layer": 0.16, "raster": 45}
+#: the one-link example's inertia about its hinge, from its MJCF numbers: Izz + m d^2 (kg.m^2)
+J_ONE_LINK = 3.75e-4 + 0.2 * 0.075**2
+
+
+def _without_wall(frame: pd.DataFrame) -> pd.DataFrame:
+    return frame.drop(columns=["wall_s"])
+
+
+def test_draws_follow_the_prediction_interval():
+    """95 % of the draws fall inside the surrogate's 95 % PI; the quantiles are its ends (log form k_x)."""
+    sur = Surrogate.load()
+    rng = np.random.default_rng(3)
+    for response in ("k_x", "c_x"):
+        pred = sur.predict(DESIGN, responses=[response])[response]
+        values = draw(sur.model(response), DESIGN, 100_000, rng)
+        assert np.all(values > 0)
+        inside = np.mean((values >= pred.low[0]) & (values <= pred.high[0]))
+        if response == "k_x":  # power law: exponentiated t, nothing truncated
+            assert inside == pytest.approx(0.95, abs=0.003)
+            lo, hi = np.quantile(values, [0.025, 0.975])
+            assert lo == pytest.approx(pred.low[0], rel=0.01)
+            assert hi == pytest.approx(pred.high[0], rel=0.01)
+            assert np.median(values) == pytest.approx(pred.value[0], rel=0.005)
+        else:  # raw mean form: about 1 % of the t lies below zero and is redrawn
+            assert 0.95 < inside < 0.965
+
+
+@pytest.mark.parametrize(
+    "text, metric, op, value",
+    [("overshoot<=5%", "overshoot_pct", "<=", 5.0), ("settling_time <= 0.3 s", "settling_time_s", "<=", 0.3)],
+)
+def test_parse_limit(text, metric, op, value):
+    limit = parse_limit(text)
+    assert (limit.metric, limit.op, limit.value) == (metric, op, value)
+
+
+@pytest.mark.parametrize("text", ["overshoot<5", "speed<=3", "overshoot<=5s", "overshoot<=nan"])
+def test_bad_limits(text):
+    with pytest.raises(DesignerError):
+        parse_limit(text)
+
+
+def _spec(tmp_path: Path, body: str) -> Path:
+    path = tmp_path / "sweep.toml"
+    path.write_text(f'scenario = "{EXAMPLES / "tune_one_link.toml"}"\n{body}')
+    return path
+
+
+@pytest.mark.parametrize(
+    "body, words",
+    [
+        ('[cases]\ntype = "lattice"', "type"),
+        ('[cases]\ntype = "grid"\n[cases.joints.j9]\nk = [1, 2]', "j9"),
+        ('[cases]\ntype = "montecarlo"', "number of draws"),
+        ('[cases]\ntype = "montecarlo"\nn = 5', "print settings"),
+        ('[sweep]\npath = "gpu"\n[cases]\ntype = "grid"\n[cases.joints.j1]\nk = [1]', "path"),
+        ('[cases]\ntype = "grid"\n[cases.joints.j1]\nk = [1]\nwidth = [3]', "not both"),
+    ],
+)
+def test_bad_specs(tmp_path, body, words):
+    with pytest.raises(DesignerError, match=words):
+        spec = sweep.load(_spec(tmp_path, body))
+        sweep.make_cases(spec)
+
+
+def _critical_grid(tmp_path: Path) -> sweep.Spec:
+    body = (
+        '[sweep]\nduration = 0.5\n[cases]\ntype = "grid"\n[cases.joints.j1]\nk = [300, 1e8]\nc = [6.0, 21.2]'
+    )
+    return sweep.load(_spec(tmp_path, body))
+
+
+def test_fmu_and_engine_paths_agree_with_the_analytic_step_response(tmp_path):
+    """Overshoot of an underdamped link is exp(-pi zeta / sqrt(1 - zeta^2)); a diverging case fails alone."""
+    spec = _critical_grid(tmp_path)
+    fmu = sweep.run(spec, executor=SerialExecutor())
+    engine = sweep.run(dataclasses.replace(spec, path="engine", check=2), executor=SerialExecutor())
+    for result in (fmu, engine):
+        t = result.table
+        assert list(t["status"]) == ["ok", "ok", "failed", "failed"]
+        assert all("diverged" in m for m in t["message"][2:])
+        for i in (0, 1):
+            zeta = t.loc[i, "j1.c"] * 1e-3 / (2 * math.sqrt(t.loc[i, "j1.k"] * 1e-3 * J_ONE_LINK))
+            analytic = 100 * math.exp(-math.pi * zeta / math.sqrt(1 - zeta**2))
+            # semi-implicit Euler at h omega = 0.007 adds about h omega / 2 to zeta
+            assert t.loc[i, "j1.overshoot_pct"] == pytest.approx(analytic, abs=1.0)
+    metrics = [c for c in fmu.table.columns if c.startswith("j1.") and c not in ("j1.k", "j1.c")]
+    np.testing.assert_allclose(
+        fmu.table[metrics].iloc[:2].to_numpy(float),
+        engine.table[metrics].iloc[:2].to_numpy(float),
+        atol=1e-12,
+    )
+    check = engine.summary["engine_check"]
+    assert check["max_angle_difference_rad"] < 1e-12 and len(check["cases"]) == 2
+
+
+def test_rerun_skips_finished_cases(tmp_path):
+    """A journal cut mid-line (an interrupted run) is resumed: finished cases are not run again."""
+    spec = dataclasses.replace(_critical_grid(tmp_path), path="engine", check=0)
+    journal = tmp_path / "cases.jsonl"
+    first = sweep.run(spec, executor=SerialExecutor(), journal=journal)
+    ok = [line for line in journal.read_text().splitlines() if '"status": "ok"' in line]
+    journal.write_text(ok[0] + "\n" + ok[1][: len(ok[1]) // 2])  # as if killed while writing
+    again = sweep.run(spec, executor=SerialExecutor(), journal=journal)
+    assert again.resumed == 1  # the whole line; the torn one and the failed cases run again
+    pd.testing.assert_frame_equal(_without_wall(first.table), _without_wall(again.table))
+    third = sweep.run(spec, executor=SerialExecutor(), journal=journal)
+    assert third.resumed == 2
+
+
+def test_grid_over_print_settings_goes_through_the_surrogate(tmp_path):
+    body = (
+        '[sweep]\nduration = 0.05\n[cases]\ntype = "grid"\n'
+        f"[cases.designs.j1]\n{_toml(DESIGN)}\n[cases.joints.j1]\nheight = [4, 14]\n"
+    )
+    spec = sweep.load(_spec(tmp_path, body))
+    cases = sweep.make_cases(spec)
+    sur = Surrogate.load()
+    for case, h in zip(cases, (4, 14), strict=True):
+        k_x = sur.predict(DESIGN | {"height": h}, responses=["k_x"])["k_x"].value[0]
+        assert case.coefficients["j1"]["k"] == pytest.approx(k_x * (0.85 * 24) ** 2, rel=1e-12)
+        assert case.inputs == {"j1.height": h}
+
+
+def _toml(d: dict) -> str:
+    return "\n".join(f"{k} = {v}" for k, v in d.items())
+
+
+def _cli(*args: str) -> subprocess.CompletedProcess:
+    code = "import sys; from designer_cli.main import main; sys.argv[0] = 'designer'; main()"
+    return subprocess.run([sys.executable, "-I", "-c", code, *map(str, args)], capture_output=True, text=True)
+
+
+def test_example_monte_carlo_sweep_cli(tmp_path):
+    """examples/sweep_arm.toml: 200 draws, 5/50/95 % percentiles, the engine path checked against the FMUs."""
+    out = tmp_path / "mc"
+    args = ("sweep", EXAMPLES / "sweep_arm.toml", "-o", out, "--workers", "1", "--json")
+    run = _cli(*args)
+    assert run.returncode == 0, run.stderr
+    summary = json.loads(run.stdout)
+    assert summary["cases"] == summary["ok"] == 200
+    p = summary["percentiles"]["j2.overshoot_pct"]
+    assert p["n"] == 200 and 0 < p["p5"] < p["p50"] < p["p95"]
+    assert summary["engine_check"]["max_angle_difference_rad"] < 1e-9
+    assert 0 <= summary["share_meeting_all"] <= 1
+    table = pd.read_parquet(out / "results.parquet")
+    assert len(table) == 200 and {"j1.k", "j2.c", "j1.k_x", "status", "wall_s"} <= set(table.columns)
+    assert np.percentile(table["j2.overshoot_pct"], 50) == pytest.approx(p["p50"])
+    assert (out / "metrics.png").stat().st_size > 10_000
+
+
+def test_tune_finds_critical_damping(tmp_path):
+    """Fastest settling without overshoot is critical damping: c within 2 % of 2 sqrt(k J)."""
+    out = tmp_path / "tuned.json"
+    args = ["tune", str(EXAMPLES / "tune_one_link.toml"), "--objective", "settling_time"]
+    args += ["--limit", "overshoot<=0%", "--bounds", "j1.k=200:600", "--bounds", "j1.c=5:150"]
+    args += ["--robustness", "10", "--workers", "1", "-o", str(out), "--json"]
+    run = _cli(*args)
+    assert run.returncode == 0, run.stderr
+    tuned = json.loads(out.read_text())
+    k, c = tuned["joints"]["j1"]["k"] * 1e-3, tuned["joints"]["j1"]["c"] * 1e-3
+    assert c == pytest.approx(2 * math.sqrt(k * J_ONE_LINK), rel=0.02)
+    assert tuned["feasible"] and tuned["metrics"]["j1.overshoot_pct"] == 0.0
+    assert tuned["fmu_check"]["status"] == "ok"
+    assert max(tuned["fmu_check"]["max_metric_difference"].values()) < 1e-9
+    design = tuned["designs"]["j1"]
+    assert design["candidates"] and design["fixed"] == {"length": 24.0}
+    assert tuned["robustness"]["cases"] == 10
+
+
+def test_cli_bad_input_is_one_line(tmp_path):
+    for args in (
+        ["sweep", str(tmp_path / "missing.toml")],
+        ["tune", str(EXAMPLES / "tune_one_link.toml"), "--bounds", "j1.k=abc"],
+        ["tune", str(EXAMPLES / "tune_one_link.toml"), "--limit", "speed<=3"],
+    ):
+        run = _cli(*args)
+        assert run.returncode == 2, run.stderr
+        assert run.stderr.startswith("error:") and len(run.stderr.strip().splitlines()) == 1
+
+
+def test_spec_in_code_and_scenario_duration():
+    sc = cosim.load(EXAMPLES / "tune_one_link.toml")
+    spec = sweep.spec.check(
+        Spec(scenario=with_duration(sc, 0.05), cases=Cases(type="grid", joints={"j1": {"c": [1.0]}}))
+    )
+    result = sweep.run(spec, executor=SerialExecutor())
+    assert result.table["status"].tolist() == ["ok"] and result.table["j1.k"][0] == 300
