@@ -177,8 +177,6 @@ def tune(
     Raises:
         DesignerError: unknown objective, joint or path; unusable bounds; a non-robot scenario.
     """
-    from scipy.optimize import differential_evolution
-
     objective = metric(objective)
     if scenario.kind != "robot":
         raise DesignerError("tune needs a robot scenario", "give a scenario with [robot] and [joints]")
@@ -190,41 +188,13 @@ def tune(
         raise DesignerError(
             f"the scenario has no joint {', '.join(unknown)}", f"it has {', '.join(scenario.joints)}"
         )
+    surrogate = surrogate or Surrogate.load()
     box = _bounds(scenario, joints, dict(bounds or {}), surrogate)
     spec = Spec(scenario=scenario, cases=Cases(type="grid"), path=path, limits=tuple(limits), check=0)
-    keys = [(j, q) for j in joints for q in ("k", "c")]
-    count = itertools.count()
-    evaluations = [0]
-
-    def coefficients(x: np.ndarray) -> dict[str, dict[str, float]]:
-        out: dict[str, dict[str, float]] = {}
-        for (j, q), v in zip(keys, x, strict=True):
-            out.setdefault(j, {})[q] = float(np.exp(v))
-        return out
-
     with _executor(executor, workers) as ex:
-
-        def scores(xs: np.ndarray) -> np.ndarray:
-            cases = finish([Case(next(count), coefficients(x)) for x in xs.T], spec)
-            rows, _ = evaluate_cases(spec, cases, executor=ex)
-            evaluations[0] += len(rows)
-            return np.array([score(r, scenario, objective, limits) for r in rows])
-
-        generation = itertools.count(1)
-        result = differential_evolution(
-            scores,
-            [tuple(np.log(box[j][q])) for j, q in keys],
-            maxiter=maxiter,
-            popsize=popsize,
-            rng=np.random.default_rng(seed),
-            polish=False,
-            updating="deferred",
-            vectorized=True,
-            callback=None
-            if progress is None
-            else (lambda *a, **k: progress(next(generation) / (maxiter + 1))),
-        )
-        best = coefficients(result.x)
+        search = _Search(spec, [(j, q) for j in joints for q in ("k", "c")], objective, ex)
+        result = _optimise(search, box, seed=seed, maxiter=maxiter, popsize=popsize, progress=progress)
+        best = search.coefficients(result.x)
         tuned = TuneResult(
             objective=objective,
             limits=[str(x) for x in limits],
@@ -232,38 +202,88 @@ def tune(
             bounds=box,
             score=float(result.fun),
             metrics={},
-            evaluations=evaluations[0],
+            evaluations=search.evaluations,
         )
         _confirm(tuned, spec, best, ex)
-        if surrogate is not None or robustness:
-            _designs(tuned, spec, surrogate or Surrogate.load(), robustness, seed, ex)
+        _designs(tuned, spec, surrogate, robustness, seed, ex)
     if progress is not None:
         progress(1.0)
     return tuned
+
+
+class _Search:
+    """The optimiser's objective: a generation of (log k, log c) vectors evaluated as one batch of cases."""
+
+    def __init__(self, spec: Spec, keys: list[tuple[str, str]], objective: str, ex: Executor) -> None:
+        self.spec, self.keys, self.objective, self.executor = spec, keys, objective, ex
+        self.evaluations = 0
+
+    def coefficients(self, x: np.ndarray) -> dict[str, dict[str, float]]:
+        """{joint: {"k", "c"}} in rig units from one vector of logs."""
+        out: dict[str, dict[str, float]] = {}
+        for (j, q), v in zip(self.keys, x, strict=True):
+            out.setdefault(j, {})[q] = float(np.exp(v))
+        return out
+
+    def __call__(self, xs: np.ndarray) -> np.ndarray:
+        """Scores of the columns of xs (parameters x population), as scipy's vectorized mode passes them."""
+        start = self.evaluations
+        cases = [Case(start + i, self.coefficients(x)) for i, x in enumerate(xs.T)]
+        rows, _ = evaluate_cases(self.spec, finish(cases, self.spec), executor=self.executor)
+        self.evaluations += len(rows)
+        sc, limits = self.spec.scenario, self.spec.limits
+        return np.array([score(r, sc, self.objective, limits) for r in rows])
+
+
+def _optimise(
+    search: _Search,
+    box: Mapping[str, Mapping[str, tuple[float, float]]],
+    *,
+    seed: int,
+    maxiter: int,
+    popsize: int,
+    progress: Callable[[float], None] | None,
+):
+    """Differential evolution over log k, log c within the box; scipy's OptimizeResult."""
+    from scipy.optimize import differential_evolution
+
+    generation = itertools.count(1)
+
+    def report(*_args, **_kwargs) -> None:
+        if progress is not None:
+            progress(next(generation) / (maxiter + 1))
+
+    return differential_evolution(
+        search,
+        [tuple(np.log(box[j][q])) for j, q in search.keys],
+        maxiter=maxiter,
+        popsize=popsize,
+        rng=np.random.default_rng(seed),
+        polish=False,
+        updating="deferred",
+        vectorized=True,
+        callback=report,
+    )
 
 
 def _confirm(tuned: TuneResult, spec: Spec, best: dict, ex: Executor) -> None:
     """The tuned case's metrics, and (engine path) the same case co-simulated with the FMUs."""
     from dataclasses import replace
 
-    case = finish([Case(0, best)], spec)
-    rows, _ = evaluate_cases(spec, case, executor=ex)
-    tuned.metrics = {k: v for k, v in rows[0].items() if k.partition(".")[0] in spec.scenario.joints}
-    if spec.path == "engine":
-        fmu_spec = replace(spec, path="fmu")
-        fmu_rows, _ = evaluate_cases(fmu_spec, finish([Case(0, best)], fmu_spec), executor=ex)
-        diffs = {
-            k: abs(v - fmu_rows[0][k])
-            for k, v in rows[0].items()
-            if k in fmu_rows[0]
-            and isinstance(v, float)
-            and k.count(".")
-            and math.isfinite(v)
-            and isinstance(fmu_rows[0][k], float)
-            and math.isfinite(fmu_rows[0][k])
-            and k.split(".")[1] not in ("k", "c")
-        }
-        tuned.fmu_check = {"status": fmu_rows[0]["status"], "max_metric_difference": diffs}
+    rows, _ = evaluate_cases(spec, finish([Case(0, best)], spec), executor=ex)
+    joints = spec.scenario.joints
+    metrics = [c for c in rows[0] if c.partition(".")[0] in joints and c.partition(".")[2] not in ("k", "c")]
+    tuned.metrics = {c: _value(rows[0], c) for c in metrics}  # None: not settled within the run
+    if spec.path != "engine":
+        return
+    fmu_spec = replace(spec, path="fmu")
+    fmu, _ = evaluate_cases(fmu_spec, finish([Case(0, best)], fmu_spec), executor=ex)
+    diffs = {c: abs(float(rows[0][c]) - float(fmu[0].get(c, math.nan))) for c in metrics}
+    tuned.fmu_check = {
+        "status": fmu[0]["status"],
+        "message": fmu[0]["message"],
+        "max_metric_difference": {c: d for c, d in diffs.items() if not math.isnan(d)},
+    }
 
 
 def _designs(
