@@ -75,7 +75,7 @@ def base_coefficients(src: JointSource) -> dict[str, float]:
 def design_of(spec: Spec, joint: str) -> dict[str, float]:
     """The print settings of a joint: given in the sweep, or those its scenario joint was built from."""
     if joint in spec.cases.designs:
-        return space.validate(spec.cases.designs[joint])
+        return space.check_design(spec.cases.designs[joint])
     src = spec.scenario.joints[joint]
     params = None if src.joint is None else src.joint.provenance.get("params")
     if params is None:
@@ -125,7 +125,7 @@ def grid(spec: Spec) -> list[Case]:
             if set(values) <= {"k", "c"}:
                 coefficients[j] = base_coefficients(spec.scenario.joints[j]) | values
             else:
-                design = space.validate(design_of(spec, j) | values)
+                design = space.check_design(design_of(spec, j) | values)
                 coefficients[j] = _predicted(surrogate, design, spec.scenario.joints[j].axis)
         cases.append(Case(i, coefficients, inputs))
     return cases

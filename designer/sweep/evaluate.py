@@ -53,24 +53,28 @@ def metrics(sc: Scenario, trace: Trace, c_si: dict[str, float]) -> dict[str, dic
     }
 
 
-def fmu_trace(sc: Scenario, fmus: dict[str, Path], case: Case) -> tuple[Trace, dict[str, float]]:
-    """Co-simulate one case with the joint FMUs (k and c set as FMU parameters); its trace and SI c."""
-    from ..cosim.run import law, robot_run
+def fmu_result(sc: Scenario, fmus: dict[str, Path], case: Case):
+    """Co-simulate one case with `designer.cosim.run`: the batch's joint FMUs, the case's k and c set
+    as FMU parameters (SI). Returns the cosim `Result` (time series and per-joint metrics)."""
+    from ..cosim import run
 
     joints = {}
     for j, src in sc.joints.items():
         params = dict(src.parameters)
         params |= {f"{src.axis}.{q}": v for q, v in si_law(src, case.coefficients[j]).items()}
         joints[j] = JointSource(axis=src.axis, fmu=fmus[j], fmi_version=src.fmi_version, parameters=params)
-    run_sc = replace(sc, joints=joints)
-    res = robot_run(run_sc, fmus, sc.step, sc.duration, sc.algorithm)
-    trace = Trace(
-        res.time,
-        {j: res.column(f"robot.{j}.q") for j in joints},
-        {j: res.column(f"robot.{j}.motor") for j in joints},
-        {j: res.column(f"robot.{j}.v") for j in joints},
+    return run(replace(sc, joints=joints))
+
+
+def trace_of(result) -> Trace:
+    """The joint angles, motor angles and deflection rates of a cosim `Result`."""
+    joints = result.scenario.joints
+    return Trace(
+        result.time,
+        {j: result.column(f"robot.{j}.q") for j in joints},
+        {j: result.column(f"robot.{j}.motor") for j in joints},
+        {j: result.column(f"robot.{j}.v") for j in joints},
     )
-    return trace, {j: law(src, fmus[j])["c"] for j, src in joints.items()}
 
 
 def case_row(case: Case, outcome: dict | Exception, wall: float) -> dict:
@@ -100,8 +104,7 @@ def _fmu_batch(task: Task) -> list[dict]:
         for case in task.cases:
             start = time.perf_counter()
             try:
-                trace, c_si = fmu_trace(task.scenario, fmus, case)
-                outcome: dict | Exception = metrics(task.scenario, trace, c_si)
+                outcome: dict | Exception = fmu_result(task.scenario, fmus, case).metrics
             except Exception as exc:  # a failed case is recorded, never fatal to the sweep
                 outcome = _failure(exc)
             rows.append(case_row(case, outcome, time.perf_counter() - start))

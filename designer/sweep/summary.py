@@ -83,7 +83,7 @@ def engine_check(spec: Spec, cases: Sequence[Case], frame: pd.DataFrame) -> dict
         return None
     from ..cosim.run import joint_fmus
     from .engine import rollout_traces
-    from .evaluate import fmu_trace, metrics
+    from .evaluate import fmu_result, metrics, si_law, trace_of
 
     ok = set(frame.loc[frame["status"] == "ok", "key"])
     finished = [c for c in cases if c.key in ok]
@@ -97,9 +97,11 @@ def engine_check(spec: Spec, cases: Sequence[Case], frame: pd.DataFrame) -> dict
     angle, metric_diff = 0.0, {}
     with joint_fmus(sc) as fmus:
         for case, fast in zip(picks, engine, strict=True):
-            trace, c_si = fmu_trace(sc, fmus, case)
+            result = fmu_result(sc, fmus, case)
+            trace = trace_of(result)
             angle = max(angle, max(float(np.max(np.abs(trace.q[j] - fast.q[j]))) for j in sc.joints))
-            slow, quick = metrics(sc, trace, c_si), metrics(sc, fast, c_si)
+            c_si = {j: si_law(src, case.coefficients[j])["c"] for j, src in sc.joints.items()}
+            slow, quick = result.metrics, metrics(sc, fast, c_si)
             for j in sc.joints:
                 for name, v in slow[j].items():
                     w = quick[j][name]
