@@ -207,3 +207,20 @@ def test_spec_in_code_and_scenario_duration():
     )
     result = sweep.run(spec, executor=SerialExecutor())
     assert result.table["status"].tolist() == ["ok"] and result.table["j1.k"][0] == 300
+
+
+def test_rig_sweep_identifies_each_case(tmp_path):
+    """Each case a virtual rig run whose log is identified: k and c come back from the log."""
+    path = tmp_path / "rig_sweep.toml"
+    path.write_text(
+        f'scenario = "{EXAMPLES / "rig.toml"}"\n[sweep]\nduration = 4.0\n'
+        '[cases]\ntype = "grid"\n[cases.joints.rig]\nk = [200, 400]\n'
+    )
+    result = sweep.run(sweep.load(path), executor=SerialExecutor())
+    t = result.table
+    assert (t["status"] == "ok").all() and list(t["rig.k"]) == [200, 400]
+    assert np.all(np.abs(t["rig.k_error_pct"]) < 0.5) and np.all(np.abs(t["rig.c_error_pct"]) < 2)
+    np.testing.assert_allclose(t["rig.k_identified"], [200, 400], rtol=5e-3)
+    assert result.summary["units"]["rig.k_identified"] == "N.mm/rad"
+    with pytest.raises(DesignerError, match="rig"):
+        sweep.spec.check(dataclasses.replace(result.spec, path="engine"))

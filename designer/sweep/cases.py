@@ -20,7 +20,7 @@ from ..cosim.scenario import JointSource
 from ..errors import DesignerError
 from ..surrogate import Surrogate
 from .draws import joint_draws, on_axis, source_axis
-from .spec import Spec
+from .spec import Spec, sources
 
 
 @dataclass(frozen=True)
@@ -45,10 +45,10 @@ def finish(cases: list[Case], spec: Spec) -> list[Case]:
     """The cases with k and c for every scenario joint (the scenario's own where a case leaves a joint
     alone) and their keys: a hash of the coefficients and of the spec's context."""
     context = context_key(spec)
-    base = {j: base_coefficients(src) for j, src in spec.scenario.joints.items()}
+    base = {j: base_coefficients(src) for j, src in sources(spec.scenario).items()}
     out = []
     for case in cases:
-        coefficients = {j: case.coefficients.get(j, base[j]) for j in spec.scenario.joints}
+        coefficients = {j: case.coefficients.get(j, base[j]) for j in base}
         payload = json.dumps({"c": coefficients, "ctx": context}, sort_keys=True)
         out.append(
             replace(case, coefficients=coefficients, key=hashlib.sha256(payload.encode()).hexdigest()[:20])
@@ -76,8 +76,9 @@ def design_of(spec: Spec, joint: str) -> dict[str, float]:
     """The print settings of a joint: given in the sweep, or those its scenario joint was built from."""
     if joint in spec.cases.designs:
         return space.check_design(spec.cases.designs[joint])
-    src = spec.scenario.joints[joint]
+    src = sources(spec.scenario)[joint]
     params = None if src.joint is None else src.joint.provenance.get("params")
+    params = params or (spec.scenario.factors if joint == "rig" else None)
     if params is None:
         raise DesignerError(
             f"joint {joint} has no print settings to vary or draw around",
@@ -123,10 +124,10 @@ def grid(spec: Spec) -> list[Case]:
         for j, values in chosen.items():
             inputs.update({f"{j}.{q}": v for q, v in values.items()})
             if set(values) <= {"k", "c"}:
-                coefficients[j] = base_coefficients(spec.scenario.joints[j]) | values
+                coefficients[j] = base_coefficients(sources(spec.scenario)[j]) | values
             else:
                 design = space.check_design(design_of(spec, j) | values)
-                coefficients[j] = _predicted(surrogate, design, spec.scenario.joints[j].axis)
+                coefficients[j] = _predicted(surrogate, design, sources(spec.scenario)[j].axis)
         cases.append(Case(i, coefficients, inputs))
     return cases
 
@@ -148,7 +149,7 @@ def suggestion(spec: Spec) -> list[Case]:
     for i, combo in enumerate(itertools.product(numbers, repeat=len(joints))):
         coefficients, inputs = {}, {}
         for j, cand in zip(joints, combo, strict=True):
-            src = spec.scenario.joints[j]
+            src = sources(spec.scenario)[j]
             joint = Joint.from_suggestion(path, candidate=cand, axes=[src.axis], name=f"joint_{j}")
             ac = joint.axis(src.axis)
             coefficients[j] = {"k": ac.k, "c": ac.c}
@@ -165,7 +166,7 @@ def montecarlo(spec: Spec) -> list[Case]:
     n = spec.cases.n
     draws = {}
     for j in spec.cases.joints:
-        draws[j] = joint_draws(surrogate, design_of(spec, j), spec.scenario.joints[j].axis, n, rng)
+        draws[j] = joint_draws(surrogate, design_of(spec, j), sources(spec.scenario)[j].axis, n, rng)
     cases = []
     for i in range(n):
         coefficients = {j: {"k": float(d["k"][i]), "c": float(d["c"][i])} for j, d in draws.items()}

@@ -66,6 +66,30 @@ def fmu_result(sc: Scenario, fmus: dict[str, Path], case: Case):
     return run(replace(sc, joints=joints))
 
 
+#: per-case metrics of a rig sweep: the identified coefficients (rig units), their errors, the fit's R2
+RIG_METRICS = ("k_identified", "c_identified", "k_error_pct", "c_error_pct", "r2")
+
+
+def rig_identification(sc: Scenario, fmus: dict[str, Path], case: Case) -> dict[str, dict]:
+    """Run the virtual rig on one case's joint, identify its log, and compare with the case's k and c.
+
+    The log is the one `designer cosim` writes for the rig (designer.cosim.run.rig_log), read
+    through the rig-log validation and identified as a measured log would be.
+    """
+    from ..cosim import run
+    from ..cosim.run import rig_log
+    from ..rig.identify import identify
+    from ..rig.logs import validate_frame
+
+    src, true = sc.rig_joint, case.coefficients["rig"]
+    params = dict(src.parameters) | {f"{src.axis}.{q}": v for q, v in si_law(src, true).items()}
+    joint = JointSource(axis=src.axis, fmu=fmus["rig"], fmi_version=src.fmi_version, parameters=params)
+    log = validate_frame(rig_log(run(replace(sc, rig_joint=joint))), f"virtual rig log of case {case.index}")
+    fit = identify(log).axes[src.axis]
+    values = (fit.k, fit.c, 100 * (fit.k / true["k"] - 1), 100 * (fit.c / true["c"] - 1), fit.r2)
+    return {"rig": dict(zip(RIG_METRICS, map(float, values), strict=True))}
+
+
 def trace_of(result) -> Trace:
     """The joint angles, motor angles and deflection rates of a cosim `Result`."""
     joints = result.scenario.joints
@@ -104,7 +128,10 @@ def _fmu_batch(task: Task) -> list[dict]:
         for case in task.cases:
             start = time.perf_counter()
             try:
-                outcome: dict | Exception = fmu_result(task.scenario, fmus, case).metrics
+                if task.scenario.kind == "rig":
+                    outcome: dict | Exception = rig_identification(task.scenario, fmus, case)
+                else:
+                    outcome = fmu_result(task.scenario, fmus, case).metrics
             except Exception as exc:  # a failed case is recorded, never fatal to the sweep
                 outcome = _failure(exc)
             rows.append(case_row(case, outcome, time.perf_counter() - start))

@@ -69,6 +69,11 @@ class Spec:
     source: Path | None = None
 
 
+def sources(scenario: Scenario) -> dict[str, Any]:
+    """The joints a sweep can vary, by name: a robot's joints, or the rig's joint as "rig"."""
+    return {"rig": scenario.rig_joint} if scenario.kind == "rig" else dict(scenario.joints)
+
+
 def _where(path: Path, key: str) -> str:
     return f"{path.name}: {key}"
 
@@ -117,7 +122,7 @@ def _cases(doc: dict, path: Path, scenario: Scenario) -> Cases:
             f"{_where(path, 'cases.designs')} must map joints to print settings", "see the README"
         )
     designs = {j: dict(d) for j, d in designs.items()}
-    joints = table.get("joints", list(scenario.joints) if kind != "grid" else None)
+    joints = table.get("joints", list(sources(scenario)) if kind != "grid" else None)
     if kind == "grid":
         if not isinstance(joints, dict) or not joints:
             raise DesignerError(
@@ -220,22 +225,26 @@ def check(spec: Spec) -> Spec:
     """Check a spec built in code as `load` checks a file; returns it.
 
     Raises:
-        DesignerError: the scenario is not a robot, a case names an unknown joint, or the
-            Monte Carlo count is missing.
+        DesignerError: a rig scenario with the engine path or limits, a case naming an unknown
+            joint, or a Monte Carlo sweep without its count.
     """
     sc = spec.scenario
-    if sc.kind != "robot":
-        raise DesignerError("a sweep runs a robot scenario", "give a scenario with [robot] and [joints]")
+    if sc.kind == "rig" and (spec.path != "fmu" or spec.limits):
+        raise DesignerError(
+            "a rig sweep identifies each case's virtual rig log through the FMU",
+            "use path='fmu' and no limits with a rig scenario",
+        )
     if spec.path not in PATHS:
         raise DesignerError(f"path={spec.path!r} is not allowed", "use path='fmu' or path='engine'")
     if spec.cases.type not in CASE_TYPES:
         raise DesignerError(
             f"cases type {spec.cases.type!r} is unknown", f"use one of {', '.join(CASE_TYPES)}"
         )
+    names = sources(sc)
     for j in spec.cases.joints:
-        if j not in sc.joints:
+        if j not in names:
             raise DesignerError(
-                f"the sweep varies joint '{j}' the scenario lacks", f"it has {', '.join(sc.joints)}"
+                f"the sweep varies joint '{j}' the scenario lacks", f"it has {', '.join(names)}"
             )
     if spec.cases.type == "montecarlo" and not spec.cases.n:
         raise DesignerError("a Monte Carlo sweep needs a number of draws", "give n (e.g. n = 200)")

@@ -12,8 +12,9 @@ import pandas as pd
 from .. import space, units
 from ..files import atomic_path, atomic_write
 from .cases import Case
+from .evaluate import RIG_METRICS
 from .limits import METRICS, applies
-from .spec import Spec
+from .spec import Spec, sources
 
 PERCENTILES = (5, 50, 95)
 
@@ -21,15 +22,16 @@ PERCENTILES = (5, 50, 95)
 def column_units(spec: Spec, frame: pd.DataFrame) -> dict[str, str]:
     """The unit of every numeric column of a sweep table (rig units for coefficients)."""
     out = {}
-    metric_units = dict(METRICS.values())
+    metric_units = dict(METRICS.values()) | {"k_error_pct": "%", "c_error_pct": "%", "r2": "1"}
+    joints = sources(spec.scenario)
     for col in frame.columns:
         joint, _, name = col.partition(".")
         if not name:
             continue
         if name in metric_units:
             out[col] = metric_units[name]
-        elif name in ("k", "c") and joint in spec.scenario.joints:
-            out[col] = units.rig_unit(name, spec.scenario.joints[joint].axis)
+        elif name in ("k", "c", "k_identified", "c_identified") and joint in joints:
+            out[col] = units.rig_unit(name[0], joints[joint].axis)
         elif name[:2] in ("k_", "c_") and name[2:] in units.AXES:
             out[col] = units.rig_unit(name[0], name[2:])
         elif name in space.BY_NAME:
@@ -39,8 +41,9 @@ def column_units(spec: Spec, frame: pd.DataFrame) -> dict[str, str]:
 
 
 def metric_columns(spec: Spec, frame: pd.DataFrame) -> list[str]:
-    names = [c for c, _ in METRICS.values()]
-    return [f"{j}.{m}" for j in spec.scenario.joints for m in names if f"{j}.{m}" in frame.columns]
+    """The metric columns of a sweep table, joint by joint."""
+    names = RIG_METRICS if spec.scenario.kind == "rig" else [c for c, _ in METRICS.values()]
+    return [f"{j}.{m}" for j in sources(spec.scenario) for m in names if f"{j}.{m}" in frame.columns]
 
 
 def percentiles(frame: pd.DataFrame, columns: Sequence[str]) -> dict[str, dict]:
