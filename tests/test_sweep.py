@@ -219,7 +219,7 @@ def test_rig_sweep_identifies_each_case(tmp_path):
     result = sweep.run(sweep.load(path), executor=SerialExecutor())
     t = result.table
     assert (t["status"] == "ok").all() and list(t["rig.k"]) == [200, 400]
-    assert np.all(np.abs(t["rig.k_error_pct"]) < 0.5) and np.all(np.abs(t["rig.c_error_pct"]) < 2)
+    assert np.all(np.abs(t["rig.k_error_pct"]) < 0.1) and np.all(np.abs(t["rig.c_error_pct"]) < 0.5)
     np.testing.assert_allclose(t["rig.k_identified"], [200, 400], rtol=5e-3)
     assert result.summary["units"]["rig.k_identified"] == "N.mm/rad"
     with pytest.raises(DesignerError, match="rig"):

@@ -41,9 +41,17 @@ def column_units(spec: Spec, frame: pd.DataFrame) -> dict[str, str]:
 
 
 def metric_columns(spec: Spec, frame: pd.DataFrame) -> list[str]:
-    """The metric columns of a sweep table, joint by joint."""
-    names = RIG_METRICS if spec.scenario.kind == "rig" else [c for c, _ in METRICS.values()]
-    return [f"{j}.{m}" for j in sources(spec.scenario) for m in names if f"{j}.{m}" in frame.columns]
+    """The metric columns of a sweep table, joint by joint (step metrics for stepped joints only)."""
+    sc = spec.scenario
+    if sc.kind == "rig":
+        return [f"rig.{m}" for m in RIG_METRICS if f"rig.{m}" in frame.columns]
+    names = [c for c, _ in METRICS.values()]
+    return [
+        f"{j}.{m}"
+        for j in sc.joints
+        for m in names
+        if f"{j}.{m}" in frame.columns and applies(m, sc.motors[j])
+    ]
 
 
 def percentiles(frame: pd.DataFrame, columns: Sequence[str]) -> dict[str, dict]:
@@ -180,6 +188,7 @@ def plot_metrics(result, path: str | Path) -> Path:
         if name in limits:
             ax.axvline(limits[name].value, color="red", lw=1.2)
         ax.set_xlabel(f"{col} ({result.summary['units'].get(col, '')})")
+        ax.set_title(f"{pct[col]['n']} cases with a value", fontsize=9)
         ax.set_ylabel("cases")
     for ax in axes.ravel()[len(cols) :]:
         ax.set_visible(False)
