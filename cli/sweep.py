@@ -196,14 +196,17 @@ def tune(
 
 def _print_tune(data: dict, sc, out: Path | None) -> None:
     from designer import units
+    from designer.sweep.limits import unit
 
     state = "meets every limit" if data["feasible"] else "does NOT meet the limits"
+    objective_unit = unit(data["objective"])
     console.print(f"tuned after {data['evaluations']} co-simulations; the best {state}")
     for j, coef in data["joints"].items():
         a = sc.joints[j].axis
+        value = data["metrics"].get(f"{j}.{data['objective']}")
         console.print(
             f"  {j}: k = {units.fmt(coef['k'], 'k', a)}, c = {units.fmt(coef['c'], 'c', a)}, "
-            f"{data['objective']} = {_number(data['metrics'].get(j + '.' + data['objective']), '')}"
+            f"{data['objective']} = {_number(value, objective_unit)}"
         )
     for j, d in data["designs"].items():
         best = d["candidates"][0]["params"] if d["candidates"] else {}
@@ -214,7 +217,8 @@ def _print_tune(data: dict, sc, out: Path | None) -> None:
     if rob:
         console.print(f"robustness over {rob['cases']} draws within the PIs of these designs:")
         for col, p in rob["percentiles"].items():
-            console.print(f"  {col}: 5/50/95 % = " + " / ".join(_number(p[f"p{q}"], "") for q in (5, 50, 95)))
+            u = unit(col.split(".", 1)[1])
+            console.print(f"  {col}: 5/50/95 % = " + " / ".join(_number(p[f"p{q}"], u) for q in (5, 50, 95)))
         if "share_meeting_all" in rob:
             console.print(f"  {100 * rob['share_meeting_all']:.0f} % of the draws meet every limit")
     if out is not None:

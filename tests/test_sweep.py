@@ -224,3 +224,28 @@ def test_rig_sweep_identifies_each_case(tmp_path):
     assert result.summary["units"]["rig.k_identified"] == "N.mm/rad"
     with pytest.raises(DesignerError, match="rig"):
         sweep.spec.check(dataclasses.replace(result.spec, path="engine"))
+
+
+def test_suggestion_cases_are_the_candidates(tmp_path):
+    """Every combination of candidates over the joints, each joint as Joint.from_suggestion gives it."""
+    from designer import Joint
+
+    path = tmp_path / "s.toml"
+    path.write_text(
+        f'scenario = "{EXAMPLES / "two_link_arm.toml"}"\n[cases]\ntype = "suggestion"\n'
+        f'file = "{EXAMPLES / "suggestion.json"}"\njoints = ["j1", "j2"]\ncandidates = [1, 2]\n'
+    )
+    cases = sweep.make_cases(sweep.load(path))
+    assert [(c.inputs["j1.candidate"], c.inputs["j2.candidate"]) for c in cases] == [
+        (1, 1),
+        (1, 2),
+        (2, 1),
+        (2, 2),
+    ]
+    for case in cases:
+        for j in ("j1", "j2"):
+            joint = Joint.from_suggestion(
+                EXAMPLES / "suggestion.json", candidate=int(case.inputs[f"{j}.candidate"]), axes=["theta"]
+            )
+            assert case.coefficients[j] == {"k": joint.axis("theta").k, "c": joint.axis("theta").c}
+    assert len({c.key for c in cases}) == 4
