@@ -7,8 +7,9 @@ with status "failed" and its message; it does not stop the batch.
 
 from __future__ import annotations
 
+import contextlib
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -156,9 +157,23 @@ def _engine_batch(task: Task) -> list[dict]:
     return rows
 
 
+@contextlib.contextmanager
+def _quiet_mujoco() -> Iterator[None]:
+    """MuJoCo's warnings (a diverging case) silenced: the row records them; no MUJOCO_LOG.TXT is written."""
+    import mujoco
+
+    previous = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(lambda message: None)
+    try:
+        yield
+    finally:
+        mujoco.set_mju_user_warning(previous)
+
+
 def evaluate(task: Task) -> list[dict]:
     """The rows of a batch, in case order (the function an executor runs)."""
-    return _engine_batch(task) if task.path == "engine" else _fmu_batch(task)
+    with _quiet_mujoco():
+        return _engine_batch(task) if task.path == "engine" else _fmu_batch(task)
 
 
 def batches(scenario: Scenario, path: str, cases: Sequence[Case], size: int) -> list[Task]:
