@@ -190,14 +190,15 @@ def test_tune_finds_critical_damping(tmp_path):
 
 
 def test_cli_bad_input_is_one_line(tmp_path):
-    for args in (
-        ["sweep", str(tmp_path / "missing.toml")],
-        ["tune", str(EXAMPLES / "tune_one_link.toml"), "--bounds", "j1.k=abc"],
-        ["tune", str(EXAMPLES / "tune_one_link.toml"), "--limit", "speed<=3"],
-    ):
-        run = _cli(*args)
-        assert run.returncode == 2, run.stderr
-        assert run.stderr.startswith("error:") and len(run.stderr.strip().splitlines()) == 1
+    from designer_cli.sweep import _parse_bounds
+
+    run = _cli("tune", EXAMPLES / "tune_one_link.toml", "--bounds", "j1.k=200:600", "--limit", "speed<=3")
+    assert run.returncode == 2, run.stderr
+    assert run.stderr.startswith("error:") and len(run.stderr.strip().splitlines()) == 1
+    for bad in ("j1.k=abc", "j1.m=1:2", "k=1:2"):
+        with pytest.raises(DesignerError, match="--bounds"):
+            _parse_bounds([bad])
+    assert _parse_bounds(["j1.c=5:150"]) == {"j1.c": (5.0, 150.0)}
 
 
 def test_spec_in_code_and_scenario_duration():

@@ -78,14 +78,14 @@ def dask_scheduler(tmp_path):
 
 
 def _specs() -> list[Spec]:
-    """200 Monte Carlo cases of the example arm on the engine path, 16 through the joint FMUs."""
+    """200 Monte Carlo cases of the example arm on the engine path, 8 through the joint FMUs."""
     sc = with_duration(cosim.load(EXAMPLES / "two_link_arm.toml"), 0.2)
     joints = {"j1": None, "j2": None}
     return [
         Spec(
             scenario=sc, cases=Cases(type="montecarlo", joints=joints, n=200, seed=7), path="engine", check=0
         ),
-        Spec(scenario=sc, cases=Cases(type="montecarlo", joints=joints, n=16, seed=8), path="fmu", batch=2),
+        Spec(scenario=sc, cases=Cases(type="montecarlo", joints=joints, n=8, seed=8), path="fmu", batch=2),
     ]
 
 
@@ -94,7 +94,7 @@ def test_same_table_serial_processes_and_dask(dask_scheduler):
 
     specs = _specs()
     serial = [sweep.run(spec, executor=SerialExecutor()).table for spec in specs]
-    assert [len(t) for t in serial] == [200, 16] and all((t["status"] == "ok").all() for t in serial)
+    assert [len(t) for t in serial] == [200, 8] and all((t["status"] == "ok").all() for t in serial)
     with executor(workers=2) as ex:
         local = [sweep.run(spec, executor=ex).table for spec in specs]
     with distributed.Client(dask_scheduler) as client:
