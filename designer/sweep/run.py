@@ -15,7 +15,7 @@ import pandas as pd
 
 from .cases import Case, make_cases
 from .evaluate import Task, batches, evaluate
-from .spec import Spec
+from .spec import Spec, check
 
 Progress = Callable[[float], None] | None
 #: columns every table ends with
@@ -159,6 +159,7 @@ def run(
     """
     from .summary import summarize
 
+    spec = check(spec)
     journal = None if journal is None else Path(journal)
     cases = make_cases(spec)
     rows, resumed = evaluate_cases(spec, cases, executor=executor, journal=journal, progress=progress)

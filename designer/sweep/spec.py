@@ -222,7 +222,8 @@ def with_duration(scenario: Scenario, duration: Any) -> Scenario:
 
 
 def check(spec: Spec) -> Spec:
-    """Check a spec built in code as `load` checks a file; returns it.
+    """Check a spec built in code as `load` checks a file; returns it (a Monte Carlo or suggestion sweep
+    without joints varies them all).
 
     Raises:
         DesignerError: a rig scenario with the engine path or limits, a case naming an unknown
@@ -241,6 +242,10 @@ def check(spec: Spec) -> Spec:
             f"cases type {spec.cases.type!r} is unknown", f"use one of {', '.join(CASE_TYPES)}"
         )
     names = sources(sc)
+    if not spec.cases.joints:
+        if spec.cases.type == "grid":
+            raise DesignerError("a grid sweep needs its axes", "give joints={'j1': {'k': [100, 200]}}")
+        spec = dataclasses.replace(spec, cases=dataclasses.replace(spec.cases, joints=dict.fromkeys(names)))
     for j in spec.cases.joints:
         if j not in names:
             raise DesignerError(
