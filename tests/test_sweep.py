@@ -33,7 +33,7 @@ def test_draws_follow_the_prediction_interval():
     rng = np.random.default_rng(3)
     for response in ("k_x", "c_x"):
         pred = sur.predict(DESIGN, responses=[response])[response]
-        values = draw(sur.model(response), DESIGN, 100_000, rng)
+        values = draw(sur.model(response), DESIGN, n=100_000, rng=rng)
         assert np.all(values > 0)
         inside = np.mean((values >= pred.low[0]) & (values <= pred.high[0]))
         if response == "k_x":  # power law: exponentiated t, nothing truncated

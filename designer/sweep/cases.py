@@ -94,9 +94,8 @@ def load_surrogate(spec: Spec) -> Surrogate:
 def _predicted(surrogate: Surrogate, design: dict[str, float], axis: str) -> dict[str, float]:
     src = source_axis(surrogate, axis)
     pred = surrogate.predict(design, responses=[f"k_{src}", f"c_{src}"])
-    k, c = on_axis(
-        float(pred[f"k_{src}"].value[0]), float(pred[f"c_{src}"].value[0]), src, axis, design["length"]
-    )
+    predicted = (float(pred[f"k_{src}"].value[0]), float(pred[f"c_{src}"].value[0]))
+    k, c = on_axis(predicted, source=src, axis=axis, length_mm=design["length"])
     return {"k": k, "c": c}
 
 
@@ -166,7 +165,9 @@ def montecarlo(spec: Spec) -> list[Case]:
     n = spec.cases.n
     draws = {}
     for j in spec.cases.joints:
-        draws[j] = joint_draws(surrogate, design_of(spec, j), sources(spec.scenario)[j].axis, n, rng)
+        draws[j] = joint_draws(
+            surrogate, design=design_of(spec, j), axis=sources(spec.scenario)[j].axis, n=n, rng=rng
+        )
     cases = []
     for i in range(n):
         coefficients = {j: {"k": float(d["k"][i]), "c": float(d["c"][i])} for j, d in draws.items()}

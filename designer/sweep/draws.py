@@ -25,7 +25,9 @@ from ..surrogate import ResponseSurface, Surrogate
 _REDRAWS = 100
 
 
-def draw(model: ResponseSurface, design: Mapping[str, float], n: int, rng: np.random.Generator) -> np.ndarray:
+def draw(
+    model: ResponseSurface, design: Mapping[str, float], *, n: int, rng: np.random.Generator
+) -> np.ndarray:
     """`n` draws (rig units) of one response's predictive distribution at one design.
 
     Raises:
@@ -48,11 +50,14 @@ def draw(model: ResponseSurface, design: Mapping[str, float], n: int, rng: np.ra
     )
 
 
-def on_axis(k: float, c: float, source_axis: str, axis: str, length_mm: float) -> tuple[float, float]:
-    """k and c of the surrogate's axis carried to the joint's axis (PRB model for a rotational one)."""
-    if axis == source_axis:
+def on_axis(
+    coefficients: tuple[float, float], *, source: str, axis: str, length_mm: float
+) -> tuple[float, float]:
+    """(k, c) on the surrogate's axis `source` carried to the joint's `axis` (PRB for a rotational one)."""
+    k, c = coefficients
+    if axis == source:
         return k, c
-    ac = rotational_from_translational(AxisCoefficients(axis=source_axis, k=k, c=c), axis, length_mm)
+    ac = rotational_from_translational(AxisCoefficients(axis=source, k=k, c=c), axis, length_mm)
     return ac.k, ac.c
 
 
@@ -69,13 +74,14 @@ def source_axis(surrogate: Surrogate, axis: str) -> str:
 
 
 def joint_draws(
-    surrogate: Surrogate, design: Mapping[str, float], axis: str, n: int, rng: np.random.Generator
+    surrogate: Surrogate, *, design: Mapping[str, float], axis: str, n: int, rng: np.random.Generator
 ) -> dict[str, np.ndarray]:
     """`n` draws of k and c on a joint's axis (rig units), plus the surrogate-axis draws they came from."""
     src = source_axis(surrogate, axis)
-    k = draw(surrogate.model(f"k_{src}"), design, n, rng)
-    c = draw(surrogate.model(f"c_{src}"), design, n, rng)
-    scaled = [on_axis(ki, ci, src, axis, design["length"]) for ki, ci in zip(k, c, strict=True)]
+    k = draw(surrogate.model(f"k_{src}"), design, n=n, rng=rng)
+    c = draw(surrogate.model(f"c_{src}"), design, n=n, rng=rng)
+    length = design["length"]
+    scaled = [on_axis((ki, ci), source=src, axis=axis, length_mm=length) for ki, ci in zip(k, c, strict=True)]
     return {
         "k": np.array([s[0] for s in scaled]),
         "c": np.array([s[1] for s in scaled]),

@@ -46,7 +46,7 @@ def si_law(src: JointSource, coefficients: dict[str, float]) -> dict[str, float]
     return {q: units.to_si(q, src.axis, coefficients[q]) for q in ("k", "c")}
 
 
-def metrics(sc: Scenario, trace: Trace, c_si: dict[str, float]) -> dict[str, dict]:
+def metrics(sc: Scenario, *, trace: Trace, c_si: dict[str, float]) -> dict[str, dict]:
     """Per-joint metrics as `designer cosim` computes them (designer.cosim.metrics.joint_metrics)."""
     return {
         j: joint_metrics(trace.time, trace.q[j], trace.motor[j], trace.v[j], c_si[j], sc.motors[j])
@@ -54,7 +54,7 @@ def metrics(sc: Scenario, trace: Trace, c_si: dict[str, float]) -> dict[str, dic
     }
 
 
-def fmu_result(sc: Scenario, fmus: dict[str, Path], case: Case):
+def fmu_result(sc: Scenario, *, fmus: dict[str, Path], case: Case):
     """Co-simulate one case with `designer.cosim.run`: the batch's joint FMUs, the case's k and c set
     as FMU parameters (SI). Returns the cosim `Result` (time series and per-joint metrics)."""
     from ..cosim import run
@@ -71,7 +71,7 @@ def fmu_result(sc: Scenario, fmus: dict[str, Path], case: Case):
 RIG_METRICS = ("k_identified", "c_identified", "k_error_pct", "c_error_pct", "r2")
 
 
-def rig_identification(sc: Scenario, fmus: dict[str, Path], case: Case) -> dict[str, dict]:
+def rig_identification(sc: Scenario, *, fmus: dict[str, Path], case: Case) -> dict[str, dict]:
     """Run the virtual rig on one case's joint, identify its log, and compare with the case's k and c.
 
     The log is the one `designer cosim` writes for the rig (designer.cosim.run.rig_log), read
@@ -102,7 +102,7 @@ def trace_of(result) -> Trace:
     )
 
 
-def case_row(case: Case, outcome: dict | Exception, wall: float) -> dict:
+def case_row(case: Case, *, outcome: dict | Exception, wall: float) -> dict:
     """One table row: case number and key, inputs, k and c per joint, metrics, status, message, wall time."""
     row: dict = {"case": case.index, "key": case.key, **case.inputs}
     for j, coef in case.coefficients.items():
@@ -130,12 +130,12 @@ def _fmu_batch(task: Task) -> list[dict]:
             start = time.perf_counter()
             try:
                 if task.scenario.kind == "rig":
-                    outcome: dict | Exception = rig_identification(task.scenario, fmus, case)
+                    outcome: dict | Exception = rig_identification(task.scenario, fmus=fmus, case=case)
                 else:
-                    outcome = fmu_result(task.scenario, fmus, case).metrics
+                    outcome = fmu_result(task.scenario, fmus=fmus, case=case).metrics
             except Exception as exc:  # a failed case is recorded, never fatal to the sweep
                 outcome = _failure(exc)
-            rows.append(case_row(case, outcome, time.perf_counter() - start))
+            rows.append(case_row(case, outcome=outcome, wall=time.perf_counter() - start))
     return rows
 
 
@@ -152,8 +152,8 @@ def _engine_batch(task: Task) -> list[dict]:
     for case, out in zip(task.cases, outcomes, strict=True):
         if not isinstance(out, Exception):
             c_si = {j: si_law(src, case.coefficients[j])["c"] for j, src in task.scenario.joints.items()}
-            out = metrics(task.scenario, out, c_si)
-        rows.append(case_row(case, out, wall))
+            out = metrics(task.scenario, trace=out, c_si=c_si)
+        rows.append(case_row(case, outcome=out, wall=wall))
     return rows
 
 
@@ -176,6 +176,6 @@ def evaluate(task: Task) -> list[dict]:
         return _engine_batch(task) if task.path == "engine" else _fmu_batch(task)
 
 
-def batches(scenario: Scenario, path: str, cases: Sequence[Case], size: int) -> list[Task]:
+def batches(scenario: Scenario, *, path: str, cases: Sequence[Case], size: int) -> list[Task]:
     """Cases split into tasks of at most `size`."""
     return [Task(scenario, path, tuple(cases[i : i + size])) for i in range(0, len(cases), size)]

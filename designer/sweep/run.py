@@ -74,7 +74,7 @@ def _failed_rows(task: Task, exc: BaseException) -> list[dict]:
     from .evaluate import case_row
 
     message = RuntimeError(f"the worker failed: {type(exc).__name__}: {exc}")
-    return [case_row(case, message, math.nan) for case in task.cases]
+    return [case_row(case, outcome=message, wall=math.nan) for case in task.cases]
 
 
 @contextlib.contextmanager
@@ -109,7 +109,7 @@ def evaluate_cases(
 
         workers = 1 if isinstance(executor, SerialExecutor) else local_workers(spec.workers)
         size = _batch_size(spec, len(todo), workers)
-        tasks = batches(spec.scenario, spec.path, todo, size)
+        tasks = batches(spec.scenario, path=spec.path, cases=todo, size=size)
         with _default_executor(spec, executor) as ex, _journal(journal) as fh:
             futures = {ex.submit(evaluate, task): task for task in tasks}
             finished = 0
@@ -164,4 +164,4 @@ def run(
     cases = make_cases(spec)
     rows, resumed = evaluate_cases(spec, cases, executor=executor, journal=journal, progress=progress)
     frame = table(rows)
-    return SweepResult(frame, summarize(spec, frame, cases), spec, resumed)
+    return SweepResult(frame, summarize(spec, frame=frame, cases=cases), spec, resumed)

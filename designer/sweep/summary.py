@@ -88,7 +88,7 @@ def limit_shares(spec: Spec, frame: pd.DataFrame) -> dict:
     return {"limits": per, "share_meeting_all": float(every.mean())}
 
 
-def engine_check(spec: Spec, cases: Sequence[Case], frame: pd.DataFrame) -> dict | None:
+def engine_check(spec: Spec, *, cases: Sequence[Case], frame: pd.DataFrame) -> dict | None:
     """The engine path against the FMU co-simulation on `spec.check` cases spread over the finished ones."""
     if spec.path != "engine" or spec.check == 0:
         return None
@@ -108,11 +108,11 @@ def engine_check(spec: Spec, cases: Sequence[Case], frame: pd.DataFrame) -> dict
     angle, metric_diff = 0.0, {}
     with joint_fmus(sc) as fmus:
         for case, fast in zip(picks, engine, strict=True):
-            result = fmu_result(sc, fmus, case)
+            result = fmu_result(sc, fmus=fmus, case=case)
             trace = trace_of(result)
             angle = max(angle, max(float(np.max(np.abs(trace.q[j] - fast.q[j]))) for j in sc.joints))
             c_si = {j: si_law(src, case.coefficients[j])["c"] for j, src in sc.joints.items()}
-            slow, quick = result.metrics, metrics(sc, fast, c_si)
+            slow, quick = result.metrics, metrics(sc, trace=fast, c_si=c_si)
             for j in sc.joints:
                 for name, v in slow[j].items():
                     w = quick[j][name]
@@ -126,7 +126,7 @@ def engine_check(spec: Spec, cases: Sequence[Case], frame: pd.DataFrame) -> dict
     }
 
 
-def summarize(spec: Spec, frame: pd.DataFrame, cases: Sequence[Case]) -> dict:
+def summarize(spec: Spec, *, frame: pd.DataFrame, cases: Sequence[Case]) -> dict:
     """The summary of a sweep table: counts, percentiles, limit shares, units, the engine check."""
     failed = frame[frame["status"] != "ok"]
     summary = {
@@ -140,7 +140,7 @@ def summarize(spec: Spec, frame: pd.DataFrame, cases: Sequence[Case]) -> dict:
         "units": column_units(spec, frame),
     }
     summary |= limit_shares(spec, frame)
-    check = engine_check(spec, cases, frame)
+    check = engine_check(spec, cases=cases, frame=frame)
     if check is not None:
         summary["engine_check"] = check
     return summary

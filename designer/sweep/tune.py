@@ -88,12 +88,14 @@ def reachable(surrogate: Surrogate, axis: str) -> dict[str, tuple[float, float]]
     for q in ("k", "c"):
         p = pred[f"{q}_{src}"]
         lo, hi = (p.value, p.value) if surrogate.model(f"{q}_{src}").predictable else (p.low, p.high)
-        scale = np.array([on_axis(1.0, 1.0, src, axis, length)[0] for length in grid["length"]])
+        scale = np.array(
+            [on_axis((1.0, 1.0), source=src, axis=axis, length_mm=length)[0] for length in grid["length"]]
+        )
         out[q] = (float(np.min(lo * scale)), float(np.max(hi * scale)))
     return out
 
 
-def score(row: Mapping, sc: Scenario, objective: str, limits: Sequence[Limit]) -> float:
+def score(row: Mapping, *, sc: Scenario, objective: str, limits: Sequence[Limit]) -> float:
     """The minimised score of one evaluated case (see the module's docstring); step metrics count
     at the joints with a step reference only."""
     if row.get("status") != "ok":
@@ -232,7 +234,7 @@ class _Search:
         rows, _ = evaluate_cases(self.spec, finish(cases, self.spec), executor=self.executor)
         self.evaluations += len(rows)
         sc, limits = self.spec.scenario, self.spec.limits
-        return np.array([score(r, sc, self.objective, limits) for r in rows])
+        return np.array([score(r, sc=sc, objective=self.objective, limits=limits) for r in rows])
 
 
 def _optimise(
@@ -304,7 +306,9 @@ def _designs(
         if src != axis:  # PRB: the length sets the scale, so it is held where the joint has it
             length = _length(sc, j)
             fixed = {"length": length}
-        scale_k, scale_c = on_axis(1.0, 1.0, src, axis, fixed["length"]) if fixed else (1.0, 1.0)
+        scale_k, scale_c = (
+            on_axis((1.0, 1.0), source=src, axis=axis, length_mm=fixed["length"]) if fixed else (1.0, 1.0)
+        )
         s = suggest(surrogate, k=coef["k"] / scale_k, c=coef["c"] / scale_c, axis=src, fixed=fixed, top=3)
         tuned.designs[j] = {"axis": src, "targets": {"k": coef["k"] / scale_k, "c": coef["c"] / scale_c}} | {
             key: s.to_dict()[key] for key in ("units", "fixed", "statements", "candidates")
@@ -319,7 +323,7 @@ def _designs(
     )
     cases = make_cases(mc)
     rows, _ = evaluate_cases(mc, cases, executor=ex)
-    summary = summarize(mc, table(rows), cases)
+    summary = summarize(mc, frame=table(rows), cases=cases)
     tuned.robustness = {k: summary[k] for k in ("cases", "ok", "failed", "percentiles") if k in summary}
     tuned.robustness |= {k: summary[k] for k in ("limits", "share_meeting_all") if k in summary}
     tuned.robustness["designs"] = chosen
