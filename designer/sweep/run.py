@@ -6,7 +6,7 @@ import contextlib
 import json
 import math
 from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import Executor, as_completed
+from concurrent.futures import Executor, Future, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO
@@ -90,6 +90,27 @@ def _journal(path: Path | None) -> Iterator[IO | None]:
         yield fh
 
 
+def _finished(ex: Executor, tasks: Sequence[Task]) -> Iterator[list[dict]]:
+    """The rows of each task as it finishes; a serial executor runs one task at a time, so its rows
+    reach the journal and the progress bar as they come (submitting all first would run them all)."""
+    from .executors import SerialExecutor
+
+    if isinstance(ex, SerialExecutor):
+        for task in tasks:
+            yield _rows(ex.submit(evaluate, task), task)
+        return
+    futures = {ex.submit(evaluate, task): task for task in tasks}
+    for future in as_completed(futures):
+        yield _rows(future, futures[future])
+
+
+def _rows(future: Future, task: Task) -> list[dict]:
+    try:
+        return future.result()
+    except Exception as exc:  # the batch as a whole failed (a lost worker...): record it, go on
+        return _failed_rows(task, exc)
+
+
 def evaluate_cases(
     spec: Spec,
     cases: Sequence[Case],
@@ -111,13 +132,8 @@ def evaluate_cases(
         size = _batch_size(spec, len(todo), workers)
         tasks = batches(spec.scenario, path=spec.path, cases=todo, size=size)
         with _default_executor(spec, executor) as ex, _journal(journal) as fh:
-            futures = {ex.submit(evaluate, task): task for task in tasks}
             finished = 0
-            for future in as_completed(futures):
-                try:
-                    rows = future.result()
-                except Exception as exc:  # the batch as a whole failed: record it, go on
-                    rows = _failed_rows(futures[future], exc)
+            for rows in _finished(ex, tasks):
                 for row in rows:
                     new[row["key"]] = row
                     if fh is not None:
