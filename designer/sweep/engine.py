@@ -14,11 +14,12 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..cosim.master import Trace
 from ..cosim.robot import Robot, SpringDamper, load_spec
 from ..cosim.scenario import Scenario
 from ..errors import DesignerError
 from .cases import Case
-from .evaluate import Trace, si_law
+from .evaluate import si_law
 
 
 def _offsets(sc: Scenario) -> dict[str, float]:
@@ -37,7 +38,8 @@ def _motors(sc: Scenario, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def rollout_traces(sc: Scenario, cases: Sequence[Case]) -> list[Trace | Exception]:
-    """The trace of each case, or a DesignerError for a case whose model diverged (MuJoCo reset it)."""
+    """The trace of each case (columns `robot.J.q|motor|v` as in a co-simulation's result, rows at
+    t = 0, h, ...), or a DesignerError for a case whose model diverged (MuJoCo reset it)."""
     import mujoco
     from mujoco import rollout
 
@@ -65,6 +67,7 @@ def rollout_traces(sc: Scenario, cases: Sequence[Case]) -> list[Trace | Exceptio
     states, _ = rollout.rollout(models, mujoco.MjData(base), state0[None, :], controls)
     qadr = 1 + robot.qpos  # FULLPHYSICS state: time, qpos, qvel, act, plugin
     vadr = 1 + base.nq + robot.dof
+    columns = [f"robot.{j}.{x}" for x in ("q", "motor", "v") for j in joints]
     out: list[Trace | Exception] = []
     for b in range(len(cases)):
         s = np.vstack([state0[None, :], states[b]])
@@ -77,7 +80,6 @@ def rollout_traces(sc: Scenario, cases: Sequence[Case]) -> list[Trace | Exceptio
                 )
             )
             continue
-        q = {j: s[:, qadr[k]] for k, j in enumerate(joints)}
-        v = {j: s[:, vadr[k]] - mv[:, k] for k, j in enumerate(joints)}
-        out.append(Trace(t, q, {j: mq[:, k] for k, j in enumerate(joints)}, v))
+        values = np.column_stack([s[:, qadr], mq, s[:, vadr] - mv])
+        out.append(Trace(t, columns, values))
     return out

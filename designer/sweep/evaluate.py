@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import units
-from ..cosim.metrics import joint_metrics
+from ..cosim.master import Trace
 from ..cosim.scenario import JointSource, Scenario
 from ..errors import DesignerError
 from .cases import Case
@@ -31,27 +31,17 @@ class Task:
     cases: tuple[Case, ...]
 
 
-@dataclass(frozen=True)
-class Trace:
-    """One case's joint angles, motor angles and deflection rates (rad, rad/s), rows at t = 0, h, ..."""
-
-    time: np.ndarray
-    q: dict[str, np.ndarray]
-    motor: dict[str, np.ndarray]
-    v: dict[str, np.ndarray]
-
-
 def si_law(src: JointSource, coefficients: dict[str, float]) -> dict[str, float]:
     """The SI k and c of a case's joint (rig units in, on the joint's axis)."""
     return {q: units.to_si(q, src.axis, coefficients[q]) for q in ("k", "c")}
 
 
-def metrics(sc: Scenario, *, trace: Trace, c_si: dict[str, float]) -> dict[str, dict]:
-    """Per-joint metrics as `designer cosim` computes them (designer.cosim.metrics.joint_metrics)."""
-    return {
-        j: joint_metrics(trace.time, trace.q[j], trace.motor[j], trace.v[j], c_si[j], sc.motors[j])
-        for j in sc.joints
-    }
+def metrics(sc: Scenario, *, trace: Trace, case: Case) -> dict[str, dict]:
+    """Per-joint metrics of an in-engine trace, as `designer cosim` computes them (its robot_metrics)."""
+    from ..cosim.run import robot_metrics
+
+    laws = {j: si_law(src, case.coefficients[j]) for j, src in sc.joints.items()}
+    return robot_metrics(sc, trace, laws)
 
 
 def fmu_result(sc: Scenario, *, fmus: dict[str, Path], case: Case):
@@ -89,17 +79,6 @@ def rig_identification(sc: Scenario, *, fmus: dict[str, Path], case: Case) -> di
     fit = identify(log).axes[src.axis]
     values = (fit.k, fit.c, 100 * (fit.k / true["k"] - 1), 100 * (fit.c / true["c"] - 1), fit.r2)
     return {"rig": dict(zip(RIG_METRICS, map(float, values), strict=True))}
-
-
-def trace_of(result) -> Trace:
-    """The joint angles, motor angles and deflection rates of a cosim `Result`."""
-    joints = result.scenario.joints
-    return Trace(
-        result.time,
-        {j: result.column(f"robot.{j}.q") for j in joints},
-        {j: result.column(f"robot.{j}.motor") for j in joints},
-        {j: result.column(f"robot.{j}.v") for j in joints},
-    )
 
 
 def case_row(case: Case, *, outcome: dict | Exception, wall: float) -> dict:
@@ -151,8 +130,7 @@ def _engine_batch(task: Task) -> list[dict]:
     rows = []
     for case, out in zip(task.cases, outcomes, strict=True):
         if not isinstance(out, Exception):
-            c_si = {j: si_law(src, case.coefficients[j])["c"] for j, src in task.scenario.joints.items()}
-            out = metrics(task.scenario, trace=out, c_si=c_si)
+            out = metrics(task.scenario, trace=out, case=case)
         rows.append(case_row(case, outcome=out, wall=wall))
     return rows
 

@@ -7,7 +7,7 @@ import json
 import math
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Executor, Future, as_completed
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import IO
 
@@ -24,14 +24,13 @@ TAIL = ("status", "message", "wall_s")
 
 @dataclass
 class SweepResult:
-    """A sweep's outcome: one row per case (see `columns`), its summary, and the spec it ran."""
+    """A sweep's outcome: one row per case (see the README for the columns), its summary, the spec."""
 
     table: pd.DataFrame
     summary: dict
     spec: Spec
     #: cases found finished in the journal and not run again
     resumed: int = 0
-    files: list[Path] = field(default_factory=list)
 
 
 def read_journal(path: Path | None) -> dict[str, dict]:

@@ -94,7 +94,7 @@ def engine_check(spec: Spec, *, cases: Sequence[Case], frame: pd.DataFrame) -> d
         return None
     from ..cosim.run import joint_fmus
     from .engine import rollout_traces
-    from .evaluate import fmu_result, metrics, si_law, trace_of
+    from .evaluate import fmu_result, metrics
 
     ok = set(frame.loc[frame["status"] == "ok", "key"])
     finished = [c for c in cases if c.key in ok]
@@ -109,10 +109,9 @@ def engine_check(spec: Spec, *, cases: Sequence[Case], frame: pd.DataFrame) -> d
     with joint_fmus(sc) as fmus:
         for case, fast in zip(picks, engine, strict=True):
             result = fmu_result(sc, fmus=fmus, case=case)
-            trace = trace_of(result)
-            angle = max(angle, max(float(np.max(np.abs(trace.q[j] - fast.q[j]))) for j in sc.joints))
-            c_si = {j: si_law(src, case.coefficients[j])["c"] for j, src in sc.joints.items()}
-            slow, quick = result.metrics, metrics(sc, trace=fast, c_si=c_si)
+            q = [f"robot.{j}.q" for j in sc.joints]
+            angle = max(angle, max(float(np.max(np.abs(result.column(c) - fast.column(c)))) for c in q))
+            slow, quick = result.metrics, metrics(sc, trace=fast, case=case)
             for j in sc.joints:
                 for name, v in slow[j].items():
                     w = quick[j][name]
