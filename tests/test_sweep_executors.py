@@ -1,6 +1,5 @@
 """A 200-case sweep gives the same table serially, on local processes and on a Dask cluster of processes."""
 
-import contextlib
 import json
 import subprocess
 import sys
@@ -70,11 +69,13 @@ def dask_scheduler(tmp_path):
             )
         yield address
     finally:
-        for p in reversed(procs):  # workers first, then the scheduler
+        for p in reversed(procs):  # workers first, while the scheduler still answers them
             p.terminate()
-        for p in procs:
-            with contextlib.suppress(subprocess.TimeoutExpired):
-                p.wait(timeout=20)
+            try:
+                p.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait()
 
 
 def _specs() -> list[Spec]:
