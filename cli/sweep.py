@@ -184,6 +184,7 @@ def tune(
             )
     data = result.to_dict()
     if out is not None:
+        out.parent.mkdir(parents=True, exist_ok=True)
         with atomic_write(out) as fh:
             json.dump(data, fh, indent=2, default=float)
     if json_out:
