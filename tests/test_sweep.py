@@ -275,3 +275,20 @@ def test_tune_on_the_fmu_path():
     assert result.evaluations == 18 and result.fmu_check is None
     assert result.feasible and result.metrics["j1.overshoot_pct"] <= 20
     assert 200 <= result.coefficients["j1"]["k"] <= 600 and result.designs["j1"]["candidates"]
+
+
+def test_reachable_range_holds_every_printable_design():
+    """Default tune bounds: every design in the tested ranges predicts k and c inside them (theta via PRB)."""
+    from designer import space
+    from designer.sweep.tune import reachable
+
+    sur = Surrogate.load()
+    box = reachable(sur, "theta")
+    rng = np.random.default_rng(5)
+    designs = {f.name: rng.uniform(f.low, f.high, 300) for f in space.FACTORS if not f.categorical}
+    designs |= {f.name: rng.choice(f.levels, 300) for f in space.FACTORS if f.categorical}
+    pred = sur.predict(designs, responses=["k_x", "c_x"])
+    scale = (0.85 * designs["length"]) ** 2
+    k, c_low, c_high = pred["k_x"].value * scale, pred["c_x"].low * scale, pred["c_x"].high * scale
+    assert box["k"][0] <= k.min() and k.max() <= box["k"][1] * (1 + 1e-9)
+    assert box["c"][0] <= c_low.min() and c_high.max() <= box["c"][1] * (1 + 1e-9)  # c: its PI envelope
