@@ -6,9 +6,9 @@ generation is one batch of co-simulations evaluated through the sweep's executor
 log k and log c, so bounds spanning decades are searched evenly. The metrics are piecewise constant
 in k and c (settling is read on the time grid, overshoot is zero on a whole region), which rules
 out gradient and simplex methods; no polishing step is run for the same reason. Scores: the sum
-of the objective over the joints for a case meeting every limit; 1e3 when the objective is
-missing (never settled in the run); 1e6 plus the limits' excess when a limit is missed; 1e9 for
-a failed case.
+of the objective over the joints for a case meeting every limit; 1e6 when the objective is
+missing (never settled in the run); 1e9 times (1 + the limits' excess) when a limit is missed;
+1e12 for a failed case.
 """
 
 from __future__ import annotations
@@ -30,9 +30,10 @@ from .cases import Case, finish
 from .draws import on_axis, source_axis
 from .limits import Limit, applies, metric
 from .run import evaluate_cases
-from .spec import Cases, Spec
+from .spec import PATHS, Cases, Spec
 
-MISSING, INFEASIBLE, FAILED = 1e3, 1e6, 1e9
+#: scores above any sum of metrics (% , s, rad, J): the ranks of what went wrong
+MISSING, INFEASIBLE, FAILED = 1e6, 1e9, 1e12
 
 
 @dataclass
@@ -171,15 +172,17 @@ def tune(
 ) -> TuneResult:
     """Tune k and c of `joints` (default all) of a robot scenario; see the module docstring.
 
-    `bounds` maps "joint.k" / "joint.c" to (low, high) in rig units; missing ones are the range the
-    surrogate reaches. `path` "engine" searches with the in-engine fast path and checks the optimum
-    by FMU co-simulation; "fmu" co-simulates every evaluation. `robustness` Monte Carlo draws of the
-    suggested designs (0: none).
+    `bounds` maps "joint.k" / "joint.c" to (low, high) in rig units (equal ends hold it fixed);
+    missing ones are the range the surrogate reaches. `path` "engine" searches with the in-engine
+    fast path and checks the optimum by FMU co-simulation; "fmu" co-simulates every evaluation.
+    `robustness`: Monte Carlo draws of the suggested designs (0: none).
 
     Raises:
         DesignerError: unknown objective, joint or path; unusable bounds; a non-robot scenario.
     """
     objective = metric(objective)
+    if path not in PATHS:
+        raise DesignerError(f"path={path!r} is not allowed", "use path='engine' or path='fmu'")
     if scenario.kind != "robot":
         raise DesignerError("tune needs a robot scenario", "give a scenario with [robot] and [joints]")
     if not any(applies(objective, ref) for ref in scenario.motors.values()):
