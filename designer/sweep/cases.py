@@ -136,12 +136,9 @@ def suggestion(spec: Spec) -> list[Case]:
     from ..joint import Joint
 
     path: Path = spec.cases.file
-    try:
-        n = len(json.loads(path.read_text())["candidates"])
-    except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise DesignerError(
-            f"cannot read a suggestion from {path}: {exc}", "give 'designer suggest --json' output"
-        ) from None
+    from ..suggest import Suggestion
+
+    n = len(Suggestion.load(path).candidates)
     numbers = spec.cases.candidates or tuple(range(1, n + 1))
     joints = list(spec.cases.joints)
     cases = []
