@@ -24,7 +24,7 @@ import typer
 
 from designer.errors import DesignerError
 
-from . import cosim, design, export, plots, rig
+from . import cosim, design, export, plots, rig, sweep
 from .common import flag_message
 
 try:  # typer 0.28 vendors click
@@ -70,6 +70,7 @@ rig.register(app)
 export.register(app)
 cosim.register(app)
 plots.register(app)
+sweep.register(app)
 
 
 class Stopped(BaseException):
