@@ -26,7 +26,7 @@ SchedulerOpt = Annotated[
 def sweep(
     spec: Annotated[Path, typer.Argument(help="sweep file (TOML); see the README for its format")],
     out: Annotated[
-        Path, typer.Option("-o", "--out", help="folder for results.parquet, summary.json, metrics.png")
+        Path, typer.Option("-o", "--output", help="folder for results.parquet, summary.json, metrics.png")
     ] = Path("sweep"),
     workers: WorkersOpt = None,
     scheduler: SchedulerOpt = None,
@@ -139,7 +139,7 @@ def tune(
             help="JOINT.k=LOW:HIGH or JOINT.c=LOW:HIGH in rig units (default: the surrogate's reach).",
         ),
     ] = None,
-    out: Annotated[Path | None, typer.Option("-o", "--out", help="write the result as JSON here")] = None,
+    out: Annotated[Path | None, typer.Option("-o", "--output", help="write the result as JSON here")] = None,
     path: Annotated[
         str, typer.Option("--path", help="engine (fast, FMU-checked optimum) or fmu.")
     ] = "engine",
