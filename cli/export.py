@@ -118,6 +118,9 @@ def _snippet(
         json_out: Annotated[bool, typer.Option("--json", help="print the result as JSON")] = False,
         **options,
     ) -> None:
+        from designer.files import check_output
+
+        check_output(output)  # folder, writability, space; the writer checks its suffix
         joint = _joint(
             axis,
             k,
