@@ -52,6 +52,9 @@ def _complete(path: Path) -> None:
 def test_signal_during_rig_simulate_leaves_complete_files_or_none(tmp_path, sig, seed):
     after = random.Random(seed).uniform(0.3, 3.0)
     r = _interrupt([*SIMULATE, "-o", "big.csv"], tmp_path, sig, after)
+    if r.returncode == -sig:  # arrived while Python was still importing, before the CLI's handlers
+        assert list(tmp_path.iterdir()) == []
+        return
     assert r.returncode in (0, 128 + sig), r.stderr
     assert "Traceback" not in r.stderr
     names = {p.name for p in tmp_path.iterdir()}
@@ -69,7 +72,7 @@ def test_signal_during_rig_simulate_leaves_complete_files_or_none(tmp_path, sig,
 def test_sigterm_during_cosim_leaves_complete_files_or_none(tmp_path):
     after = random.Random(5).uniform(1.0, 4.0)
     r = _interrupt(["cosim", str(EXAMPLES / "rig.toml"), "-o", "res"], tmp_path, signal.SIGTERM, after)
-    assert r.returncode in (0, 143) and "Traceback" not in r.stderr, r.stderr
+    assert r.returncode in (0, 143, -signal.SIGTERM) and "Traceback" not in r.stderr, r.stderr
     for p in tmp_path.rglob("*"):
         assert not p.name.startswith("."), f"part file left: {p}"
         if p.is_file():
