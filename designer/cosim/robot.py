@@ -85,6 +85,14 @@ def check_joints(spec, names: Sequence[str]) -> None:
             )
 
 
+def diverged(t: float) -> DesignerError:
+    """The error for MuJoCo's bad-acceleration warning in the step from `t` (s): it reset the state."""
+    return DesignerError(
+        f"the robot diverged at t = {t:g} s (MuJoCo reset it)",
+        "use a smaller step, or the gauss-seidel algorithm",
+    )
+
+
 @dataclass(frozen=True)
 class SpringDamper:
     """The law computed in-engine for the reference: tau = -(k (s - offset) + c v), SI."""
@@ -172,10 +180,7 @@ class Robot:
             )
         self._mj_step(self.model, self.data)
         if self._bad.number:
-            raise DesignerError(
-                f"the robot diverged at t = {self.time:g} s (MuJoCo reset it)",
-                "use a smaller step, or the gauss-seidel algorithm",
-            )
+            raise diverged(self.time)
         self._steps += 1
         self.time = self._steps * h
         self._motor(self.time)

@@ -15,6 +15,7 @@ from .. import units
 from ..errors import DesignerError
 from ..files import atomic_path, atomic_write
 from .fmu import FmuSystem, read_parameters
+from .kernel import run_master
 from .master import Master, Result
 from .metrics import joint_metrics
 from .robot import Robot, SpringDamper, load_spec
@@ -60,8 +61,9 @@ def robot_run(
     duration: float,
     algorithm: str,
     progress: Progress = None,
+    engine: str = "auto",
 ) -> Result:
-    """The robot co-simulated with its joint FMUs."""
+    """The robot co-simulated with its joint FMUs, by `engine` (see kernel.run_master)."""
     robot = Robot(load_spec(sc.model, sc.lengths, sc.masses), sc.motors, step, sc.integrator)
     systems: dict = {"robot": robot}
     connections = []
@@ -78,7 +80,8 @@ def robot_run(
                 (f"robot.{name}.v", f"{name}.{a}.v"),
                 (f"{name}.{a}.f", f"robot.{name}.tau"),
             ]
-        return Master(systems, connections, algorithm).run(duration, step, progress)
+        master = Master(systems, connections, algorithm)
+        return run_master(master, duration, step, progress=progress, engine=engine)
     finally:
         for s in systems.values():
             if isinstance(s, FmuSystem):

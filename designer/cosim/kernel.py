@@ -1,0 +1,316 @@
+"""Run a Master's fixed-step loop in the compiled kernel (fmus/kernel/): same exchange, same bits, C speed.
+
+Python keeps everything but the loop: the Master checks the wiring and orders the exchange
+(`Master.schedule`), fmpy instantiates the FMUs, the Robot compiles the MuJoCo model. This module
+hands the kernel their raw pointers (each FMU's instance and its fmi2/fmi3 Set/Get/DoStep functions,
+mjModel and mjData, the motor references' numbers) and a preallocated output array, then reads the
+array. `run` picks the engine: the kernel when it can run every system, else the Python master
+(`Result.engine` says which ran).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+from collections.abc import Callable
+from ctypes import POINTER, c_double, c_int32, c_int64, c_uint32, c_void_p
+
+import numpy as np
+
+from ..errors import DesignerError
+from .fmu import FmuSystem
+from .master import Master, Result, diverged, steps
+from .references import Chirp, Sine, Step, Trajectory
+from .robot import Robot
+from .robot import diverged as robot_diverged
+
+ENGINES = ("auto", "kernel", "python")
+_ROBOT, _FMI2, _FMI3 = 0, 1, 2
+_OK, _FMU_STATUS, _DIVERGED, _ROBOT_DIVERGED = 0, 1, 2, 3
+_STATUS = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
+_P_DOUBLE = POINTER(c_double)
+_P_INT = POINTER(c_int32)
+
+
+class _Reference(ctypes.Structure):
+    _fields_ = [
+        ("kind", c_int32),
+        ("n", c_int32),
+        ("p", c_double * 4),
+        ("t", _P_DOUBLE),
+        ("q", _P_DOUBLE),
+        ("cursor", c_int64),
+    ]
+
+
+class _Robot(ctypes.Structure):
+    _fields_ = [
+        ("model", c_void_p),
+        ("data", c_void_p),
+        ("n_joints", c_int32),
+        ("n_inputs", c_int32),
+        ("qposadr", _P_INT),
+        ("dofadr", _P_INT),
+        ("input_dof", _P_INT),
+        ("refs", POINTER(_Reference)),
+        ("motor_q", _P_DOUBLE),
+        ("motor_v", _P_DOUBLE),
+        ("steps", c_int64),
+        ("time", c_double),
+    ]
+
+
+class _System(ctypes.Structure):
+    _fields_ = [
+        ("kind", c_int32),
+        ("n_in", c_int32),
+        ("n_out", c_int32),
+        ("out_offset", c_int32),
+        ("src", _P_INT),
+        ("in_buf", _P_DOUBLE),
+        ("instance", c_void_p),
+        ("set_fn", c_void_p),
+        ("get_fn", c_void_p),
+        ("step_fn", c_void_p),
+        ("in_vr", POINTER(c_uint32)),
+        ("out_vr", POINTER(c_uint32)),
+        ("steps", c_int64),
+    ]
+
+
+class _Run(ctypes.Structure):
+    _fields_ = [
+        ("n_systems", c_int32),
+        ("n_ops", c_int32),
+        ("n_cols", c_int32),
+        ("pad", c_int32),
+        ("systems", POINTER(_System)),
+        ("ops", _P_INT),
+        ("values", _P_DOUBLE),
+        ("step", c_double),
+        ("n", c_int64),
+        ("error_system", c_int32),
+        ("error_call", c_int32),
+        ("error_status", c_int32),
+        ("pad2", c_int32),
+        ("error_time", c_double),
+    ]
+
+
+@functools.cache
+def library() -> ctypes.CDLL:
+    """The kernel's shared library, built on first use (see kernel_build).
+
+    Raises:
+        DesignerError: no C compiler or the build failed.
+    """
+    from .kernel_build import build_kernel
+
+    lib = ctypes.CDLL(str(build_kernel()))
+    lib.ks_run_rows.argtypes = [POINTER(_Run), c_int64, c_int64]
+    lib.ks_run_rows.restype = c_int32
+    lib.ks_reference_eval.argtypes = [POINTER(_Reference), c_double, _P_DOUBLE, _P_DOUBLE]
+    lib.ks_reference_eval.restype = None
+    return lib
+
+
+def _ints(values) -> np.ndarray:
+    return np.ascontiguousarray(values, dtype=np.int32)
+
+
+def _ptr(array: np.ndarray, kind=_P_DOUBLE):
+    return array.ctypes.data_as(kind)
+
+
+def reference(ref, keep: list) -> _Reference:
+    """A motor reference as the kernel's struct; arrays it points to are appended to `keep`.
+
+    Raises:
+        DesignerError: a reference type the kernel does not know (a Python callable).
+    """
+    out = _Reference()
+    if isinstance(ref, Step):
+        out.kind, params = 0, (ref.amplitude, ref.at, ref.initial)
+    elif isinstance(ref, Sine):
+        out.kind, params = 1, (ref.amplitude, ref.frequency, ref.offset, ref.phase)
+    elif isinstance(ref, Chirp):
+        out.kind, params = 2, (ref.amplitude, ref.f0, ref.f1, ref.sweep)
+    elif isinstance(ref, Trajectory):
+        t, q = np.ascontiguousarray(ref.t, float), np.ascontiguousarray(ref.q, float)
+        keep += [t, q]
+        out.kind, params, out.n, out.t, out.q = 3, (), len(t), _ptr(t), _ptr(q)
+    else:
+        raise DesignerError(
+            f"the kernel has no motor reference of type {type(ref).__name__}",
+            "use a step, sine, chirp or trajectory reference, or engine='python'",
+        )
+    out.p[: len(params)] = [float(p) for p in params]
+    return out
+
+
+def _robot(robot: Robot, keep: list) -> _Robot:
+    if robot.in_engine:
+        raise DesignerError(
+            "the kernel does not run in-engine spring-dampers", "use engine='python' for the reference"
+        )
+    refs = (_Reference * len(robot.motors))(*[reference(r, keep) for r in robot.motors])
+    qposadr, dofadr, inputs = _ints(robot.qpos), _ints(robot.dof), _ints(robot._input_dof)
+    keep += [refs, qposadr, dofadr, inputs]
+    return _Robot(
+        model=robot.model._address,
+        data=robot.data._address,
+        n_joints=len(robot.joints),
+        n_inputs=len(inputs),
+        qposadr=_ptr(qposadr, _P_INT),
+        dofadr=_ptr(dofadr, _P_INT),
+        input_dof=_ptr(inputs, _P_INT),
+        refs=refs,
+        motor_q=_ptr(robot.motor_q),
+        motor_v=_ptr(robot.motor_v),
+        steps=robot._steps,
+        time=robot.time,
+    )
+
+
+def _function(fmu, name: str) -> int:
+    return ctypes.cast(getattr(fmu.dll, name), c_void_p).value
+
+
+def _fmu(system: FmuSystem, out: _System) -> None:
+    fmu, v = system.fmu, system.version
+    out.kind = _FMI3 if v == 3 else _FMI2
+    out.instance = fmu.component
+    names = (
+        ("fmi3SetFloat64", "fmi3GetFloat64", "fmi3DoStep")
+        if v == 3
+        else ("fmi2SetReal", "fmi2GetReal", "fmi2DoStep")
+    )
+    out.set_fn, out.get_fn, out.step_fn = (_function(fmu, n) for n in names)
+    out.in_vr = ctypes.cast(system._in_vr, POINTER(c_uint32))
+    out.out_vr = ctypes.cast(system._out_vr, POINTER(c_uint32))
+    out.steps = system._steps
+
+
+def _systems(master: Master, keep: list) -> ctypes.Array:
+    """The master's systems as kernel structs, in its order.
+
+    Raises:
+        DesignerError: a system the kernel cannot run (neither a Robot nor an FmuSystem).
+    """
+    structs = (_System * len(master.systems))()
+    for out, (name, system) in zip(structs, master.systems.items(), strict=True):
+        src = _ints(master._src[name])
+        buf = np.zeros(len(src))
+        keep += [src, buf]
+        out.n_in, out.n_out = len(system.inputs), len(system.outputs)
+        out.out_offset = master._out[name].start
+        out.src, out.in_buf = _ptr(src, _P_INT), _ptr(buf)
+        if isinstance(system, Robot):
+            robot = _robot(system, keep)
+            keep.append(robot)
+            out.kind, out.instance = _ROBOT, ctypes.addressof(robot)
+        elif isinstance(system, FmuSystem):
+            _fmu(system, out)
+        else:
+            raise DesignerError(
+                f"the kernel cannot run system {name} ({type(system).__name__})",
+                "use engine='python' for systems written in Python",
+            )
+    return structs
+
+
+def _fail(master: Master, run: _Run, rc: int) -> DesignerError:
+    """The error for the kernel's outcome `rc`: divergence, or an FMU's error status."""
+    if rc == _DIVERGED:
+        return diverged(run.error_time)
+    if rc == _ROBOT_DIVERGED:
+        return robot_diverged(run.error_time)
+    name = list(master.systems)[run.error_system]
+    system = master.systems[name]
+    call = ("SetReal", "GetReal", "DoStep") if system.version == 2 else ("SetFloat64", "GetFloat64", "DoStep")
+    status = _STATUS[run.error_status] if run.error_status < len(_STATUS) else str(run.error_status)
+    return DesignerError(
+        f"FMU {name}: fmi{system.version}{call[run.error_call]} returned {status} "
+        f"at t = {run.error_time:g} s",
+        "see the FMU's log above; check its parameters and inputs, or use a smaller step",
+    )
+
+
+def _sync(master: Master, structs: ctypes.Array) -> None:
+    """Hand the step counts and times the kernel advanced back to the Python systems."""
+    for out, system in zip(structs, master.systems.values(), strict=True):
+        if isinstance(system, Robot):
+            robot = _Robot.from_address(out.instance)
+            system._steps, system.time = robot.steps, robot.time
+        else:
+            system._steps = out.steps
+
+
+def run(
+    master: Master, duration: float, step: float, *, progress: Callable[[float], None] | None = None
+) -> Result:
+    """Run `master`'s systems from 0 to `duration` (s) at macro step `step` (s) in the compiled kernel.
+
+    The result is bit for bit the one `master.run` gives, with `engine="kernel"`.
+
+    Raises:
+        DesignerError: the kernel cannot be built or cannot run a system; an FMU returned Discard,
+            Error or Fatal; the co-simulation diverged.
+    """
+    n = steps(duration, step)
+    lib = library()
+    keep: list = []
+    structs = _systems(master, keep)
+    index = {name: i for i, name in enumerate(master.systems)}
+    ops = _ints([(0 if op == "get" else 1, index[name]) for op, name in master.schedule()]).ravel()
+    values = np.empty((n + 1, len(master.columns)))
+    state = _Run(
+        n_systems=len(structs),
+        n_ops=len(ops) // 2,
+        n_cols=values.shape[1],
+        systems=structs,
+        ops=_ptr(ops, _P_INT),
+        values=_ptr(values),
+        step=step,
+        n=n,
+    )
+    chunk = n + 1 if progress is None else max(1, n // 200)
+    try:
+        for first in range(0, n + 1, chunk):
+            rc = lib.ks_run_rows(ctypes.byref(state), first, min(first + chunk, n + 1))
+            if rc != _OK:
+                raise _fail(master, state, rc)
+            if progress is not None:
+                progress(min(first + chunk, n) / n)
+    finally:
+        _sync(master, structs)
+    return Result(time=np.arange(n + 1) * step, columns=master.columns, values=values, engine="kernel")
+
+
+def run_master(
+    master: Master,
+    duration: float,
+    step: float,
+    *,
+    progress: Callable[[float], None] | None = None,
+    engine: str = "auto",
+) -> Result:
+    """Run `master` with `engine`: "kernel", "python" (Master.run), or "auto" (the kernel when it can).
+
+    "auto" falls back to the Python master when there is no C compiler or a system is one the kernel
+    cannot run (a Python system, an in-engine reference); `Result.engine` says which ran.
+
+    Raises:
+        DesignerError: unknown engine; with engine="kernel", the kernel cannot run; any run error.
+    """
+    if engine not in ENGINES:
+        raise DesignerError(f"unknown engine '{engine}'", f"use one of: {', '.join(ENGINES)}")
+    if engine == "auto":
+        try:
+            library()
+            _systems(master, [])
+        except DesignerError:
+            engine = "python"
+    if engine == "python":
+        return master.run(duration, step, progress)
+    return run(master, duration, step, progress=progress)

@@ -1,0 +1,51 @@
+/* The fixed-step loop of designer/cosim/master.py: per row, the exchange schedule (gets and sets in
+ * the master's order), the row recorded, every system stepped, the row checked for non-finite values. */
+#include "kernel.h"
+
+static int32_t fail(ks_run *run, int32_t system, int32_t call, int32_t status, double t) {
+    run->error_system = system;
+    run->error_call = call;
+    run->error_status = status;
+    run->error_time = t;
+    return run->systems[system].kind == KS_ROBOT ? KS_ROBOT_DIVERGED : KS_FMU_STATUS;
+}
+
+/* A status above Warning stops the run, as fmpy raises for it in the Python master. */
+static int32_t exchange(ks_run *run, double *row, double t) {
+    for (int32_t i = 0; i < run->n_ops; i++) {
+        int32_t op = run->ops[2 * i], k = run->ops[2 * i + 1];
+        ks_system *s = &run->systems[k];
+        int32_t status = op == KS_GET ? ks_get(s, row) : ks_set(s, row);
+        if (status > 1) return fail(run, k, op == KS_GET ? KS_CALL_GET : KS_CALL_SET, status, t);
+    }
+    return KS_OK;
+}
+
+/* Any NaN or infinity in the row makes the sum of value * 0 NaN: one multiply-add per column. */
+static int finite_row(const double *row, int32_t n) {
+    double acc = 0.0;
+    for (int32_t k = 0; k < n; k++) acc += row[k] * 0.0;
+    return acc == acc;
+}
+
+int32_t ks_run_rows(ks_run *run, int64_t first, int64_t last) {
+    double h = run->step;
+    for (int64_t i = first; i < last; i++) {
+        double *row = run->values + i * run->n_cols;
+        double t = (double)i * h;
+        int32_t rc = exchange(run, row, t);
+        if (rc != KS_OK) return rc;
+        if (i == run->n) break;
+        for (int32_t k = 0; k < run->n_systems; k++) {
+            ks_system *s = &run->systems[k];
+            double at = s->kind == KS_ROBOT ? ((ks_robot *)s->instance)->time : t;
+            int32_t status = ks_step(s, h);
+            if (status > 1) return fail(run, k, KS_CALL_STEP, status, at);
+        }
+        if (!finite_row(row, run->n_cols)) {
+            run->error_time = t;
+            return KS_DIVERGED;
+        }
+    }
+    return KS_OK;
+}

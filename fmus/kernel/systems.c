@@ -1,0 +1,78 @@
+/* The kernel's systems: get outputs into a row, set inputs from a row, step; each returns the FMI
+ * status (0 OK, 1 Warning, 2 Discard, 3 Error, 4 Fatal); the robot's step returns 2 or more when
+ * MuJoCo reset a diverged state. */
+#include <mujoco/mujoco.h>
+
+#include "fmi2FunctionTypes.h"
+#include "fmi3FunctionTypes.h"
+#include "kernel.h"
+
+/* Outputs in Robot.outputs order: deflections, their rates, joint angles, motor angles. */
+static void robot_get(const ks_robot *r, double *out) {
+    const mjData *d = (const mjData *)r->data;
+    int32_t n = r->n_joints;
+    for (int32_t j = 0; j < n; j++) {
+        double q = d->qpos[r->qposadr[j]];
+        out[j] = q - r->motor_q[j];
+        out[n + j] = d->qvel[r->dofadr[j]] - r->motor_v[j];
+        out[2 * n + j] = q;
+        out[3 * n + j] = r->motor_q[j];
+    }
+}
+
+/* One physics step, then the motors at the new time; MuJoCo's bad-acceleration warning (it reset the
+ * state) is the robot's divergence, as in Robot.do_step. */
+static int32_t robot_step(ks_robot *r, double h) {
+    mjData *d = (mjData *)r->data;
+    mj_step((const mjModel *)r->model, d);
+    if (d->warning[mjWARN_BADQACC].number) return KS_ROBOT_DIVERGED;
+    r->steps++;
+    r->time = (double)r->steps * h;
+    ks_robot_motors(r, r->time);
+    return 0;
+}
+
+int32_t ks_get(ks_system *s, double *row) {
+    double *out = row + s->out_offset;
+    switch (s->kind) {
+    case KS_ROBOT: robot_get((const ks_robot *)s->instance, out); return 0;
+    case KS_FMI2:
+        return ((fmi2GetRealTYPE *)s->get_fn)(s->instance, s->out_vr, (size_t)s->n_out, out);
+    default:
+        return ((fmi3GetFloat64TYPE *)s->get_fn)(s->instance, s->out_vr, (size_t)s->n_out, out,
+                                                  (size_t)s->n_out);
+    }
+}
+
+int32_t ks_set(ks_system *s, const double *row) {
+    if (s->kind == KS_ROBOT) {
+        const ks_robot *r = (const ks_robot *)s->instance;
+        double *qfrc = ((mjData *)r->data)->qfrc_applied;
+        for (int32_t k = 0; k < s->n_in; k++) qfrc[r->input_dof[k]] = row[s->src[k]];
+        return 0;
+    }
+    for (int32_t k = 0; k < s->n_in; k++) s->in_buf[k] = row[s->src[k]];
+    if (s->kind == KS_FMI2)
+        return ((fmi2SetRealTYPE *)s->set_fn)(s->instance, s->in_vr, (size_t)s->n_in, s->in_buf);
+    return ((fmi3SetFloat64TYPE *)s->set_fn)(s->instance, s->in_vr, (size_t)s->n_in, s->in_buf,
+                                              (size_t)s->n_in);
+}
+
+int32_t ks_step(ks_system *s, double h) {
+    int32_t status;
+    double t = (double)s->steps * h;
+    switch (s->kind) {
+    case KS_ROBOT: return robot_step((ks_robot *)s->instance, h);
+    case KS_FMI2:
+        status = ((fmi2DoStepTYPE *)s->step_fn)(s->instance, t, h, fmi2True);
+        break;
+    default: {
+        fmi3Boolean event = fmi3False, terminate = fmi3False, early = fmi3False;
+        fmi3Float64 last = 0.0;
+        status = ((fmi3DoStepTYPE *)s->step_fn)(s->instance, t, h, fmi3True, &event, &terminate, &early,
+                                                &last);
+    }
+    }
+    s->steps++;
+    return status;
+}
