@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import ctypes
 import shutil
+from collections import deque
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -18,6 +19,11 @@ import numpy as np
 from ..errors import DesignerError
 
 PARAMETERS = ("m", "c", "k", "offset")
+STATUS = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
+#: the log categories the FMI standard suggests for problems, enabled where an FMU declares them
+PROBLEM_CATEGORIES = ("logStatusWarning", "logStatusDiscard", "logStatusError", "logStatusFatal")
+#: how many of an FMU's last log messages are kept to explain an error
+LOG_LINES = 50
 
 
 def _axes_of(md) -> set[str]:
@@ -97,7 +103,11 @@ class FmuSystem:
             from fmpy.fmi2 import FMU2Slave
 
             self.fmu = FMU2Slave(**kwargs)
-        self.fmu.instantiate()
+        self.log: deque[str] = deque(maxlen=LOG_LINES)
+        self._instantiate()
+        problems = [c.name for c in md.logCategories if c.name in PROBLEM_CATEGORIES]
+        if problems:  # only problems: an FMU logging every call would slow each step
+            self.fmu.setDebugLogging(True, problems)
         for key, value in (parameters or {}).items():
             if key not in refs:
                 raise DesignerError(f"FMU {path} has no parameter '{key}'", "use names such as theta.k")
@@ -128,6 +138,30 @@ class FmuSystem:
             f = self.fmu
             self._set = lambda: f.fmi2SetReal(f.component, self._in_vr, len(self._in), self._in_ptr)
             self._get = lambda: f.fmi2GetReal(f.component, self._out_vr, len(self._out), self._out_ptr)
+
+    def _instantiate(self) -> None:
+        """Instantiate with a logger that keeps the FMU's last messages in `self.log` (none printed)."""
+
+        def record(*args) -> None:  # FMI 2: (env, instance, status, category, message); FMI 3: (env, ...)
+            status, category, message = args[-3:]
+            label = STATUS[status] if 0 <= status < len(STATUS) else str(status)
+            self.log.append(
+                f"[{label}] {(category or b'').decode(errors='replace')}: {message.decode(errors='replace')}"
+            )
+
+        if self.version == 3:
+            self.fmu.instantiate(logMessage=record)
+            return
+        from fmpy.fmi2 import defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+        from fmpy.logging import addLoggerProxy
+
+        self._callbacks = fmi2CallbackFunctions()
+        self._logger = fmi2CallbackLoggerTYPE(record)  # kept alive as long as the instance
+        self._callbacks.logger = self._logger
+        self._callbacks.allocateMemory = defaultCallbacks.allocateMemory
+        self._callbacks.freeMemory = defaultCallbacks.freeMemory
+        addLoggerProxy(ctypes.byref(self._callbacks))
+        self.fmu.instantiate(callbacks=self._callbacks)
 
     def _set_scalar(self, vr: int, value: float) -> None:
         if self.version == 3:

@@ -229,10 +229,11 @@ def _fail(master: Master, run: _Run, rc: int) -> DesignerError:
     system = master.systems[name]
     call = ("SetReal", "GetReal", "DoStep") if system.version == 2 else ("SetFloat64", "GetFloat64", "DoStep")
     status = _STATUS[run.error_status] if run.error_status < len(_STATUS) else str(run.error_status)
+    log = "\n".join(f"  {line}" for line in system.log) or "  (the FMU logged nothing)"
     return DesignerError(
         f"FMU {name}: fmi{system.version}{call[run.error_call]} returned {status} "
-        f"at t = {run.error_time:g} s",
-        "see the FMU's log above; check its parameters and inputs, or use a smaller step",
+        f"at t = {run.error_time:g} s; its log:\n{log}",
+        "check the FMU's parameters and inputs, or use a smaller step",
     )
 
 
