@@ -129,7 +129,7 @@ def test_interrupted_run_leaves_complete_files_or_none(tmp_path, monkeypatch):
     names = sorted(p.name for p in out.iterdir())
     assert names == ["metrics.json", "timeseries.csv", "timeseries.parquet"]
     assert len(np.loadtxt(out / "timeseries.csv", delimiter=",", skiprows=1)) == 201
-    monkeypatch.setattr(cosim_run.Master, "run", interrupt)
+    monkeypatch.setattr(cosim_run, "run_master", interrupt)
     with pytest.raises(KeyboardInterrupt):
         simulate(sc, tmp_path / "none")
     assert not (tmp_path / "none").exists()
