@@ -26,7 +26,8 @@ from .robot import diverged as robot_diverged
 
 ENGINES = ("auto", "kernel", "python")
 _ROBOT, _FMI2, _FMI3 = 0, 1, 2
-_OK, _FMU_STATUS, _DIVERGED, _ROBOT_DIVERGED = 0, 1, 2, 3
+_OK, _FMU_STATUS, _DIVERGED, _ROBOT_DIVERGED, _EVENT, _TERMINATE = 0, 1, 2, 3, 4, 5
+_CALLS = {2: ("SetReal", "GetReal", "DoStep"), 3: ("SetFloat64", "GetFloat64", "DoStep")}
 _STATUS = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
 _P_DOUBLE = POINTER(c_double)
 _P_INT = POINTER(c_int32)
@@ -72,9 +73,13 @@ class _System(ctypes.Structure):
         ("set_fn", c_void_p),
         ("get_fn", c_void_p),
         ("step_fn", c_void_p),
+        ("time_fn", c_void_p),
+        ("completed_fn", c_void_p),
         ("in_vr", POINTER(c_uint32)),
         ("out_vr", POINTER(c_uint32)),
         ("steps", c_int64),
+        ("asked", c_int32),
+        ("pad", c_int32),
     ]
 
 
@@ -94,6 +99,7 @@ class _Run(ctypes.Structure):
         ("error_status", c_int32),
         ("pad2", c_int32),
         ("error_time", c_double),
+        ("event_row", c_int64),
     ]
 
 
@@ -177,15 +183,20 @@ def _function(fmu, name: str) -> int:
 
 
 def _fmu(system: FmuSystem, out: _System) -> None:
+    """An FMU instance: co-simulation (DoStep) or Model Exchange without states (SetTime, and
+    CompletedIntegratorStep when the FMU needs it), as FmuSystem.do_step drives it."""
     fmu, v = system.fmu, system.version
     out.kind = _FMI3 if v == 3 else _FMI2
     out.instance = fmu.component
-    names = (
-        ("fmi3SetFloat64", "fmi3GetFloat64", "fmi3DoStep")
-        if v == 3
-        else ("fmi2SetReal", "fmi2GetReal", "fmi2DoStep")
-    )
-    out.set_fn, out.get_fn, out.step_fn = (_function(fmu, n) for n in names)
+    p = f"fmi{v}"
+    out.set_fn = _function(fmu, p + ("SetFloat64" if v == 3 else "SetReal"))
+    out.get_fn = _function(fmu, p + ("GetFloat64" if v == 3 else "GetReal"))
+    if system.kind == "co-simulation":
+        out.step_fn = _function(fmu, p + "DoStep")
+    else:
+        out.time_fn = _function(fmu, p + "SetTime")
+        if system._needs_cis:
+            out.completed_fn = _function(fmu, p + "CompletedIntegratorStep")
     out.in_vr = ctypes.cast(system._in_vr, POINTER(c_uint32))
     out.out_vr = ctypes.cast(system._out_vr, POINTER(c_uint32))
     out.steps = system._steps
@@ -220,21 +231,48 @@ def _systems(master: Master, keep: list) -> ctypes.Array:
 
 
 def _fail(master: Master, run: _Run, rc: int) -> DesignerError:
-    """The error for the kernel's outcome `rc`: divergence, or an FMU's error status."""
+    """The error for the kernel's outcome `rc`: divergence, a stop request, an FMU's error status."""
     if rc == _DIVERGED:
         return diverged(run.error_time)
     if rc == _ROBOT_DIVERGED:
         return robot_diverged(run.error_time)
     name = list(master.systems)[run.error_system]
     system = master.systems[name]
-    call = ("SetReal", "GetReal", "DoStep") if system.version == 2 else ("SetFloat64", "GetFloat64", "DoStep")
+    if rc == _TERMINATE:
+        return system._terminated()
+    call = (*_CALLS[system.version], "SetTime", "CompletedIntegratorStep")[run.error_call]
     status = _STATUS[run.error_status] if run.error_status < len(_STATUS) else str(run.error_status)
     log = "\n".join(f"  {line}" for line in system.log) or "  (the FMU logged nothing)"
     return DesignerError(
-        f"FMU {name}: fmi{system.version}{call[run.error_call]} returned {status} "
-        f"at t = {run.error_time:g} s; its log:\n{log}",
+        f"FMU {name}: fmi{system.version}{call} returned {status} at t = {run.error_time:g} s; "
+        f"its log:\n{log}",
         "check the FMU's parameters and inputs, or use a smaller step",
     )
+
+
+def _events(master: Master, structs: ctypes.Array) -> None:
+    """Run the event iterations the Model Exchange instances asked for in their last step."""
+    for out, system in zip(structs, master.systems.values(), strict=True):
+        if out.asked:
+            out.asked = 0
+            system.completed(True, False)
+
+
+def _loop(lib: ctypes.CDLL, master: Master, state: _Run, structs: ctypes.Array, chunk: int, progress) -> None:
+    """Rows 0..n in chunks of `chunk` rows, progress after each; events handled between rows."""
+    n, first = state.n, 0
+    while first <= n:
+        last = min(first + chunk, n + 1)
+        rc = lib.ks_run_rows(ctypes.byref(state), first, last)
+        if rc == _EVENT:
+            _events(master, structs)
+            first = state.event_row + 1
+            continue
+        if rc != _OK:
+            raise _fail(master, state, rc)
+        if progress is not None:
+            progress(min(last, n) / n)
+        first = last
 
 
 def _sync(master: Master, structs: ctypes.Array) -> None:
@@ -277,15 +315,16 @@ def run(
     )
     chunk = n + 1 if progress is None else max(1, n // 200)
     try:
-        for first in range(0, n + 1, chunk):
-            rc = lib.ks_run_rows(ctypes.byref(state), first, min(first + chunk, n + 1))
-            if rc != _OK:
-                raise _fail(master, state, rc)
-            if progress is not None:
-                progress(min(first + chunk, n) / n)
+        _loop(lib, master, state, structs, chunk, progress)
     finally:
         _sync(master, structs)
-    return Result(time=np.arange(n + 1) * step, columns=master.columns, values=values, engine="kernel")
+    return Result(
+        time=np.arange(n + 1) * step,
+        columns=master.columns,
+        values=values,
+        delays=master.delays(),
+        engine="kernel",
+    )
 
 
 def run_master(

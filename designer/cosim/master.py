@@ -1,10 +1,20 @@
 """A fixed-step co-simulation master over a connection graph: Gauss-Seidel (default) or Jacobi.
 
-A system exposes `inputs` and `outputs` (names), `feedthrough` (outputs depend on inputs at the same
-instant), `get() -> array`, `set(array)` and `do_step(h)`. Gauss-Seidel reads the state-based systems'
-outputs at t, then evaluates the feedthrough systems in dependency order (set inputs, read outputs at
-the same instant), then sets the remaining inputs and steps everyone: no delay around a loop. Jacobi
-reads every output first, so a feedthrough element answers with the inputs of the previous step.
+A system exposes `inputs` and `outputs` (names), `feedthrough` (it can give outputs for inputs set at
+the same instant), `get() -> array`, `set(array)`, `do_step(h)` and optionally `delay` (None, or a
+sentence saying which of its outputs lag their inputs by one step; collected into `Result.delays`).
+
+The exchange at t = i h, before every system steps from t to t + h (this is the exact sequence; an
+FMU system maps `get`/`set`/`do_step` to FMI calls as `cosim.fmu` describes):
+- Gauss-Seidel: (1) `get` every state system (not feedthrough), in the order given; (2) for each
+  feedthrough system in dependency order: `set` its inputs, then `get` its outputs (a force element
+  runs as Model Exchange, where that sequence is defined); (3) `set` the inputs of every state system;
+  record the outputs; (4) `do_step(h)` on every system in the order given. No delay around a loop
+  whose feedthrough elements run as Model Exchange.
+- Jacobi: `get` every system, then `set` every system, record, `do_step(h)` everyone: a feedthrough
+  element answers with the inputs of the previous step.
+A force element that offers co-simulation only is not feedthrough: it is read before it is set, a
+one-step delay, stated in `Result.delays`.
 """
 
 from __future__ import annotations
@@ -34,12 +44,14 @@ class System(Protocol):
 class Result:
     """Time series of every output, columns named `system.variable`, rows at t = 0, h, ..., N h.
 
-    `engine` says what ran the loop: "python" (this master) or "kernel" (the compiled kernel).
+    `delays` names every output that lags its inputs by one step (empty: none); `engine` says what
+    ran the loop: "python" (this master) or "kernel" (the compiled kernel).
     """
 
     time: np.ndarray
     columns: list[str]
     values: np.ndarray
+    delays: tuple[str, ...] = ()
     engine: str = "python"
 
     def column(self, name: str) -> np.ndarray:
@@ -143,6 +155,10 @@ class Master:
         name, var = self._split(ref)
         return self._out[name].start + self._position(name, var, kind)
 
+    def delays(self) -> tuple[str, ...]:
+        """The systems' statements of outputs lagging their inputs by one step (see FmuSystem.delay)."""
+        return tuple(d for s in self.systems.values() if (d := getattr(s, "delay", None)))
+
     def schedule(self) -> list[tuple[str, str]]:
         """One exchange as ("get" | "set", system) operations in order; the compiled kernel runs the same.
 
@@ -189,4 +205,4 @@ class Master:
                 progress(i / n)
         if progress is not None:
             progress(1.0)
-        return Result(time=np.arange(n + 1) * step, columns=self.columns, values=values)
+        return Result(time=np.arange(n + 1) * step, columns=self.columns, values=values, delays=self.delays())

@@ -271,6 +271,8 @@ def simulate(sc: Scenario, out: Path, with_validation: bool = False, progress: P
             res = robot_run(sc, fmus, sc.step, sc.duration, sc.algorithm, part(0.0, share))
             metrics = robot_metrics(sc, res, laws)
         summary = {"scenario": str(sc.path), "kind": sc.kind, "step": sc.step, "metrics": metrics}
+        if res.delays:
+            summary["delays"] = list(res.delays)
         if with_validation:
             summary["validation"] = validate(sc, fmus, laws, part(share, 1.0 - share))
     frame = pd.DataFrame(res.values, columns=res.columns)

@@ -26,9 +26,11 @@ enum { KS_GET = 0, KS_SET = 1 };
 /* motor references */
 enum { KS_REF_STEP = 0, KS_REF_SINE = 1, KS_REF_CHIRP = 2, KS_REF_TABLE = 3 };
 /* outcomes of ks_run_rows */
-enum { KS_OK = 0, KS_FMU_STATUS = 1, KS_DIVERGED = 2, KS_ROBOT_DIVERGED = 3 };
+enum { KS_OK = 0, KS_FMU_STATUS = 1, KS_DIVERGED = 2, KS_ROBOT_DIVERGED = 3, KS_EVENT = 4, KS_TERMINATE = 5 };
 /* which FMI call failed (index into the Python side's names) */
-enum { KS_CALL_SET = 0, KS_CALL_GET = 1, KS_CALL_STEP = 2 };
+enum { KS_CALL_SET = 0, KS_CALL_GET = 1, KS_CALL_STEP = 2, KS_CALL_TIME = 3, KS_CALL_COMPLETED = 4 };
+/* what a Model Exchange instance asked for in CompletedIntegratorStep */
+enum { KS_ASKED_EVENT = 1, KS_ASKED_TERMINATE = 2 };
 
 /* A motor reference: angle q(t) and rate v(t), rad and rad/s.
  * step:  p = {amplitude, at, initial}
@@ -60,7 +62,9 @@ typedef struct {
     double time;
 } ks_robot;
 
-/* One system of the graph: the robot (instance = ks_robot*) or an FMU co-simulation instance. */
+/* One system of the graph: the robot (instance = ks_robot*) or an FMU instance, co-simulation
+ * (step: DoStep(n h, h)) or Model Exchange without states (step: SetTime((n + 1) h), then
+ * CompletedIntegratorStep when the FMU needs it; an event it asks for is left to Python). */
 typedef struct {
     int32_t kind;
     int32_t n_in;
@@ -71,10 +75,14 @@ typedef struct {
     void *instance;
     void *set_fn;        /* fmi2SetReal / fmi3SetFloat64 */
     void *get_fn;        /* fmi2GetReal / fmi3GetFloat64 */
-    void *step_fn;       /* fmi2DoStep / fmi3DoStep */
+    void *step_fn;       /* co-simulation: fmi2DoStep / fmi3DoStep; NULL for Model Exchange */
+    void *time_fn;       /* Model Exchange: fmi2SetTime / fmi3SetTime */
+    void *completed_fn;  /* Model Exchange: fmi2/fmi3CompletedIntegratorStep, NULL if not needed */
     const uint32_t *in_vr;
     const uint32_t *out_vr;
     int64_t steps;
+    int32_t asked;       /* KS_ASKED_* flags from the last step */
+    int32_t pad;
 } ks_system;
 
 /* A run: the systems, the exchange schedule, the output array and, after an error, what failed. */
@@ -93,6 +101,7 @@ typedef struct {
     int32_t error_status;
     int32_t pad2;
     double error_time;    /* s */
+    int64_t event_row;    /* KS_EVENT: the row after whose step systems asked for an event */
 } ks_run;
 
 KS_EXPORT int32_t ks_run_rows(ks_run *run, int64_t first, int64_t last);

@@ -28,23 +28,45 @@ static int finite_row(const double *row, int32_t n) {
     return acc == acc;
 }
 
+/* Steps every system from row i's time; an FMU's stop request ends the run, event requests are
+ * collected (the Python side runs the event iterations before the next row). */
+static int32_t step_all(ks_run *run, double t, int *events) {
+    double h = run->step;
+    for (int32_t k = 0; k < run->n_systems; k++) {
+        ks_system *s = &run->systems[k];
+        double at = s->kind == KS_ROBOT ? ((ks_robot *)s->instance)->time : t;
+        int32_t status = ks_step(s, h);
+        if (status > 1) return fail(run, k, s->step_fn || s->kind == KS_ROBOT ? KS_CALL_STEP : KS_CALL_TIME,
+                                    status, at);
+        if (s->asked & KS_ASKED_TERMINATE) {
+            run->error_system = k;
+            run->error_time = t;
+            return KS_TERMINATE;
+        }
+        *events |= s->asked;
+    }
+    return KS_OK;
+}
+
 int32_t ks_run_rows(ks_run *run, int64_t first, int64_t last) {
     double h = run->step;
     for (int64_t i = first; i < last; i++) {
         double *row = run->values + i * run->n_cols;
         double t = (double)i * h;
+        int events = 0;
         int32_t rc = exchange(run, row, t);
         if (rc != KS_OK) return rc;
         if (i == run->n) break;
-        for (int32_t k = 0; k < run->n_systems; k++) {
-            ks_system *s = &run->systems[k];
-            double at = s->kind == KS_ROBOT ? ((ks_robot *)s->instance)->time : t;
-            int32_t status = ks_step(s, h);
-            if (status > 1) return fail(run, k, KS_CALL_STEP, status, at);
-        }
+        rc = step_all(run, t, &events);
+        if (rc != KS_OK) return rc;
         if (!finite_row(row, run->n_cols)) {
             run->error_time = t;
             return KS_DIVERGED;
+        }
+        if (events) {
+            run->error_time = t;
+            run->event_row = i;
+            return KS_EVENT;
         }
     }
     return KS_OK;

@@ -58,20 +58,40 @@ int32_t ks_set(ks_system *s, const double *row) {
                                               (size_t)s->n_in);
 }
 
+/* Model Exchange without states: time advances to (n + 1) h; the FMU may ask for an event or stop. */
+static int32_t exchange_step(ks_system *s, double h) {
+    int32_t status;
+    int ask_event, ask_stop;
+    s->steps++;
+    if (s->kind == KS_FMI2) {
+        fmi2Boolean event = fmi2False, stop = fmi2False;
+        status = ((fmi2SetTimeTYPE *)s->time_fn)(s->instance, (double)s->steps * h);
+        if (status > 1 || !s->completed_fn) return status;
+        status = ((fmi2CompletedIntegratorStepTYPE *)s->completed_fn)(s->instance, fmi2True, &event, &stop);
+        ask_event = event, ask_stop = stop;
+    } else {
+        fmi3Boolean event = fmi3False, stop = fmi3False;
+        status = ((fmi3SetTimeTYPE *)s->time_fn)(s->instance, (double)s->steps * h);
+        if (status > 1 || !s->completed_fn) return status;
+        status = ((fmi3CompletedIntegratorStepTYPE *)s->completed_fn)(s->instance, fmi3True, &event, &stop);
+        ask_event = event, ask_stop = stop;
+    }
+    s->asked = (ask_event ? KS_ASKED_EVENT : 0) | (ask_stop ? KS_ASKED_TERMINATE : 0);
+    return status;
+}
+
 int32_t ks_step(ks_system *s, double h) {
     int32_t status;
     double t = (double)s->steps * h;
-    switch (s->kind) {
-    case KS_ROBOT: return robot_step((ks_robot *)s->instance, h);
-    case KS_FMI2:
+    if (s->kind == KS_ROBOT) return robot_step((ks_robot *)s->instance, h);
+    if (!s->step_fn) return exchange_step(s, h);
+    if (s->kind == KS_FMI2) {
         status = ((fmi2DoStepTYPE *)s->step_fn)(s->instance, t, h, fmi2True);
-        break;
-    default: {
+    } else {
         fmi3Boolean event = fmi3False, terminate = fmi3False, early = fmi3False;
         fmi3Float64 last = 0.0;
         status = ((fmi3DoStepTYPE *)s->step_fn)(s->instance, t, h, fmi3True, &event, &terminate, &early,
                                                 &last);
-    }
     }
     s->steps++;
     return status;
