@@ -227,3 +227,52 @@ def test_systems_the_kernel_cannot_run_go_to_python():
         kernel.run(Master({"robot": robot}, []), 0.01, 1e-3)
     with pytest.raises(DesignerError, match="unknown engine"):
         kernel.run_master(Master({"robot": robot}, []), 0.01, 1e-3, engine="fast")
+
+
+def test_model_exchange_completed_steps_and_events_match(monkeypatch):
+    """FMUs that need CompletedIntegratorStep and ask for an event every 250th step: the kernel
+    calls it through the pointer and hands the event iterations to Python, as the master does."""
+    import ctypes
+
+    from designer.cosim import fmu as fmu_module
+
+    proto = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p)
+    original_init, real_function = fmu_module.FmuSystem.__init__, kernel._function
+    events, fakes, keep = [], {}, []
+
+    def asking(fmu):
+        real, count = proto(real_function(fmu, "fmi2CompletedIntegratorStep")), [0]
+
+        def completed(component, no_set, enter, stop):
+            status = real(component, no_set, enter, stop)
+            count[0] += 1
+            ctypes.cast(enter, ctypes.POINTER(ctypes.c_int))[0] = count[0] % 250 == 0
+            return status
+
+        return proto(completed)
+
+    def init(self, *args, **kwargs):
+        original_init(self, *args, **kwargs)
+        fake = asking(self.fmu)
+        keep.append(fake)
+        fakes[id(self.fmu)] = ctypes.cast(fake, ctypes.c_void_p).value
+        self._needs_cis = True
+
+        def python_completed():
+            enter, stop = ctypes.c_int(0), ctypes.c_int(0)
+            fake(self.fmu.component, 1, ctypes.addressof(enter), ctypes.addressof(stop))
+            return bool(enter.value), bool(stop.value)
+
+        self.fmu.completedIntegratorStep = python_completed
+        iteration = self._event_iteration
+        self._event_iteration = lambda: (events.append((self.fmu.instanceName, self._steps)), iteration())
+
+    def function(fmu, name):
+        return fakes[id(fmu)] if name.endswith("CompletedIntegratorStep") else real_function(fmu, name)
+
+    monkeypatch.setattr(fmu_module.FmuSystem, "__init__", init)
+    monkeypatch.setattr(kernel, "_function", function)
+    py, ker = both(load(EXAMPLE), duration=1.0)
+    assert_same(py, ker)
+    half = len(events) // 2
+    assert half == 8 and events[:half] == events[half:], events

@@ -255,6 +255,7 @@ def _events(master: Master, structs: ctypes.Array) -> None:
     for out, system in zip(structs, master.systems.values(), strict=True):
         if out.asked:
             out.asked = 0
+            system._steps = out.steps
             system.completed(True, False)
 
 
