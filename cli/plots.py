@@ -98,7 +98,7 @@ Surrogate = Annotated[
 def _surrogate(path: Path | None):
     from designer.surrogate import Surrogate as _S
 
-    return _S.load_default() if path is None else _S.load(path)
+    return _S.load() if path is None else _S.load(path)
 
 
 def _fixed(pairs: list[str]) -> dict[str, float]:
@@ -262,7 +262,7 @@ def validate_cmd(
     from designer.report import validate
 
     with progress_bar("validating") as bar:
-        results, page, md, seconds = validate(output, table, progress=bar)
+        results, page, md, seconds = validate(output, table=table, progress=bar)
     failed = [r for r in results if not r.passed]
     if as_json:
         print_json(

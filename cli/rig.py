@@ -207,7 +207,7 @@ def _augment(plans, n: int, k: float | None, c: float | None, axis: str, data: P
     from designer.data import load_table
     from designer.surrogate import Surrogate
 
-    sur = Surrogate().fit(load_table(data)) if data is not None else Surrogate.load_default()
+    sur = Surrogate().fit(load_table(data)) if data is not None else Surrogate.load()
     target = {r: v for r, v in ((f"k_{axis}", k), (f"c_{axis}", c)) if v is not None}
     unknown = [r for r in target if r not in sur.responses]
     if unknown:

@@ -1,5 +1,6 @@
 """The compiled co-simulation kernel against the Python master: the same bits, the same errors."""
 
+import importlib
 import math
 import shutil
 import subprocess
@@ -11,13 +12,13 @@ import numpy as np
 import pytest
 
 from designer.cosim import kernel
-from designer.cosim import run as cosim_run
 from designer.cosim.master import Master
 from designer.cosim.references import Chirp, Sine, Step, Trajectory
 from designer.cosim.robot import Robot, SpringDamper, load_spec
 from designer.cosim.scenario import load
 from designer.errors import DesignerError
 
+cosim_run = importlib.import_module("designer.cosim.run")
 EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "two_link_arm.toml"
 REFERENCES = [
     '{ type = "sine", amplitude = 0.5, frequency = 0.7, offset = 0.1, phase = 0.3 }',
@@ -276,3 +277,13 @@ def test_model_exchange_completed_steps_and_events_match(monkeypatch):
     assert_same(py, ker)
     half = len(events) // 2
     assert half == 8 and events[:half] == events[half:], events
+
+
+def test_public_run_says_which_engine_ran(tmp_path):
+    import designer.cosim
+
+    sc = n_link(tmp_path, 2, "gauss-seidel")
+    fast = designer.cosim.run(sc)
+    slow = designer.cosim.run(sc, engine="python")
+    assert (fast.engine, slow.engine) == ("kernel", "python")
+    assert fast.summary()["engine"] == "kernel" and np.array_equal(fast.values, slow.values)

@@ -111,7 +111,7 @@ def test_cli_doe_writes_plan(tmp_path):
 
 
 def test_augment_with_the_surrogate():
-    sur = Surrogate.load_default()
+    sur = Surrogate.load()
     near = near_target(lambda X: {r: p.value for r, p in sur.predict(X).items()}, {"k_x": 0.8, "c_x": 2e-3})
     plan, narrowing = augment(6, sur.models, sur.table, target=near)
     assert len(plan) == 6
@@ -131,6 +131,6 @@ def test_cli_augment_with_the_shipped_surrogate(tmp_path):
     assert len(doc["runs"]) == 4 and len(pd.read_csv(tmp_path / "next.csv")) == 4
     for run in doc["runs"]:
         space.validate({f: run[f] for f in space.FACTOR_NAMES})
-    assert set(doc["pi_narrowing"]) == set(Surrogate.load_default().responses)
+    assert set(doc["pi_narrowing"]) == set(Surrogate.load().responses)
     k = doc["pi_narrowing"]["k_x"]
     assert k["half_width_after"] < k["half_width_before"]

@@ -5,7 +5,7 @@ Python keeps everything but the loop: the Master checks the wiring and orders th
 hands the kernel their raw pointers (each FMU's instance and its fmi2/fmi3 Set/Get/DoStep functions,
 mjModel and mjData, the motor references' numbers) and a preallocated output array, then reads the
 array. `run` picks the engine: the kernel when it can run every system, else the Python master
-(`Result.engine` says which ran).
+(`Trace.engine` says which ran).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import DesignerError
 from .fmu import FmuSystem
-from .master import Master, Result, diverged, steps
+from .master import Master, Trace, diverged, steps
 from .references import Chirp, Sine, Step, Trajectory
 from .robot import Robot
 from .robot import diverged as robot_diverged
@@ -288,7 +288,7 @@ def _sync(master: Master, structs: ctypes.Array) -> None:
 
 def run(
     master: Master, duration: float, step: float, *, progress: Callable[[float], None] | None = None
-) -> Result:
+) -> Trace:
     """Run `master`'s systems from 0 to `duration` (s) at macro step `step` (s) in the compiled kernel.
 
     The result is bit for bit the one `master.run` gives, with `engine="kernel"`.
@@ -319,7 +319,7 @@ def run(
         _loop(lib, master, state, structs, chunk, progress)
     finally:
         _sync(master, structs)
-    return Result(
+    return Trace(
         time=np.arange(n + 1) * step,
         columns=master.columns,
         values=values,
@@ -335,11 +335,11 @@ def run_master(
     *,
     progress: Callable[[float], None] | None = None,
     engine: str = "auto",
-) -> Result:
+) -> Trace:
     """Run `master` with `engine`: "kernel", "python" (Master.run), or "auto" (the kernel when it can).
 
     "auto" falls back to the Python master when there is no C compiler or a system is one the kernel
-    cannot run (a Python system, an in-engine reference); `Result.engine` says which ran.
+    cannot run (a Python system, an in-engine reference); `Trace.engine` says which ran.
 
     Raises:
         DesignerError: unknown engine; with engine="kernel", the kernel cannot run; any run error.

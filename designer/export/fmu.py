@@ -75,10 +75,12 @@ class Variable:
     depends_on: tuple[str, ...] | None = None  # for Outputs and derivatives
 
 
-def _pi_text(pi: tuple[float, float] | None, quantity: str, axis: str) -> str:
-    if pi is None:
+def _pi_text(ac: AxisCoefficients, quantity: str) -> str:
+    """The 95 % PI of a predicted coefficient in SI, for the variable's description."""
+    pred, axis = ac.predicted.get(quantity), ac.axis
+    if pred is None:
         return ""
-    lo, hi = (units.to_si(quantity, axis, v) for v in pi)
+    lo, hi = (units.to_si(quantity, axis, v) for v in (pred.low, pred.high))
     return f", 95 % PI {lo:.4g} to {hi:.4g} {units.si_unit(quantity, axis)}"
 
 
@@ -114,7 +116,7 @@ def _variables(joint: Joint, interface: str) -> list[Variable]:
                 "Real",
                 "parameter",
                 "tunable",
-                f"damping on {a}; {ac.origin}" + _pi_text(ac.c_pi95, "c", a),
+                f"damping on {a}; {ac.origin}" + _pi_text(ac, "c"),
                 si["c"],
                 units.si_unit("c", a),
             )
@@ -125,7 +127,7 @@ def _variables(joint: Joint, interface: str) -> list[Variable]:
                 "Real",
                 "parameter",
                 "tunable",
-                f"stiffness on {a}; {ac.origin}" + _pi_text(ac.k_pi95, "k", a),
+                f"stiffness on {a}; {ac.origin}" + _pi_text(ac, "k"),
                 si["k"],
                 units.si_unit("k", a),
             )

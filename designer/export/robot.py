@@ -94,3 +94,13 @@ def export_robot(joint: Joint, path: str | Path, fmt: str) -> Path:
     with atomic_write(path) as fh:
         fh.write(text)
     return path
+
+
+def export_mjcf(joint: Joint, path: str | Path) -> Path:
+    """Write the joint as an MJCF model at `path` (atomically); returns the path."""
+    return export_robot(joint, path, "mjcf")
+
+
+def export_urdf(joint: Joint, path: str | Path) -> Path:
+    """Write the joint as a URDF chain at `path` (atomically); returns the path."""
+    return export_robot(joint, path, "urdf")
