@@ -158,9 +158,15 @@ def robot_reference(sc: Scenario, laws: Mapping, step: float, duration: float, i
 
 
 def rig_run(
-    sc: Scenario, fmu: Path, params: Mapping, step: float, duration: float, progress: Progress = None
+    sc: Scenario,
+    fmu: Path,
+    params: Mapping,
+    step: float,
+    duration: float,
+    progress: Progress = None,
+    engine: str = "auto",
 ) -> Trace:
-    """The hub servo driving the joint FMU's body interface."""
+    """The hub servo driving the joint FMU's body interface (the servo is Python: "auto" runs it there)."""
     from .rig import HubServo, check_stable, servo_gains
 
     check_stable(params["m"], params["c"], params["k"], step)
@@ -171,7 +177,8 @@ def rig_run(
             raise DesignerError("the rig's FMU has the force interface", "export it with interface='body'")
         hub = HubServo(sc.hub, *servo_gains(params["m"], params["c"], params["k"]))
         connections = [(f"joint.{a}.s", "hub.s"), (f"joint.{a}.v", "hub.v"), ("hub.f", f"joint.{a}.f")]
-        return Master({"joint": joint, "hub": hub}, connections, sc.algorithm).run(duration, step, progress)
+        master = Master({"joint": joint, "hub": hub}, connections, sc.algorithm)
+        return run_master(master, duration, step, progress=progress, engine=engine)
     finally:
         joint.close()
 
@@ -288,7 +295,7 @@ def run(
     with joint_fmus(sc) as fmus:
         if sc.kind == "rig":
             laws = {"rig": law(sc.rig_joint, fmus["rig"])}
-            trace = rig_run(sc, fmus["rig"], laws["rig"], sc.step, sc.duration, part(0.0, share))
+            trace = rig_run(sc, fmus["rig"], laws["rig"], sc.step, sc.duration, part(0.0, share), engine)
             metrics = rig_metrics(sc, trace, laws["rig"])
             check = _validate_rig if validate else None
         else:
