@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DesignerError
-from ..rig.simulate import DURATION, F0, F1, HUB_AMPLITUDE
-from ..rig.simulate import Chirp as RigChirp
+from ..rig.chirp import DURATION, F0, F1, HUB_AMPLITUDE
+from ..rig.chirp import Chirp as RigChirp
 
 
 @dataclass(frozen=True)

@@ -9,40 +9,18 @@ dropout segments (the sensor reading NaN or stuck at zero), as on the real rig.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
 from .. import units
 from ..errors import DesignerError
+from .chirp import DURATION, F0, F1, HUB_AMPLITUDE, Chirp
 from .logs import LOAD, STUCK_SAMPLES
 
-#: the study's excitation (section 3.2)
-HUB_AMPLITUDE = 1.0
-F0 = 0.2
-F1 = 1.85
-DURATION = 2200.0
 RATE = 1000.0
 #: length of one simulated dropout segment, s
 DROPOUT_SECONDS = 0.05
-
-
-@dataclass(frozen=True)
-class Chirp:
-    """q(t) = sin(2 pi (f0 t + (f1 - f0) t^2 / (2 T))) and its exact derivatives."""
-
-    f0: float = F0
-    f1: float = F1
-    duration: float = DURATION
-
-    def __call__(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """q, q' and q'' at the times t."""
-        sweep = (self.f1 - self.f0) / self.duration
-        phase = 2 * np.pi * (self.f0 * t + sweep * t**2 / 2)
-        omega = 2 * np.pi * (self.f0 + sweep * t)
-        s, c = np.sin(phase), np.cos(phase)
-        return s, omega * c, 2 * np.pi * sweep * c - omega**2 * s
 
 
 def _check(name: str, value: float, positive: bool = True) -> float:
