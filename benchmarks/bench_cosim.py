@@ -78,11 +78,9 @@ def floor_cpu(sc, laws, duration: float) -> float:
 
 
 def bare_cpu(sc, laws, duration: float) -> float:
-    """CPU seconds of the law and the motor references in Python around mj_step."""
-    spec = load_spec(sc.model, sc.lengths, sc.masses)
-    spec.option.timestep = STEP
-    model = spec.compile()
-    data = mujoco.MjData(model)
+    """CPU seconds of the law and the motor references in Python around mj_step (the Robot's model)."""
+    robot = Robot(load_spec(sc.model, sc.lengths, sc.masses), sc.motors, STEP, "euler")
+    model, data = robot.model, robot.data
     joints = [(model.joint(j).qposadr[0], model.joint(j).dofadr[0], sc.motors[j], laws[j]) for j in sc.joints]
 
     def loop():

@@ -287,3 +287,20 @@ def test_public_run_says_which_engine_ran(tmp_path):
     slow = designer.cosim.run(sc, engine="python")
     assert (fast.engine, slow.engine) == ("kernel", "python")
     assert fast.summary()["engine"] == "kernel" and np.array_equal(fast.values, slow.values)
+
+
+def test_skipping_the_constraint_stage_changes_no_bit(monkeypatch):
+    import mujoco
+
+    from designer.cosim import robot as robot_module
+
+    sc = load(EXAMPLE)
+    spec = load_spec(sc.model, sc.lengths, sc.masses)
+    assert robot_module.constraint_free(spec.compile())
+    spec.joints[0].limited = mujoco.mjtLimited.mjLIMITED_TRUE
+    spec.joints[0].range = [-1.0, 1.0]
+    assert not robot_module.constraint_free(spec.compile())
+    fast = both(sc, duration=2.0)[1]
+    monkeypatch.setattr(robot_module, "constraint_free", lambda model: False)
+    full = both(sc, duration=2.0)[1]
+    assert np.array_equal(fast.values, full.values)

@@ -155,9 +155,19 @@ def reference(ref, keep: list) -> _Reference:
 
 
 def _robot(robot: Robot, keep: list) -> _Robot:
+    """The robot as the kernel's struct: MuJoCo's mjModel/mjData pointers, its joints and motors.
+
+    Raises:
+        DesignerError: in-engine spring-dampers (the validation reference), or bindings too old.
+    """
     if robot.in_engine:
         raise DesignerError(
             "the kernel does not run in-engine spring-dampers", "use engine='python' for the reference"
+        )
+    if not hasattr(robot.model, "_address"):  # the raw pointers came with mujoco's 3.x bindings
+        raise DesignerError(
+            "this mujoco's Python bindings give no raw model pointers",
+            "update mujoco, or use engine='python'",
         )
     refs = (_Reference * len(robot.motors))(*[reference(r, keep) for r in robot.motors])
     qposadr, dofadr, inputs = _ints(robot.qpos), _ints(robot.dof), _ints(robot._input_dof)
