@@ -304,3 +304,25 @@ def test_skipping_the_constraint_stage_changes_no_bit(monkeypatch):
     monkeypatch.setattr(robot_module, "constraint_free", lambda model: False)
     full = both(sc, duration=2.0)[1]
     assert np.array_equal(fast.values, full.values)
+
+
+def test_runs_in_threads_agree_and_mujoco_keeps_its_clock():
+    import ctypes
+    from concurrent.futures import ThreadPoolExecutor
+
+    from designer.cosim.kernel_build import mujoco_paths
+
+    hook = ctypes.c_void_p.in_dll(ctypes.CDLL(str(mujoco_paths()[1])), "mjcb_time")
+    before = hook.value
+    sc = load(EXAMPLE)
+    with cosim_run.joint_fmus(sc) as fmus:
+
+        def one(_):
+            return cosim_run.robot_run(sc, fmus, sc.step, 2.0, sc.algorithm, engine="kernel").values
+
+        with ThreadPoolExecutor(3) as pool:
+            results = list(pool.map(one, range(3)))
+        with pytest.raises(DesignerError, match="diverged"):
+            cosim_run.robot_run(sc, fmus, 5e-3, 1.0, "jacobi", engine="kernel")
+    assert all(np.array_equal(results[0], r) for r in results[1:])
+    assert hook.value == before

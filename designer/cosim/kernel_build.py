@@ -30,6 +30,7 @@ FLAGS: tuple[str, ...] = (
     "-fno-builtin-pow",
     "-fno-builtin-sin",
     "-fno-builtin-cos",
+    "-pthread",
     "-Werror=implicit-function-declaration",
 )
 SOURCES = ("kernel/master.c", "kernel/systems.c", "kernel/references.c")

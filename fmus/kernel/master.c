@@ -1,5 +1,7 @@
 /* The fixed-step loop of designer/cosim/master.py: per row, the exchange schedule (gets and sets in
  * the master's order), the row recorded, every system stepped, the row checked for non-finite values. */
+#include <pthread.h>
+
 #include <mujoco/mujoco.h>
 
 #include "kernel.h"
@@ -75,13 +77,24 @@ static int32_t run_rows(ks_run *run, int64_t first, int64_t last) {
 }
 
 /* MuJoCo's Python bindings install a clock as mjcb_time, which mj_step then reads around each of its
- * stages for its profiling timers (d->timer): about 0.7 us of a 2-link arm's step. The loop runs
- * without it (no physics changes, only those timers stay still) and gives it back. */
+ * stages for its profiling timers (d->timer): about 0.7 us of a 2-link arm's step. The loops run
+ * without it (no physics changes, only those timers stay still); the last loop to finish gives it
+ * back, so runs in several threads at once do not lose it. */
+static pthread_mutex_t clock_lock = PTHREAD_MUTEX_INITIALIZER;
+static int clock_users = 0;
+static mjfTime clock_saved = NULL;
+
 int32_t ks_run_rows(ks_run *run, int64_t first, int64_t last) {
-    mjfTime clock = mjcb_time;
     int32_t rc;
-    mjcb_time = NULL;
+    pthread_mutex_lock(&clock_lock);
+    if (clock_users++ == 0) {
+        clock_saved = mjcb_time;
+        mjcb_time = NULL;
+    }
+    pthread_mutex_unlock(&clock_lock);
     rc = run_rows(run, first, last);
-    mjcb_time = clock;
+    pthread_mutex_lock(&clock_lock);
+    if (--clock_users == 0) mjcb_time = clock_saved;
+    pthread_mutex_unlock(&clock_lock);
     return rc;
 }
