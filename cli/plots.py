@@ -241,7 +241,9 @@ def _read_series(path: Path):
     if not path.is_file():
         raise DesignerError(f"no such file: {path}", "give a CSV or Parquet time series")
     try:
-        return pd.read_parquet(path) if path.suffix.lower() in (".parquet", ".pq") else pd.read_csv(path)
+        from designer.data import read_frame
+
+        return read_frame(path)
     except (ValueError, OSError, pd.errors.ParserError, UnicodeDecodeError) as exc:
         raise DesignerError(
             f"cannot read {path}: {str(exc).splitlines()[0]}", "give a CSV or Parquet file"

@@ -71,7 +71,7 @@ CHECKS: tuple[tuple[str, str], ...] = (
     ("designer.stats_checks", "check_table4"),
     ("designer.stats_checks", "check_main_effects"),
     ("designer.surrogate_checks", "check_surrogate_loo"),
-    ("designer.export.checks", "check_fmu"),
+    ("designer.export.checks", "check_fmus"),
     ("designer.rig.checks", "check_identification"),
     ("designer.cosim.checks", "check_cosim"),
 )

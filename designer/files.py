@@ -104,3 +104,17 @@ def atomic_folder(path: str | Path) -> Iterator[Path]:
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
+
+
+def check_suffix(path: str | Path, suffixes: tuple[str, ...], *, what: str) -> Path:
+    """Refuse a path whose suffix is not one of `suffixes` (a writer writes only its own format).
+
+    Raises:
+        DesignerError: naming the `path` argument, the format and the suffixes it takes.
+    """
+    path = Path(path)
+    if path.suffix.lower() not in suffixes:
+        raise DesignerError(
+            f"path={str(path)!r} does not name {what} file", f"give a path ending in {' or '.join(suffixes)}"
+        )
+    return path

@@ -193,7 +193,7 @@ class Suggestion:
         except (KeyError, TypeError, ValueError, AttributeError) as exc:
             raise DesignerError(
                 f"{where} is not a suggestion (missing or malformed {exc})",
-                "use the output of designer.suggest(...).to_dict() (designer suggest --json)",
+                "use the output of designer.suggest(...).to_dict()",
             ) from None
 
     @classmethod
@@ -207,10 +207,12 @@ class Suggestion:
         except (OSError, ValueError) as exc:
             raise DesignerError(
                 f"cannot read a suggestion from path={str(path)!r}: {exc}",
-                "give a JSON file written from Suggestion.to_dict() (designer suggest --json)",
+                "give a JSON file written from Suggestion.to_dict()",
             ) from None
         if not isinstance(data, dict):
-            raise DesignerError(f"{path.name} is not a suggestion", "give designer suggest --json output")
+            raise DesignerError(
+                f"{path.name} is not a suggestion", "give a JSON file written from Suggestion.to_dict()"
+            )
         return cls.from_dict(data, where=path.name)
 
 
@@ -298,12 +300,12 @@ def suggest(
         raise DesignerError(
             f"the surrogate has no axis '{axis}'",
             f"it has {', '.join(surrogate.axes) or 'none'}; "
-            "fit one on a table with that axis (designer fit --data)",
+            "fit one on a table with that axis: Surrogate().fit(table)",
         )
     if k is None and c is None:
-        raise DesignerError("no target given", "give --k and/or --c")
+        raise DesignerError("no target given", "give k= and/or c=")
     if top < 1:
-        raise DesignerError(f"--top {top} must be at least 1", "give a positive number of candidates")
+        raise DesignerError(f"top={top} must be at least 1", "give a positive number of candidates")
     importance = importance or {}
     bounds = bounds or {}
     targets = {

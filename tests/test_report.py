@@ -10,9 +10,9 @@ import pytest
 from imagecheck import assert_picture, chromium, dump_dom
 
 from designer import checks, report
+from designer.data import load_table
 from designer.data_checks import check_dataset
 from designer.stats_checks import check_main_effects
-from designer.data import load_table
 
 
 def test_validate_writes_a_passing_report(tmp_path):

@@ -23,7 +23,7 @@ def test_flagship_target(sur):
     assert r.reachable
     assert any("c_x is not predictable" in s for s in r.statements)
     assert r.predictability["k"]["q2"] >= 0.4
-    space.validate(top.params)  # printable and in range
+    space.check_design(top.params)  # printable and in range
     # distinct candidates, ranked by desirability
     assert len(r.candidates) == 5
     d = [c.desirability for c in r.candidates]

@@ -19,7 +19,7 @@ from ..errors import DesignerError
 from ..export.build import cache_dir, find_compiler, source_dir
 from ..files import atomic_path
 
-#: -ffp-contract=off and no pow/sin/cos builtins: the arithmetic of the Python master, bit for bit
+#: -ffp-contract=off and no sin/cos builtins: the arithmetic of the Python master, bit for bit
 FLAGS: tuple[str, ...] = (
     "-std=gnu99",
     "-O2",
@@ -27,7 +27,6 @@ FLAGS: tuple[str, ...] = (
     "-shared",
     "-fvisibility=hidden",
     "-ffp-contract=off",
-    "-fno-builtin-pow",
     "-fno-builtin-sin",
     "-fno-builtin-cos",
     "-pthread",

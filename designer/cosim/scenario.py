@@ -184,7 +184,7 @@ class Scenario:
         if self.factors is not None:
             from .. import space
 
-            object.__setattr__(self, "factors", space.validate(self.factors))
+            object.__setattr__(self, "factors", space.check_design(self.factors))
 
     def _check_validation(self) -> None:
         steps = self.validation_steps or tuple(self.step / 2**i for i in range(4))

@@ -52,12 +52,52 @@ def libcosim_step(path: Path, steps: int, step: float) -> object:
     return np.array(out)
 
 
-def check_fmu(ctx: Context) -> CheckResult:
+def _step_rows(body: Path, version: int, t: np.ndarray, exact: np.ndarray) -> tuple[list, dict]:
+    """fmpy's co-simulation and model exchange of the body FMU under the load, against `exact`."""
+    from fmpy import simulate_fmu
+
+    rows, curves, scale = [], {}, np.max(np.abs(exact))
+    for fmi_type, tol in FMU_TOLERANCE.items():
+        r = simulate_fmu(
+            str(body),
+            fmi_type=fmi_type,
+            stop_time=FMU_STOP,
+            step_size=1e-3,
+            output_interval=1e-3,
+            relative_tolerance=1e-10,
+            start_values={"x.f": FMU_LOAD},
+            output=["x.s"],
+        )
+        s = np.interp(t, r["time"], r["x.s"])
+        err = float(np.max(np.abs(s - exact)) / scale)
+        curves[f"FMI {version} {fmi_type}"] = s
+        rows.append(_row(f"fmpy step response FMI {version} {fmi_type}", err, tol))
+    return rows, curves
+
+
+def _row(check: str, err: float, tol: float) -> dict:
+    return {
+        "check": check,
+        "figure": f"max error {err:.2g} of the peak (limit {tol:g})",
+        "passed": err <= tol,
+    }
+
+
+def _libcosim_row(body: Path, t: np.ndarray, exact: np.ndarray) -> dict:
+    """libcosimpy stepping the FMI 2 body FMU, against `exact` (skipped when not installed)."""
+    try:
+        s = libcosim_step(body, len(t) - 1, 1e-3)
+    except ImportError:
+        return {"check": "libcosimpy", "figure": "skipped: libcosimpy not installed", "passed": True}
+    err = float(np.max(np.abs(s - exact[1:])) / np.max(np.abs(exact)))
+    return _row("libcosimpy step response FMI 2 CoSimulation", err, FMU_TOLERANCE["CoSimulation"])
+
+
+def check_fmus(ctx: Context) -> CheckResult:
     """FMI 2 and 3 archives pass validate_fmu; the body step response matches the analytic one in fmpy
     (co-simulation and model exchange) and in libcosimpy."""
     import tempfile
 
-    from fmpy import simulate_fmu
     from fmpy.validation import validate_fmu
 
     from ..joint import Joint
@@ -69,12 +109,13 @@ def check_fmu(ctx: Context) -> CheckResult:
     rows, curves = [], {}
     t = np.linspace(0.0, FMU_STOP, int(round(FMU_STOP / 1e-3)) + 1)
     exact = step_response(m, c, k, FMU_LOAD, t)
-    scale = np.max(np.abs(exact))
     with tempfile.TemporaryDirectory(prefix="designer-report-") as tmp:
         for version in (2, 3):
             for interface in ("force", "body"):
-                path = export_fmu(joint, Path(tmp) / f"joint{version}{interface}.fmu", version, interface)
-                problems = validate_fmu(str(path))
+                path = Path(tmp) / f"joint{version}{interface}.fmu"
+                problems = validate_fmu(
+                    str(export_fmu(joint, path, fmi_version=version, interface=interface))
+                )
                 rows.append(
                     {
                         "check": f"validate_fmu FMI {version} {interface}",
@@ -82,47 +123,12 @@ def check_fmu(ctx: Context) -> CheckResult:
                         "passed": not problems,
                     }
                 )
-            body = Path(tmp) / f"joint{version}body.fmu"
-            for fmi_type, tol in FMU_TOLERANCE.items():
-                r = simulate_fmu(
-                    str(body),
-                    fmi_type=fmi_type,
-                    stop_time=FMU_STOP,
-                    step_size=1e-3,
-                    output_interval=1e-3,
-                    relative_tolerance=1e-10,
-                    start_values={"x.f": FMU_LOAD},
-                    output=["x.s"],
-                )
-                s = np.interp(t, r["time"], r["x.s"])
-                err = float(np.max(np.abs(s - exact)) / scale)
-                curves[f"FMI {version} {fmi_type}"] = s
-                rows.append(
-                    {
-                        "check": f"fmpy step response FMI {version} {fmi_type}",
-                        "figure": f"max error {err:.2g} of the peak (limit {tol:g})",
-                        "passed": err <= tol,
-                    }
-                )
-        try:
-            s = libcosim_step(Path(tmp) / "joint2body.fmu", len(t) - 1, 1e-3)
-        except ImportError:
-            rows.append(
-                {"check": "libcosimpy", "figure": "skipped: libcosimpy not installed", "passed": True}
-            )
-        else:
-            err = float(np.max(np.abs(s - exact[1:])) / scale)
-            tol = FMU_TOLERANCE["CoSimulation"]
-            rows.append(
-                {
-                    "check": "libcosimpy step response FMI 2 CoSimulation",
-                    "figure": f"max error {err:.2g} of the peak (limit {tol:g})",
-                    "passed": err <= tol,
-                }
-            )
-    frame = pd.DataFrame({"t": t, "analytic": exact, **curves})
+            more, found = _step_rows(Path(tmp) / f"joint{version}body.fmu", version, t, exact)
+            rows += more
+            curves |= found
+        rows.append(_libcosim_row(Path(tmp) / "joint2body.fmu", t, exact))
     errors = {f"{name} error": curves[name] - exact for name in curves}
-    frame = frame.assign(**errors)
+    frame = pd.DataFrame({"t": t, "analytic": exact, **curves}).assign(**errors)
     fig = plot_timeseries(
         frame,
         ctx.figures / "fmu_step_response.png",

@@ -56,7 +56,7 @@ def held_values(table: pd.DataFrame, free: list[str], fixed: Mapping[str, float]
     fixed = dict(fixed or {})
     for name in fixed:
         if name in free:
-            raise DesignerError(f"{name} is drawn on an axis and also held fixed", f"drop --fix {name}=...")
+            raise DesignerError(f"{name} is drawn on an axis and also held fixed", f"drop {name} from fixed=")
     held = {}
     for f in space.FACTORS:
         if f.name in free:
@@ -75,7 +75,7 @@ def _free_factors(names: list[str]) -> list[space.Factor]:
         if f.categorical:
             raise DesignerError(
                 f"{f.name} is categorical ({f.describe_range()})",
-                "draw continuous factors (density, length, width, height) and hold it with --fix",
+                "draw continuous factors (density, length, width, height) and hold it in fixed=",
             )
     if len(set(names)) != len(names):
         raise DesignerError(f"a factor is repeated in {', '.join(names)}", "draw distinct factors")
@@ -301,7 +301,9 @@ def plot_volume(
 
     path, html = check_image_path(path), _check_html(html)
     if len(factors) != 3:
-        raise DesignerError(f"a volume needs three factors, got {len(factors)}", "give --x, --y and --z")
+        raise DesignerError(
+            f"a volume needs three factors, got {len(factors)}", "give three factors in factors="
+        )
     model = surrogate.model(response)
     fs = _free_factors(factors)
     table = surrogate.table

@@ -24,7 +24,7 @@ def check_identification(ctx: Context) -> CheckResult:
     from ..plots.checks import plot_identification
     from ..rig.identify import identify
     from ..rig.logs import validate_frame
-    from ..rig.simulate import simulate
+    from .simulate import simulate
 
     rows = []
     for i, (axis, coef) in enumerate(IDENTIFY_SETS):

@@ -14,10 +14,12 @@ import numpy as np
 import pandas as pd
 
 from .. import units
+from ..chirp import F0, F1, HUB_AMPLITUDE, SWEEP, Chirp
 from ..errors import DesignerError
-from .chirp import DURATION, F0, F1, HUB_AMPLITUDE, Chirp
 from .logs import LOAD, STUCK_SAMPLES
 
+#: the study's excitation (section 3.2), its sweep the default duration
+DURATION = SWEEP
 RATE = 1000.0
 #: length of one simulated dropout segment, s
 DROPOUT_SECONDS = 0.05
@@ -62,10 +64,10 @@ def simulate(
         raise DesignerError("no axis to simulate", "give m, c, k for at least one axis")
     n = int(round(duration * rate)) + 1
     if n < 3 * STUCK_SAMPLES:
-        raise DesignerError(f"{n} samples is too short a run", "raise --duration or --rate")
+        raise DesignerError(f"{n} samples is too short a run", "raise duration or rate")
     rng = np.random.default_rng(seed)
     t = np.arange(n) / rate
-    q, dq, ddq = Chirp(f0, f1, duration)(t)
+    q, dq, ddq = Chirp(1.0, f0, f1, duration).motion(t)
     cols: dict[str, np.ndarray] = {"t": t}
     for axis, coef in coefficients.items():
         units.check_axis(axis)

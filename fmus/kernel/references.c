@@ -1,6 +1,7 @@
 /* Motor references, the same arithmetic as designer/cosim/references.py, operation for operation,
  * so a run gives the same bits as the Python master (built with -ffp-contract=off and without the
- * pow/sin/cos builtins, so every call goes to the C library Python's math module uses). */
+ * sin/cos builtins, so every call goes to the C library that Python's math module and numpy's
+ * scalar loops use). */
 #include <math.h>
 
 #include "kernel.h"
@@ -18,12 +19,13 @@ static void sine_ref(const double *p, double t, double *q, double *v) {
     *v = p[0] * w * cos(w * t + p[3]);
 }
 
+/* designer.chirp.Chirp.motion on a 0-d array: numpy squares t**2 as t * t */
 static void chirp_ref(const double *p, double t, double *q, double *v) {
-    double sweep = (p[2] - p[1]) / p[3];
-    double phase = 2.0 * PI * (p[1] * t + sweep * pow(t, 2.0) / 2.0);
-    double omega = 2.0 * PI * (p[1] + sweep * t);
+    double rate = (p[2] - p[1]) / p[3];
+    double phase = 2.0 * PI * (p[1] * t + rate * (t * t) / 2.0);
+    double omega = 2.0 * PI * (p[1] + rate * t);
     *q = p[0] * sin(phase);
-    *v = p[0] * (omega * cos(phase));
+    *v = p[0] * omega * cos(phase);
 }
 
 /* Linear between samples, held outside; the interval is the last i with t[i] <= t (numpy's
