@@ -4,7 +4,7 @@ Python keeps everything but the loop: the Master checks the wiring and orders th
 (`Master.schedule`), fmpy instantiates the FMUs, the Robot compiles the MuJoCo model. This module
 hands the kernel their raw pointers (each FMU's instance and its fmi2/fmi3 Set/Get/DoStep functions,
 mjModel and mjData, the motor references' numbers) and a preallocated output array, then reads the
-array. `run` picks the engine: the kernel when it can run every system, else the Python master
+array. `run_master` picks the engine: the kernel when it can run every system, else the Python master
 (`Trace.engine` says which ran).
 """
 
@@ -25,6 +25,8 @@ from .robot import Robot
 from .robot import diverged as robot_diverged
 
 ENGINES = ("auto", "kernel", "python")
+#: rows per kernel call without a progress callback
+CHUNK = 10000
 _ROBOT, _FMI2, _FMI3 = 0, 1, 2
 _OK, _FMU_STATUS, _DIVERGED, _ROBOT_DIVERGED, _EVENT, _TERMINATE = 0, 1, 2, 3, 4, 5
 _CALLS = {2: ("SetReal", "GetReal", "DoStep"), 3: ("SetFloat64", "GetFloat64", "DoStep")}
@@ -324,7 +326,8 @@ def run(
         step=step,
         n=n,
     )
-    chunk = n + 1 if progress is None else max(1, n // 200)
+    # back in Python every chunk: for the progress, and so that Ctrl-C stops a long run within ms
+    chunk = CHUNK if progress is None else max(1, n // 200)
     try:
         _loop(lib, master, state, structs, chunk, progress)
     finally:
