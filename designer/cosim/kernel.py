@@ -134,7 +134,8 @@ def reference(ref, keep: list) -> _Reference:
     """A motor reference as the kernel's struct; arrays it points to are appended to `keep`.
 
     Raises:
-        DesignerError: a reference type the kernel does not know (a Python callable).
+        DesignerError: a reference type the kernel does not know (a Python callable), or a
+            trajectory without samples.
     """
     out = _Reference()
     if isinstance(ref, Step):
@@ -145,6 +146,11 @@ def reference(ref, keep: list) -> _Reference:
         out.kind, params = 2, (ref.amplitude, ref.f0, ref.f1, ref.sweep)
     elif isinstance(ref, Trajectory):
         t, q = np.ascontiguousarray(ref.t, float), np.ascontiguousarray(ref.q, float)
+        if t.ndim != 1 or len(t) < 1 or q.shape != t.shape:
+            raise DesignerError(
+                f"the trajectory has {t.size} times and {q.size} angles",
+                "give one angle per time, at least one sample",
+            )
         keep += [t, q]
         out.kind, params, out.n, out.t, out.q = 3, (), len(t), _ptr(t), _ptr(q)
     else:
