@@ -117,6 +117,18 @@ def test_n_link_arms_bit_identical(tmp_path, n, algorithm, fmi3):
     assert len(py.columns) == 4 * n + n
 
 
+def test_rig_bit_identical():
+    sc = load(EXAMPLE.parent / "rig.toml")
+    with cosim_run.joint_fmus(sc) as fmus:
+        law = cosim_run.law(sc.rig_joint, fmus["rig"])
+        py, ker = (
+            cosim_run.rig_run(sc, fmus["rig"], law, sc.step, 2.0, None, engine)
+            for engine in ("python", "kernel")
+        )
+    assert_same(py, ker)
+    assert np.ptp(ker.column("hub.f")) > 0
+
+
 def test_divergence_is_found_at_the_same_instant():
     sc = load(EXAMPLE)
     errors = []

@@ -21,13 +21,14 @@ from ..errors import DesignerError
 from .fmu import FmuSystem
 from .master import Master, Trace, diverged, steps
 from .references import Chirp, Sine, Step, Trajectory
+from .rig import HubServo
 from .robot import Robot
 from .robot import diverged as robot_diverged
 
 ENGINES = ("auto", "kernel", "python")
 #: rows per kernel call without a progress callback
 CHUNK = 10000
-_ROBOT, _FMI2, _FMI3 = 0, 1, 2
+_ROBOT, _FMI2, _FMI3, _SERVO = 0, 1, 2, 3
 _OK, _FMU_STATUS, _DIVERGED, _ROBOT_DIVERGED, _EVENT, _TERMINATE = 0, 1, 2, 3, 4, 5
 _CALLS = {2: ("SetReal", "GetReal", "DoStep"), 3: ("SetFloat64", "GetFloat64", "DoStep")}
 _STATUS = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
@@ -60,6 +61,17 @@ class _Robot(ctypes.Structure):
         ("motor_v", _P_DOUBLE),
         ("steps", c_int64),
         ("time", c_double),
+    ]
+
+
+class _Servo(ctypes.Structure):
+    _fields_ = [
+        ("chirp", _Reference),
+        ("stiffness", c_double),
+        ("damping", c_double),
+        ("out", c_double * 2),
+        ("steps", c_int64),
+        ("h", c_double),
     ]
 
 
@@ -224,7 +236,7 @@ def _systems(master: Master, keep: list) -> ctypes.Array:
     """The master's systems as kernel structs, in its order.
 
     Raises:
-        DesignerError: a system the kernel cannot run (neither a Robot nor an FmuSystem).
+        DesignerError: a system the kernel cannot run (not a Robot, FmuSystem or HubServo).
     """
     structs = (_System * len(master.systems))()
     for out, (name, system) in zip(structs, master.systems.items(), strict=True):
@@ -240,6 +252,17 @@ def _systems(master: Master, keep: list) -> ctypes.Array:
             out.kind, out.instance = _ROBOT, ctypes.addressof(robot)
         elif isinstance(system, FmuSystem):
             _fmu(system, out)
+        elif isinstance(system, HubServo):
+            servo = _Servo(
+                reference(system.chirp, keep),
+                system.stiffness,
+                system.damping,
+                (c_double * 2)(*system._out),
+                system._steps,
+                system._h,
+            )
+            keep.append(servo)
+            out.kind, out.instance = _SERVO, ctypes.addressof(servo)
         else:
             raise DesignerError(
                 f"the kernel cannot run system {name} ({type(system).__name__})",
@@ -300,6 +323,9 @@ def _sync(master: Master, structs: ctypes.Array) -> None:
         if isinstance(system, Robot):
             robot = _Robot.from_address(out.instance)
             system._steps, system.time = robot.steps, robot.time
+        elif isinstance(system, HubServo):
+            servo = _Servo.from_address(out.instance)
+            system._steps, system._h, system._out[:] = servo.steps, servo.h, list(servo.out)
         else:
             system._steps = out.steps
 
@@ -358,7 +384,7 @@ def run_master(
     """Run `master` with `engine`: "kernel", "python" (Master.run), or "auto" (the kernel when it can).
 
     "auto" falls back to the Python master when there is no C compiler or a system is one the kernel
-    cannot run (a Python system, an in-engine reference); `Trace.engine` says which ran.
+    cannot run (a system written in Python, an in-engine reference); `Trace.engine` says which ran.
 
     Raises:
         DesignerError: unknown engine; with engine="kernel", the kernel cannot run; any run error.

@@ -166,7 +166,7 @@ def rig_run(
     progress: Progress = None,
     engine: str = "auto",
 ) -> Trace:
-    """The hub servo driving the joint FMU's body interface (the servo is Python: "auto" runs it there)."""
+    """The hub servo driving the joint FMU's body interface, by `engine` (see kernel.run_master)."""
     from .rig import HubServo, check_stable, servo_gains
 
     check_stable(params["m"], params["c"], params["k"], step)
@@ -281,7 +281,7 @@ def run(
         progress: called with the fraction done, 0 to 1.
         engine: "kernel" runs the loop compiled (fmus/kernel/, built on first use with the system C
             compiler), "python" in the reference master, "auto" the kernel when there is a compiler
-            and it can run every system (the rig's servo is Python); `Result.engine` says which ran.
+            and it can run every system; `Result.engine` says which ran.
 
     Raises:
         DesignerError: an FMU that cannot be loaded, a co-simulation that diverges.

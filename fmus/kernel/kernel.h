@@ -20,7 +20,7 @@
 #endif
 
 /* kinds of system */
-enum { KS_ROBOT = 0, KS_FMI2 = 1, KS_FMI3 = 2 };
+enum { KS_ROBOT = 0, KS_FMI2 = 1, KS_FMI3 = 2, KS_SERVO = 3 };
 /* operations of the exchange schedule */
 enum { KS_GET = 0, KS_SET = 1 };
 /* motor references */
@@ -62,7 +62,18 @@ typedef struct {
     double time;
 } ks_robot;
 
-/* One system of the graph: the robot (instance = ks_robot*) or an FMU instance, co-simulation
+/* The virtual rig's hub (designer/cosim/rig.py HubServo): inputs s, v; outputs the load
+ * f = K (q - s) + C (q' - v) and the hub angle q, with q(t) its chirp at the servo's time. */
+typedef struct {
+    ks_reference chirp;
+    double stiffness; /* K, SI */
+    double damping;   /* C, SI */
+    double out[2];    /* f, q as last set */
+    int64_t steps;
+    double h;         /* the last step, 0 before the first */
+} ks_servo;
+
+/* One system of the graph: the robot (instance = ks_robot*), the hub (ks_servo*) or an FMU instance, co-simulation
  * (step: DoStep(n h, h)) or Model Exchange without states (step: SetTime((n + 1) h), then
  * CompletedIntegratorStep when the FMU needs it; an event it asks for is left to Python). */
 typedef struct {

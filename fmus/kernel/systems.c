@@ -32,10 +32,22 @@ static int32_t robot_step(ks_robot *r, double h) {
     return 0;
 }
 
+/* HubServo.set: the chirp at steps * h, then the servo's law on the specimen's s and v. */
+static void servo_set(ks_servo *r, double s, double v) {
+    double q, dq;
+    ks_reference_eval(&r->chirp, (double)r->steps * r->h, &q, &dq);
+    r->out[0] = r->stiffness * (q - s) + r->damping * (dq - v);
+    r->out[1] = q;
+}
+
 int32_t ks_get(ks_system *s, double *row) {
     double *out = row + s->out_offset;
     switch (s->kind) {
     case KS_ROBOT: robot_get((const ks_robot *)s->instance, out); return 0;
+    case KS_SERVO:
+        out[0] = ((const ks_servo *)s->instance)->out[0];
+        out[1] = ((const ks_servo *)s->instance)->out[1];
+        return 0;
     case KS_FMI2:
         return ((fmi2GetRealTYPE *)s->get_fn)(s->instance, s->out_vr, (size_t)s->n_out, out);
     default:
@@ -49,6 +61,10 @@ int32_t ks_set(ks_system *s, const double *row) {
         const ks_robot *r = (const ks_robot *)s->instance;
         double *qfrc = ((mjData *)r->data)->qfrc_applied;
         for (int32_t k = 0; k < s->n_in; k++) qfrc[r->input_dof[k]] = row[s->src[k]];
+        return 0;
+    }
+    if (s->kind == KS_SERVO) {
+        servo_set((ks_servo *)s->instance, row[s->src[0]], row[s->src[1]]);
         return 0;
     }
     for (int32_t k = 0; k < s->n_in; k++) s->in_buf[k] = row[s->src[k]];
@@ -84,6 +100,11 @@ int32_t ks_step(ks_system *s, double h) {
     int32_t status;
     double t = (double)s->steps * h;
     if (s->kind == KS_ROBOT) return robot_step((ks_robot *)s->instance, h);
+    if (s->kind == KS_SERVO) {
+        ((ks_servo *)s->instance)->h = h;
+        ((ks_servo *)s->instance)->steps++;
+        return 0;
+    }
     if (!s->step_fn) return exchange_step(s, h);
     if (s->kind == KS_FMI2) {
         status = ((fmi2DoStepTYPE *)s->step_fn)(s->instance, t, h, fmi2True);
