@@ -231,15 +231,44 @@ def test_auto_falls_back_to_python_without_a_compiler(tmp_path, monkeypatch):
             kernel.library.cache_clear()
 
 
+def test_in_engine_reference_bit_identical():
+    sc = load(EXAMPLE)
+    laws = {j: {"k": 0.333, "c": 8.3e-4, "offset": 0.01} for j in sc.joints}
+    ker = cosim_run.robot_reference(sc, laws, 1e-3, 2.0, "rk4")
+    py = _reference_master(sc, laws).run(2.0, 1e-3)
+    assert_same(py, ker)
+
+
+def _reference_master(sc, laws):
+    springs = {j: SpringDamper(p["k"], p["c"], p["offset"]) for j, p in laws.items()}
+    robot = Robot(load_spec(sc.model, sc.lengths, sc.masses), sc.motors, 1e-3, "rk4", in_engine=springs)
+    return Master({"robot": robot}, [])
+
+
+class Hold:
+    """A system written in Python: the kernel cannot run it."""
+
+    feedthrough = False
+    inputs: list = []
+    outputs = ["x"]
+
+    def get(self):
+        return np.array([1.0])
+
+    def set(self, values):
+        pass
+
+    def do_step(self, h):
+        pass
+
+
 def test_systems_the_kernel_cannot_run_go_to_python():
-    spec = load_spec()
-    robot = Robot(spec, {"j1": Step(0.1)}, 1e-3, in_engine={"j1": SpringDamper(0.3, 1e-3)})
-    res = kernel.run_master(Master({"robot": robot}, []), 0.01, 1e-3)
-    assert res.engine == "python"
-    with pytest.raises(DesignerError, match="in-engine"):
-        kernel.run(Master({"robot": robot}, []), 0.01, 1e-3)
+    master = Master({"hold": Hold()}, [])
+    assert kernel.run_master(master, 0.01, 1e-3).engine == "python"
+    with pytest.raises(DesignerError, match="cannot run system hold"):
+        kernel.run(master, 0.01, 1e-3)
     with pytest.raises(DesignerError, match="unknown engine"):
-        kernel.run_master(Master({"robot": robot}, []), 0.01, 1e-3, engine="fast")
+        kernel.run_master(master, 0.01, 1e-3, engine="fast")
 
 
 def test_model_exchange_completed_steps_and_events_match(monkeypatch):

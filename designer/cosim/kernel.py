@@ -61,6 +61,11 @@ class _Robot(ctypes.Structure):
         ("motor_v", _P_DOUBLE),
         ("steps", c_int64),
         ("time", c_double),
+        ("n_engine", c_int32),
+        ("pad", c_int32),
+        ("engine_actuator", _P_INT),
+        ("engine_joint", _P_INT),
+        ("engine_law", _P_DOUBLE),
     ]
 
 
@@ -175,15 +180,12 @@ def reference(ref, keep: list) -> _Reference:
 
 
 def _robot(robot: Robot, keep: list) -> _Robot:
-    """The robot as the kernel's struct: MuJoCo's mjModel/mjData pointers, its joints and motors.
+    """The robot as the kernel's struct: MuJoCo's mjModel/mjData pointers, its joints and motors,
+    the spring-dampers MuJoCo computes itself (the validation reference).
 
     Raises:
-        DesignerError: in-engine spring-dampers (the validation reference), or bindings too old.
+        DesignerError: mujoco's bindings too old to give raw pointers.
     """
-    if robot.in_engine:
-        raise DesignerError(
-            "the kernel does not run in-engine spring-dampers", "use engine='python' for the reference"
-        )
     if not hasattr(robot.model, "_address"):  # the raw pointers came with mujoco's 3.x bindings
         raise DesignerError(
             "this mujoco's Python bindings give no raw model pointers",
@@ -191,7 +193,10 @@ def _robot(robot: Robot, keep: list) -> _Robot:
         )
     refs = (_Reference * len(robot.motors))(*[reference(r, keep) for r in robot.motors])
     qposadr, dofadr, inputs = _ints(robot.qpos), _ints(robot.dof), _ints(robot._input_dof)
-    keep += [refs, qposadr, dofadr, inputs]
+    engine_act = _ints(robot.actuators)
+    engine_joint = _ints([robot.joints.index(j) for j in robot.in_engine])
+    engine_law = np.array([(v.k, v.c, v.offset) for v in robot.in_engine.values()], float).reshape(-1, 3)
+    keep += [refs, qposadr, dofadr, inputs, engine_act, engine_joint, engine_law]
     return _Robot(
         model=robot.model._address,
         data=robot.data._address,
@@ -205,6 +210,10 @@ def _robot(robot: Robot, keep: list) -> _Robot:
         motor_v=_ptr(robot.motor_v),
         steps=robot._steps,
         time=robot.time,
+        n_engine=len(engine_act),
+        engine_actuator=_ptr(engine_act, _P_INT),
+        engine_joint=_ptr(engine_joint, _P_INT),
+        engine_law=_ptr(engine_law),
     )
 
 
@@ -384,7 +393,7 @@ def run_master(
     """Run `master` with `engine`: "kernel", "python" (Master.run), or "auto" (the kernel when it can).
 
     "auto" falls back to the Python master when there is no C compiler or a system is one the kernel
-    cannot run (a system written in Python, an in-engine reference); `Trace.engine` says which ran.
+    cannot run (a system written in Python); `Trace.engine` says which ran.
 
     Raises:
         DesignerError: unknown engine; with engine="kernel", the kernel cannot run; any run error.

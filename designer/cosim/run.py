@@ -154,7 +154,7 @@ def robot_reference(sc: Scenario, laws: Mapping, step: float, duration: float, i
     """The same robot with every joint's spring-damper computed inside MuJoCo."""
     springs = {j: SpringDamper(p["k"], p["c"], p["offset"]) for j, p in laws.items()}
     robot = Robot(load_spec(sc.model, sc.lengths, sc.masses), sc.motors, step, integrator, in_engine=springs)
-    return Master({"robot": robot}, []).run(duration, step)
+    return run_master(Master({"robot": robot}, []), duration, step)
 
 
 def rig_run(

@@ -60,6 +60,13 @@ typedef struct {
     double *motor_v;          /* n_joints */
     int64_t steps;
     double time;
+    /* joints whose spring-damper MuJoCo computes (the validation reference): before each step,
+     * ctrl[actuator] = k (q_motor + offset) + c q_motor' (Robot.do_step) */
+    int32_t n_engine;
+    int32_t pad;
+    const int32_t *engine_actuator; /* n_engine */
+    const int32_t *engine_joint;    /* n_engine: index into the joints */
+    const double *engine_law;       /* n_engine x (k, c, offset), SI */
 } ks_robot;
 
 /* The virtual rig's hub (designer/cosim/rig.py HubServo): inputs s, v; outputs the load

@@ -24,6 +24,11 @@ static void robot_get(const ks_robot *r, double *out) {
  * state) is the robot's divergence, as in Robot.do_step. */
 static int32_t robot_step(ks_robot *r, double h) {
     mjData *d = (mjData *)r->data;
+    for (int32_t i = 0; i < r->n_engine; i++) {
+        const double *law = r->engine_law + 3 * i;
+        int32_t j = r->engine_joint[i];
+        d->ctrl[r->engine_actuator[i]] = law[0] * (r->motor_q[j] + law[2]) + law[1] * r->motor_v[j];
+    }
     mj_step((const mjModel *)r->model, d);
     if (d->warning[mjWARN_BADQACC].number) return KS_ROBOT_DIVERGED;
     r->steps++;
