@@ -209,11 +209,15 @@ def test_third_party_fmu_bit_identical(tmp_path, spring_fmu):
 
 def test_fmu_error_status_comes_with_the_fmus_log(tmp_path, spring_fmu):
     sc = spring_arm(tmp_path, spring_fmu, parameters='parameters = { "theta.m" = -1.0 }')
-    with cosim_run.joint_fmus(sc) as fmus, pytest.raises(DesignerError) as info:
-        cosim_run.robot_run(sc, fmus, sc.step, sc.duration, sc.algorithm, engine="kernel")
-    message = str(info.value)
-    assert "FMU j2: fmi2DoStep returned Discard at t = 0.101 s" in message
-    assert "theta.m = -1.0 is negative" in message
+    messages = []
+    with cosim_run.joint_fmus(sc) as fmus:
+        for engine in ("python", "kernel"):
+            with pytest.raises(DesignerError) as info:
+                cosim_run.robot_run(sc, fmus, sc.step, sc.duration, sc.algorithm, engine=engine)
+            messages.append(str(info.value))
+    assert messages[0] == messages[1]
+    assert "FMU j2: fmi2DoStep returned Discard at t = 0.101 s" in messages[0]
+    assert "theta.m = -1.0 is negative" in messages[0]
 
 
 def test_auto_falls_back_to_python_without_a_compiler(tmp_path, monkeypatch):

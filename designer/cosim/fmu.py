@@ -184,6 +184,7 @@ class FmuSystem:
         self._in_ptr = self._in.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         self._out_ptr = self._out.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         self._steps = 0
+        self._h = 0.0  # the last macro step, s (0 before the first)
         f, ni, no = self.fmu, len(self.inputs), len(self.outputs)
         if self.version == 3:
             self._set = lambda: f.fmi3SetFloat64(f.component, self._in_vr, ni, self._in_ptr, ni)
@@ -223,24 +224,52 @@ class FmuSystem:
             self.fmu.setReal([vr], [value])
 
     def get(self) -> np.ndarray:
-        self._get()
+        try:
+            self._get()
+        except Exception as exc:
+            self._surface(exc)
         return self._out.copy()
 
     def set(self, values: np.ndarray) -> None:
         self._in[:] = values
-        self._set()
+        try:
+            self._set()
+        except Exception as exc:
+            self._surface(exc)
 
     def do_step(self, h: float) -> None:
         """Co-simulation: DoStep(n h, h). Model Exchange (no states): SetTime((n + 1) h), then
         CompletedIntegratorStep if the FMU needs it, and an event iteration if it asks for one."""
-        if self.kind == "co-simulation":
-            self.fmu.doStep(self._steps * h, h)
+        self._h = h
+        try:
+            if self.kind == "co-simulation":
+                self.fmu.doStep(self._steps * h, h)
+                self._steps += 1
+                return
             self._steps += 1
-            return
-        self._steps += 1
-        self.fmu.setTime(self._steps * h)
-        if self._needs_cis:
-            self.completed(*self.fmu.completedIntegratorStep())
+            self.fmu.setTime(self._steps * h)
+            if self._needs_cis:
+                self.completed(*self.fmu.completedIntegratorStep())
+        except Exception as exc:
+            self._surface(exc)
+
+    def _surface(self, exc: Exception) -> None:
+        """Called in an except block: fmpy's exception for a status above Warning becomes a
+        DesignerError carrying the FMU's log; anything else goes on as it was."""
+        from fmpy.fmi1 import FMICallException
+
+        if isinstance(exc, FMICallException):
+            raise self.status_error(exc.function, exc.status, self._steps * self._h) from None
+        raise  # the exception being handled
+
+    def status_error(self, call: str, status: int, t: float) -> DesignerError:
+        """The error for FMI function `call` returning `status` at time `t` (s), with the FMU's log."""
+        label = STATUS[status] if 0 <= status < len(STATUS) else str(status)
+        log = "\n".join(f"  {line}" for line in self.log) or "  (the FMU logged nothing)"
+        return DesignerError(
+            f"FMU {self.fmu.instanceName}: {call} returned {label} at t = {t:g} s; its log:\n{log}",
+            "check the FMU's parameters and inputs, or use a smaller step",
+        )
 
     def completed(self, enter: bool, terminate: bool) -> None:
         """Act on CompletedIntegratorStep's answer: stop, or an event iteration (also for the kernel).

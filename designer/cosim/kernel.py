@@ -31,7 +31,6 @@ CHUNK = 10000
 _ROBOT, _FMI2, _FMI3, _SERVO = 0, 1, 2, 3
 _OK, _FMU_STATUS, _DIVERGED, _ROBOT_DIVERGED, _EVENT, _TERMINATE = 0, 1, 2, 3, 4, 5
 _CALLS = {2: ("SetReal", "GetReal", "DoStep"), 3: ("SetFloat64", "GetFloat64", "DoStep")}
-_STATUS = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
 _P_DOUBLE = POINTER(c_double)
 _P_INT = POINTER(c_int32)
 
@@ -291,13 +290,7 @@ def _fail(master: Master, run: _Run, rc: int) -> DesignerError:
     if rc == _TERMINATE:
         return system._terminated()
     call = (*_CALLS[system.version], "SetTime", "CompletedIntegratorStep")[run.error_call]
-    status = _STATUS[run.error_status] if run.error_status < len(_STATUS) else str(run.error_status)
-    log = "\n".join(f"  {line}" for line in system.log) or "  (the FMU logged nothing)"
-    return DesignerError(
-        f"FMU {name}: fmi{system.version}{call} returned {status} at t = {run.error_time:g} s; "
-        f"its log:\n{log}",
-        "check the FMU's parameters and inputs, or use a smaller step",
-    )
+    return system.status_error(f"fmi{system.version}{call}", run.error_status, run.error_time)
 
 
 def _events(master: Master, structs: ctypes.Array) -> None:
