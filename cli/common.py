@@ -64,6 +64,7 @@ FLAGS: tuple[tuple[str, str], ...] = (
     (r"\ballow_extrapolation=True\b", "--allow-extrapolation"),
     (r"\btop=", "--top "),
     (r"\bk= and/or c=", "--k and/or --c"),
+    (r"\btargets=\{'k': 0\.8\}", "--target k=0.8"),
 )
 
 

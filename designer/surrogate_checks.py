@@ -14,6 +14,7 @@ def check_surrogate_loo(ctx: Context) -> CheckResult:
     """Leave-one-out metrics per response, and whether its 95 % PIs cover as often as they claim."""
     from scipy.stats import binom
 
+    from .plots.common import save_figure
     from .plots.loo import loo_table, plot_loo
 
     sur = ctx.surrogate
@@ -37,7 +38,7 @@ def check_surrogate_loo(ctx: Context) -> CheckResult:
             }
         )
     table = pd.DataFrame(rows)
-    fig = plot_loo(sur, sur.responses, ctx.figures / "surrogate_loo.png")
+    fig = save_figure(plot_loo(sur), ctx.figures / "surrogate_loo.png")
     summary = "; ".join(
         f"{r['response']}: {r['form']}, Q2 {r['Q2']:.2f}, 95 % PI covers {r['PI coverage']}" for r in rows
     )

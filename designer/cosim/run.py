@@ -28,6 +28,7 @@ from .scenario import JointSource, Scenario
 
 if TYPE_CHECKING:
     import pandas as pd
+    from matplotlib.figure import Figure
 
 Progress = Callable[[float], None] | None
 
@@ -371,7 +372,9 @@ def write_outputs(
         json.dump(result.summary(), fh, indent=2, default=float)
     written.append(out / "metrics.json")
     if want["plot"]:
-        written.append(plot_result(result, out / "plot.png"))
+        from ..plots.common import save_figure
+
+        written.append(save_figure(plot_result(result), out / "plot.png"))
     if result.scenario.kind == "rig":
         from ..rig.logs import write_log
 
@@ -403,12 +406,13 @@ def _write_series(result: Result, out: Path, csv: bool, parquet: bool) -> list[P
     return written
 
 
-def plot_result(result: Result, path: str | Path) -> Path:
-    """Angles (or coordinate and hub) and loads against time, one panel each, written to `path`."""
+def plot_result(result: Result) -> Figure:
+    """Angles (or coordinate and hub) and loads against time, one panel each: a matplotlib Figure
+    (save it with `designer.plots.common.save_figure` or `Figure.savefig`)."""
     from ..plots.timeseries import plot_timeseries
 
     frame = result.to_frame()
     angles = [c for c in frame.columns if c.endswith((".q", ".motor", ".s"))]
     loads = [c for c in frame.columns if c.endswith((".f", ".tau"))]
     panels = {"angle [rad] / coordinate [SI]": angles, "torque [N.m] / force [N]": loads}
-    return plot_timeseries(frame, path, panels={label: cols for label, cols in panels.items() if cols})
+    return plot_timeseries(frame, panels={label: cols for label, cols in panels.items() if cols})
