@@ -126,7 +126,7 @@ def library() -> ctypes.CDLL:
     """The kernel's shared library, built on first use (see kernel_build).
 
     Raises:
-        DesignerError: no C compiler or the build failed.
+        DesignerError: no C compiler, the build failed, or its structs differ from the mirrors here.
     """
     from .kernel_build import build_kernel
 
@@ -135,6 +135,14 @@ def library() -> ctypes.CDLL:
     lib.ks_run_rows.restype = c_int32
     lib.ks_reference_eval.argtypes = [POINTER(_Reference), c_double, _P_DOUBLE, _P_DOUBLE]
     lib.ks_reference_eval.restype = None
+    sizes = (c_int64 * 5)()
+    lib.ks_sizes(sizes)
+    mirror = [ctypes.sizeof(t) for t in (_Reference, _Robot, _Servo, _System, _Run)]
+    if list(sizes) != mirror:
+        raise DesignerError(
+            f"the kernel's structs ({list(sizes)} bytes) do not match their Python mirror ({mirror})",
+            "use engine='python', and report this with your platform",
+        )
     return lib
 
 

@@ -125,6 +125,8 @@ typedef struct {
 KS_EXPORT int32_t ks_run_rows(ks_run *run, int64_t first, int64_t last);
 KS_EXPORT void ks_reference_eval(ks_reference *ref, double t, double *q, double *v);
 KS_EXPORT void ks_robot_motors(ks_robot *robot, double t);
+/* sizes of ks_reference, ks_robot, ks_servo, ks_system, ks_run: the ctypes mirror checks them */
+KS_EXPORT void ks_sizes(int64_t sizes[5]);
 
 /* systems.c */
 int32_t ks_get(ks_system *s, double *row);

@@ -98,3 +98,11 @@ int32_t ks_run_rows(ks_run *run, int64_t first, int64_t last) {
     pthread_mutex_unlock(&clock_lock);
     return rc;
 }
+
+void ks_sizes(int64_t sizes[5]) {
+    sizes[0] = sizeof(ks_reference);
+    sizes[1] = sizeof(ks_robot);
+    sizes[2] = sizeof(ks_servo);
+    sizes[3] = sizeof(ks_system);
+    sizes[4] = sizeof(ks_run);
+}
