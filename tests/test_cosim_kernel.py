@@ -275,10 +275,13 @@ def test_systems_the_kernel_cannot_run_go_to_python():
         kernel.run_master(master, 0.01, 1e-3, engine="fast")
 
 
-def test_model_exchange_completed_steps_and_events_match(monkeypatch):
-    """FMUs that need CompletedIntegratorStep and ask for an event every 250th step: the kernel
-    calls it through the pointer and hands the event iterations to Python, as the master does."""
+def asking_fmus(monkeypatch, every=250, fail_at=None):
+    """Joint FMUs made to need CompletedIntegratorStep, asking for an event every `every`th call and
+    answering Error at call `fail_at`; the kernel calls the fake through its pointer, the Python
+    master through fmpy's method. Returns the list the event iterations are recorded in."""
     import ctypes
+
+    from fmpy.fmi1 import FMICallException
 
     from designer.cosim import fmu as fmu_module
 
@@ -292,8 +295,8 @@ def test_model_exchange_completed_steps_and_events_match(monkeypatch):
         def completed(component, no_set, enter, stop):
             status = real(component, no_set, enter, stop)
             count[0] += 1
-            ctypes.cast(enter, ctypes.POINTER(ctypes.c_int))[0] = count[0] % 250 == 0
-            return status
+            ctypes.cast(enter, ctypes.POINTER(ctypes.c_int))[0] = count[0] % every == 0
+            return 3 if count[0] == fail_at else status
 
         return proto(completed)
 
@@ -306,7 +309,9 @@ def test_model_exchange_completed_steps_and_events_match(monkeypatch):
 
         def python_completed():
             enter, stop = ctypes.c_int(0), ctypes.c_int(0)
-            fake(self.fmu.component, 1, ctypes.addressof(enter), ctypes.addressof(stop))
+            status = fake(self.fmu.component, 1, ctypes.addressof(enter), ctypes.addressof(stop))
+            if status > 1:
+                raise FMICallException("fmi2CompletedIntegratorStep", status)
             return bool(enter.value), bool(stop.value)
 
         self.fmu.completedIntegratorStep = python_completed
@@ -318,10 +323,30 @@ def test_model_exchange_completed_steps_and_events_match(monkeypatch):
 
     monkeypatch.setattr(fmu_module.FmuSystem, "__init__", init)
     monkeypatch.setattr(kernel, "_function", function)
+    return events
+
+
+def test_model_exchange_completed_steps_and_events_match(monkeypatch):
+    """The kernel calls CompletedIntegratorStep through the pointer and hands the event iterations
+    the FMUs ask for to Python, as the master does."""
+    events = asking_fmus(monkeypatch)
     py, ker = both(load(EXAMPLE), duration=1.0)
     assert_same(py, ker)
     half = len(events) // 2
     assert half == 8 and events[:half] == events[half:], events
+
+
+def test_model_exchange_error_status_is_reported_alike(monkeypatch):
+    asking_fmus(monkeypatch, fail_at=300)
+    sc = load(EXAMPLE)
+    messages = []
+    with cosim_run.joint_fmus(sc) as fmus:
+        for engine in ("python", "kernel"):
+            with pytest.raises(DesignerError) as info:
+                cosim_run.robot_run(sc, fmus, sc.step, 1.0, sc.algorithm, engine=engine)
+            messages.append(str(info.value))
+    assert messages[0] == messages[1]
+    assert "FMU j1: fmi2CompletedIntegratorStep returned Error at t = 0.3 s" in messages[0]
 
 
 def test_public_run_says_which_engine_ran(tmp_path):

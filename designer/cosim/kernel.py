@@ -97,7 +97,7 @@ class _System(ctypes.Structure):
         ("out_vr", POINTER(c_uint32)),
         ("steps", c_int64),
         ("asked", c_int32),
-        ("pad", c_int32),
+        ("failed", c_int32),
     ]
 
 

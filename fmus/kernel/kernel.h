@@ -100,7 +100,7 @@ typedef struct {
     const uint32_t *out_vr;
     int64_t steps;
     int32_t asked;       /* KS_ASKED_* flags from the last step */
-    int32_t pad;
+    int32_t failed;      /* Model Exchange: KS_CALL_TIME or KS_CALL_COMPLETED, the call of the last step */
 } ks_system;
 
 /* A run: the systems, the exchange schedule, the output array and, after an error, what failed. */

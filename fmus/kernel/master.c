@@ -40,8 +40,10 @@ static int32_t step_all(ks_run *run, double t, int *events) {
         ks_system *s = &run->systems[k];
         double at = s->kind == KS_ROBOT ? ((ks_robot *)s->instance)->time : t;
         int32_t status = ks_step(s, h);
-        if (status > 1) return fail(run, k, s->step_fn || s->kind == KS_ROBOT ? KS_CALL_STEP : KS_CALL_TIME,
-                                    status, at);
+        int me = (s->kind == KS_FMI2 || s->kind == KS_FMI3) && !s->step_fn;
+        /* the times FmuSystem.do_step reports: n h for DoStep, (n + 1) h once Model Exchange moved on */
+        if (status > 1)
+            return fail(run, k, me ? s->failed : KS_CALL_STEP, status, me ? (double)s->steps * h : at);
         if (s->asked & KS_ASKED_TERMINATE) {
             run->error_system = k;
             run->error_time = t;

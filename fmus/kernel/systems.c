@@ -84,16 +84,19 @@ static int32_t exchange_step(ks_system *s, double h) {
     int32_t status;
     int ask_event, ask_stop;
     s->steps++;
+    s->failed = KS_CALL_TIME;
     if (s->kind == KS_FMI2) {
         fmi2Boolean event = fmi2False, stop = fmi2False;
         status = ((fmi2SetTimeTYPE *)s->time_fn)(s->instance, (double)s->steps * h);
         if (status > 1 || !s->completed_fn) return status;
+        s->failed = KS_CALL_COMPLETED;
         status = ((fmi2CompletedIntegratorStepTYPE *)s->completed_fn)(s->instance, fmi2True, &event, &stop);
         ask_event = event, ask_stop = stop;
     } else {
         fmi3Boolean event = fmi3False, stop = fmi3False;
         status = ((fmi3SetTimeTYPE *)s->time_fn)(s->instance, (double)s->steps * h);
         if (status > 1 || !s->completed_fn) return status;
+        s->failed = KS_CALL_COMPLETED;
         status = ((fmi3CompletedIntegratorStepTYPE *)s->completed_fn)(s->instance, fmi3True, &event, &stop);
         ask_event = event, ask_stop = stop;
     }
