@@ -73,6 +73,8 @@ def _print(summary: dict) -> None:
         console.print(f"  max error at the scenario's step: {val['max_error']:.3g} (rad or m)")
         for row in val["steps"]:
             console.print(f"  step {row['step']:.4g} s: max error {row['max_error']:.3g} (rad or m)")
+    for note in summary.get("notes", []):
+        console.print(f"note: {note}")
     ran = {"kernel": "the compiled kernel", "python": "the Python master"}[summary["engine"]]
     console.print(f"loop run by {ran}")
     for f in summary["files"]:
