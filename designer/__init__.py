@@ -38,6 +38,8 @@ _PUBLIC = {
     "export_modelica": "export",
     "export_mjcf": "export",
     "export_urdf": "export",
+    "export_sdf": "export",
+    "export_ssp": "export",
     "identify": "rig.identify",
 }
 #: public names that are subpackages
