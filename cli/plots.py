@@ -98,7 +98,7 @@ Surrogate = Annotated[
 def _surrogate(path: Path | None):
     from designer.surrogate import Surrogate as _S
 
-    return _S.load_default() if path is None else _S.load(path)
+    return _S.load() if path is None else _S.load(path)
 
 
 def _fixed(pairs: list[str]) -> dict[str, float]:
@@ -241,7 +241,9 @@ def _read_series(path: Path):
     if not path.is_file():
         raise DesignerError(f"no such file: {path}", "give a CSV or Parquet time series")
     try:
-        return pd.read_parquet(path) if path.suffix.lower() in (".parquet", ".pq") else pd.read_csv(path)
+        from designer.data import read_frame
+
+        return read_frame(path)
     except (ValueError, OSError, pd.errors.ParserError, UnicodeDecodeError) as exc:
         raise DesignerError(
             f"cannot read {path}: {str(exc).splitlines()[0]}", "give a CSV or Parquet file"
@@ -262,7 +264,7 @@ def validate_cmd(
     from designer.report import validate
 
     with progress_bar("validating") as bar:
-        results, page, md, seconds = validate(output, table, progress=bar)
+        results, page, md, seconds = validate(output, table=table, progress=bar)
     failed = [r for r in results if not r.passed]
     if as_json:
         print_json(

@@ -15,7 +15,7 @@ from designer.surrogate import Surrogate
 
 @pytest.fixture(scope="module")
 def sur():
-    return Surrogate.load_default()
+    return Surrogate.load()
 
 
 def test_surface_png_and_html(sur, tmp_path):

@@ -2,7 +2,7 @@
 
 A system exposes `inputs` and `outputs` (names), `feedthrough` (it can give outputs for inputs set at
 the same instant), `get() -> array`, `set(array)`, `do_step(h)` and optionally `delay` (None, or a
-sentence saying which of its outputs lag their inputs by one step; collected into `Result.delays`).
+sentence saying which of its outputs lag their inputs by one step; collected into `Trace.delays`).
 
 The exchange at t = i h, before every system steps from t to t + h (this is the exact sequence; an
 FMU system maps `get`/`set`/`do_step` to FMI calls as `cosim.fmu` describes):
@@ -14,7 +14,7 @@ FMU system maps `get`/`set`/`do_step` to FMI calls as `cosim.fmu` describes):
 - Jacobi: `get` every system, then `set` every system, record, `do_step(h)` everyone: a feedthrough
   element answers with the inputs of the previous step.
 A force element that offers co-simulation only is not feedthrough: it is read before it is set, a
-one-step delay, stated in `Result.delays`.
+one-step delay, stated in `Trace.delays`.
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ class System(Protocol):
 
 
 @dataclass(frozen=True)
-class Result:
+class Trace:
     """Time series of every output, columns named `system.variable`, rows at t = 0, h, ..., N h;
     `delays` names every output that lags its inputs by one step (empty: none)."""
 
@@ -157,7 +157,7 @@ class Master:
         duration: float,
         step: float,
         progress: Callable[[float], None] | None = None,
-    ) -> Result:
+    ) -> Trace:
         """Run from 0 to `duration` with macro step `step`; outputs are recorded after each exchange."""
         if not (np.isfinite(step) and step > 0):
             raise DesignerError(f"step {step:g} s is not positive", "give a positive step in seconds")
@@ -182,4 +182,4 @@ class Master:
         if progress is not None:
             progress(1.0)
         delays = tuple(d for s in self.systems.values() if (d := getattr(s, "delay", None)))
-        return Result(time=np.arange(n + 1) * step, columns=self.columns, values=values, delays=delays)
+        return Trace(time=np.arange(n + 1) * step, columns=self.columns, values=values, delays=delays)

@@ -147,7 +147,7 @@ def find_compiler() -> list[str]:
             raise DesignerError(
                 f"the C compiler '{cmd[0]}' named by $CC was not found",
                 "install a C compiler (for example apt-get install gcc), point CC at it, "
-                "or export with --source-only and build from the FMU's sources/",
+                "or export with source_only=True and build from the FMU's sources/",
             )
         return cmd
     for name in ("cc", "gcc", "clang"):
@@ -155,7 +155,7 @@ def find_compiler() -> list[str]:
             return [name]
     raise DesignerError(
         "no C compiler found (tried $CC, cc, gcc, clang)",
-        "install one (for example apt-get install gcc), or export with --source-only and build the "
+        "install one (for example apt-get install gcc), or export with source_only=True and build the "
         "binary from the FMU's sources/ (fmpy: python -m fmpy compile joint.fmu)",
     )
 
@@ -228,10 +228,10 @@ def _run(cmd: list[str], name: str) -> None:
         done = subprocess.run(cmd, capture_output=True, text=True, check=False)
     except OSError as exc:
         raise DesignerError(
-            f"could not run the C compiler '{name}': {exc}", "check $CC, or export with --source-only"
+            f"could not run the C compiler '{name}': {exc}", "check $CC, or export with source_only=True"
         ) from None
     if done.returncode != 0:
         raise DesignerError(
             f"compiling the FMU binary failed:\n{done.stderr.strip()}",
-            f"check the compiler with '{name} --version', or export with --source-only",
+            f"check the compiler with '{name} --version', or export with source_only=True",
         )

@@ -18,9 +18,9 @@ def loo_table(surrogate, response: str) -> pd.DataFrame:
     return pd.DataFrame(
         {
             "observed": observed,
-            "predicted": np.asarray(pred["value"], float),
-            "lo": np.asarray(pred["lo"], float),
-            "hi": np.asarray(pred["hi"], float),
+            "predicted": np.asarray(pred.value, float),
+            "lo": np.asarray(pred.low, float),
+            "hi": np.asarray(pred.high, float),
         }
     ).assign(covered=lambda d: (d.observed >= d.lo) & (d.observed <= d.hi))
 

@@ -56,7 +56,7 @@ def held_values(table: pd.DataFrame, free: list[str], fixed: Mapping[str, float]
     fixed = dict(fixed or {})
     for name in fixed:
         if name in free:
-            raise DesignerError(f"{name} is drawn on an axis and also held fixed", f"drop --fix {name}=...")
+            raise DesignerError(f"{name} is drawn on an axis and also held fixed", f"drop {name} from fixed=")
     held = {}
     for f in space.FACTORS:
         if f.name in free:
@@ -75,7 +75,7 @@ def _free_factors(names: list[str]) -> list[space.Factor]:
         if f.categorical:
             raise DesignerError(
                 f"{f.name} is categorical ({f.describe_range()})",
-                "draw continuous factors (density, length, width, height) and hold it with --fix",
+                "draw continuous factors (density, length, width, height) and hold it in fixed=",
             )
     if len(set(names)) != len(names):
         raise DesignerError(f"a factor is repeated in {', '.join(names)}", "draw distinct factors")
@@ -216,8 +216,8 @@ def plot_surface(
     X[x], X[y] = gx.ravel(), gy.ravel()
     pred = model.predict(X)
     observed = table[response].to_numpy(float)
-    zlo = float(min(pred.lo.min(), observed.min(), target if target is not None else np.inf))
-    zhi = float(max(pred.hi.max(), observed.max(), target if target is not None else -np.inf))
+    zlo = float(min(pred.low.min(), observed.min(), target if target is not None else np.inf))
+    zhi = float(max(pred.high.max(), observed.max(), target if target is not None else -np.inf))
     zlo, zhi = zlo - 0.02 * (zhi - zlo), zhi + 0.02 * (zhi - zlo)
 
     def grid(z: np.ndarray) -> pv.PolyData:
@@ -235,8 +235,8 @@ def plot_surface(
             rgb=_rgb(pred.value, vlo, vhi),
             color=tuple(_rgb(np.array([0.5]), 0, 1)[0]),
         ),
-        Layer("95 % PI lower", grid(pred.lo), color=PI_COLOR, opacity=0.25),
-        Layer("95 % PI upper", grid(pred.hi), color=PI_COLOR, opacity=0.25),
+        Layer("95 % PI lower", grid(pred.low), color=PI_COLOR, opacity=0.25),
+        Layer("95 % PI upper", grid(pred.high), color=PI_COLOR, opacity=0.25),
     ]
     near = _runs_near(table, held)
     runs = np.c_[
@@ -269,7 +269,7 @@ def plot_surface(
             floor = line.copy()
             floor.points[:, 2] = 0.0
             layers.append(Layer("target, projected", floor, color=TARGET_COLOR, size=1.5, opacity=0.6))
-        share = float(np.mean((pred.lo <= target) & (target <= pred.hi)))
+        share = float(np.mean((pred.low <= target) & (target <= pred.high)))
     held_txt = ", ".join(f"{k} {v:g} {space.factor(k).unit}" for k, v in held.items())
     title = f"{response_label(response)} over {x} and {y}; held: {held_txt}"
     scene = Scene(
@@ -301,7 +301,9 @@ def plot_volume(
 
     path, html = check_image_path(path), _check_html(html)
     if len(factors) != 3:
-        raise DesignerError(f"a volume needs three factors, got {len(factors)}", "give --x, --y and --z")
+        raise DesignerError(
+            f"a volume needs three factors, got {len(factors)}", "give three factors in factors="
+        )
     model = surrogate.model(response)
     fs = _free_factors(factors)
     table = surrogate.table
@@ -326,7 +328,7 @@ def plot_volume(
         iso = vol.contour([target], scalars="value")
         if iso.n_points:
             layers.append(Layer(f"target {target:g} {model.unit}", iso, color=TARGET_COLOR, opacity=0.85))
-        share = float(np.mean((pred.lo <= target) & (target <= pred.hi)))
+        share = float(np.mean((pred.low <= target) & (target <= pred.high)))
     pts = np.c_[[_unit(table[f.name], f.low, f.high) for f in fs]].T
     observed = table[response].to_numpy(float)
     layers.append(

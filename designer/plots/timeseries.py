@@ -40,7 +40,7 @@ def plot_timeseries(
         )
     if len(panels) > MAX_PANELS:
         raise DesignerError(
-            f"{len(panels)} signals is too many for one figure", f"pick at most {MAX_PANELS} with --columns"
+            f"{len(panels)} signals is too many for one figure", f"pick at most {MAX_PANELS} with columns="
         )
     fig, axes = plt.subplots(len(panels), 1, sharex=True, figsize=(9, 1.9 * len(panels) + 0.8), squeeze=False)
     for ax, (label, cols) in zip(axes[:, 0], panels.items(), strict=True):
