@@ -396,3 +396,17 @@ def test_runs_in_threads_agree_and_mujoco_keeps_its_clock():
             cosim_run.robot_run(sc, fmus, 5e-3, 1.0, "jacobi", engine="kernel")
     assert all(np.array_equal(results[0], r) for r in results[1:])
     assert hook.value == before
+
+
+def test_each_fmu_keeps_its_own_log_and_closes_after_an_error():
+    from designer.cosim.fmu import _LOGS, FmuSystem
+
+    sc = load(EXAMPLE)
+    with cosim_run.joint_fmus(sc) as fmus:
+        first, second = (FmuSystem(fmus[j], ["theta"], name=j) for j in ("j1", "j2"))
+        with pytest.raises(DesignerError, match=r"(?s)FMU j1: fmi2SetReal returned Error.*not a finite"):
+            first.set(np.array([np.nan, 0.0]))
+        assert len(first.log) == 1 and not second.log
+        first.close()
+        second.close()
+    assert not _LOGS

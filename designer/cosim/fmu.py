@@ -18,7 +18,10 @@ How each FMU is driven (FMI 2.0 sections 3.2.3 and 4.2.4, FMI 3.0 sections 3.2 a
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
+import functools
+import itertools
 import shutil
 from collections import deque
 from collections.abc import Mapping, Sequence
@@ -34,6 +37,35 @@ STATUS = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
 PROBLEM_CATEGORIES = ("logStatusWarning", "logStatusDiscard", "logStatusError", "logStatusFatal")
 #: how many of an FMU's last log messages are kept to explain an error
 LOG_LINES = 50
+
+
+#: FMI 2 instances' logs by their componentEnvironment token
+_LOGS: dict[int, deque[str]] = {}
+_TOKENS = itertools.count(1)
+
+
+def log_line(status: int, category: bytes | None, message: bytes | None) -> str:
+    """One FMU log message as a line: [status] category: message."""
+    label = STATUS[status] if 0 <= status < len(STATUS) else str(status)
+    text = (message or b"").decode(errors="replace")
+    return f"[{label}] {(category or b'').decode(errors='replace')}: {text}"
+
+
+@functools.cache
+def _fmi2_router():
+    """The process's one FMI 2 logger: a message goes to the log its componentEnvironment names;
+    one from an instance made elsewhere (fmpy's own callbacks) is printed as fmpy would."""
+    from fmpy.fmi1 import printLogMessage
+    from fmpy.fmi2 import fmi2CallbackLoggerTYPE
+
+    def route(env, instance, status, category, message) -> None:
+        log = _LOGS.get(env or 0)
+        if log is None:
+            printLogMessage(env, instance, status, category, message)
+        else:
+            log.append(log_line(status, category, message))
+
+    return fmi2CallbackLoggerTYPE(route)
 
 
 def _axes_of(md) -> set[str]:
@@ -195,25 +227,25 @@ class FmuSystem:
 
     def _instantiate_logging(self, fmu) -> None:
         """Instantiate with a logger that keeps the FMU's last messages in `self.log` (none printed)."""
+        if self.version == 3:  # fmpy keeps one callback per instance
 
-        def record(*args) -> None:  # FMI 2: (env, instance, status, category, message); FMI 3: (env, ...)
-            status, category, message = args[-3:]
-            label = STATUS[status] if 0 <= status < len(STATUS) else str(status)
-            self.log.append(
-                f"[{label}] {(category or b'').decode(errors='replace')}: {message.decode(errors='replace')}"
-            )
+            def record(env, status, category, message) -> None:
+                self.log.append(log_line(status, category, message))
 
-        if self.version == 3:
             fmu.instantiate(logMessage=record)
             return
-        from fmpy.fmi2 import defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+        from fmpy.fmi2 import defaultCallbacks, fmi2CallbackFunctions
         from fmpy.logging import addLoggerProxy
 
+        # fmpy's proxy (it formats FMI 2's printf-style messages) keeps ONE logger for the process, so
+        # the instance is told apart by its componentEnvironment, a token naming its log
+        self._token = next(_TOKENS)
+        _LOGS[self._token] = self.log
         self._callbacks = fmi2CallbackFunctions()
-        self._logger = fmi2CallbackLoggerTYPE(record)  # kept alive as long as the instance
-        self._callbacks.logger = self._logger
+        self._callbacks.logger = _fmi2_router()
         self._callbacks.allocateMemory = defaultCallbacks.allocateMemory
         self._callbacks.freeMemory = defaultCallbacks.freeMemory
+        self._callbacks.componentEnvironment = self._token
         addLoggerProxy(ctypes.byref(self._callbacks))
         fmu.instantiate(callbacks=self._callbacks)
 
@@ -290,9 +322,17 @@ class FmuSystem:
         )
 
     def close(self) -> None:
-        """Terminate and free the instance and remove its unpacked archive."""
+        """Terminate and free the instance and remove its unpacked archive.
+
+        An instance that returned Error may refuse Terminate (FMI 2.0 section 2.1.3); it is freed all
+        the same, and the error that stopped the run is the one that surfaces.
+        """
+        from fmpy.fmi1 import FMICallException
+
         try:
-            self.fmu.terminate()
+            with contextlib.suppress(FMICallException):
+                self.fmu.terminate()
             self.fmu.freeInstance()
         finally:
+            _LOGS.pop(getattr(self, "_token", None), None)
             shutil.rmtree(self._dir, ignore_errors=True)
