@@ -8,7 +8,7 @@ import typer
 
 from designer.errors import DesignerError
 
-from . import cosim, design, export, plots, rig
+from . import cosim, design, export, plots, rig, sweep
 from .common import flag_message
 
 app = typer.Typer(
@@ -23,6 +23,7 @@ rig.register(app)
 export.register(app)
 cosim.register(app)
 plots.register(app)
+sweep.register(app)
 
 
 def main() -> None:

@@ -43,7 +43,7 @@ _PUBLIC = {
     "identify": "rig.identify",
 }
 #: public names that are subpackages
-_SUBPACKAGES = ("cosim",)
+_SUBPACKAGES = ("cosim", "sweep")
 
 __all__ = ["DesignerError", "__version__", *_PUBLIC, *_SUBPACKAGES]
 

@@ -128,8 +128,8 @@ def test_cli_exports_fmu_with_json(tmp_path, cache_env):
         (["--k", "0.8"], "one --k and one --c per --axis"),
         (["--k", "-1", "--c", "2e-3"], "not a valid value"),
         (["--k", "0.8", "--c", "2e-3", "--axis", "w"], "unknown axis"),
-        (["--k", "0.8", "--c", "2e-3", "--fmi", "4"], "FMI version 4"),
-        (["--k", "0.8", "--c", "2e-3", "--interface", "spring"], "unknown interface"),
+        (["--k", "0.8", "--c", "2e-3", "--fmi", "4"], "--fmi 4 is not supported"),
+        (["--k", "0.8", "--c", "2e-3", "--interface", "spring"], "--interface 'spring' is not an interface"),
         (["--density", "60"], "missing factor"),
     ],
 )
