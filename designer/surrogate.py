@@ -147,28 +147,32 @@ def _ridge_fit(Z: np.ndarray, y: np.ndarray, alpha: float, Zg: np.ndarray | None
 
     Cutting planes: the QP is solved with only the grid points found violated so far as
     constraints, adding the newly violated ones until none is; the result is the optimum of the
-    fully constrained problem, with a few rows instead of hundreds.
+    fully constrained problem, with a few rows instead of hundreds. The QP is solved for y scaled
+    to unit mean magnitude (qrqp's tolerances are absolute: damping in N.s/mm is ~1e-3).
     """
     p = Z.shape[1]
     H = 2 * (Z.T @ Z + alpha * _penalty(p))
-    g = -2 * Z.T @ y
-    beta = np.linalg.solve(H, -g)
+    beta = np.linalg.solve(H, 2 * Z.T @ y)
     if Zg is None:
         return beta
+    scale = float(np.mean(np.abs(y))) or 1.0
+    g = -2 * Z.T @ (y / scale)
+    beta, lower = beta / scale, lower / scale
     active = np.zeros(len(Zg), dtype=bool)
     opts = {"print_iter": False, "print_header": False, "print_info": False, "error_on_fail": False}
+    opts["max_iter"] = 5000
+    solved = True
     for _ in range(len(Zg)):
         violated = Zg @ beta < lower * (1 - 1e-9)
-        if not violated.any():
-            return beta
-        active |= violated
+        if solved and not violated.any():
+            return beta * scale
+        active |= violated  # an unsolved QP is solved again, warm-started where it stopped
         A = Zg[active]
         solver = ca.conic(
             "ridge", "qrqp", {"h": ca.Sparsity.dense(p, p), "a": ca.Sparsity.dense(*A.shape)}, opts
         )
         sol = solver(h=H, g=g, a=A, lba=lower, uba=np.inf, x0=beta)
-        if not solver.stats()["success"]:
-            break
+        solved = bool(solver.stats()["success"])
         beta = np.asarray(sol["x"]).ravel()
     raise DesignerError(
         "the constrained surrogate fit did not converge", "check the table for extreme values"

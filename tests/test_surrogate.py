@@ -39,6 +39,92 @@ def test_loo_figures_on_the_bundled_table(refit):
         assert 0.85 <= m.loo["coverage95"] <= 1.0
 
 
+def test_nested_figures_are_the_headline(refit):
+    """Nested LOO (selection repeated per fold) is lower than the chosen form's own LOO, as expected."""
+    k, c = refit.models["k_x"], refit.models["c_x"]
+    assert 0.30 <= k.loo_nested["q2"] <= 0.34 < k.loo["q2"]
+    assert 0.90 <= k.loo_nested["coverage95"] <= 0.97
+    assert c.loo_nested["q2"] < 0 and not c.predictable
+    assert k.accuracy is k.loo_nested
+    # run 21 (row 20, k = 2.092 N/mm) carries the power law: without it the linear form is chosen
+    assert {"row": 20, "form": "linear"}.items() <= next(d for d in k.influence if d["row"] == 20).items()
+    assert refit.training["run"][20] == 21
+
+
+BLACK_BOX_ROWS = {"k_x": range(44), "c_x": (0, 2, 3, 8, 15, 20, 30, 43)}
+
+
+@pytest.mark.parametrize("response", ["k_x", "c_x"])
+def test_nested_loo_equals_refits_without_each_run(refit, response):
+    """The reported nested prediction of a run is what the whole `fit`, run on the table without that
+    run, predicts there (black box; every run for k_x, 8 runs for c_x among them influential ones)."""
+    t = data.load_table()
+    nested = refit.models[response].nested_predictions
+    y = t[response].to_numpy(float)
+    for i in BLACK_BOX_ROWS[response]:
+        alone = Surrogate().fit(t.drop(index=t.index[i]), responses=[response], nested=False)
+        p = alone.predict(t.iloc[[i]], responses=[response])[response]
+        assert p.value[0] == pytest.approx(nested.value[i], rel=1e-9)
+        assert (p.low[0], p.high[0]) == pytest.approx((nested.low[i], nested.high[i]), rel=1e-9)
+    # and the reported Q2 is the Q2 of those predictions
+    q2 = 1 - np.sum((y - nested.value) ** 2) / np.sum((y - y.mean()) ** 2)
+    assert refit.models[response].loo_nested["q2"] == pytest.approx(q2, rel=1e-12)
+
+
+def test_lack_of_fit_matches_statsmodels():
+    """Pure error / lack of fit of an unpenalised linear fit equals statsmodels' nested-model F test."""
+    import pandas as pd
+    import statsmodels.formula.api as smf
+    from statsmodels.stats.anova import anova_lm
+
+    from designer.validation import lack_of_fit
+
+    rng = np.random.default_rng(3)
+    t = data.load_table().iloc[::3]
+    t = pd.concat([t, t.iloc[:6]], ignore_index=True)
+    t["y"] = 1 + 0.02 * t["density"] + 0.3 * (t["width"] - 4) ** 2 + rng.normal(0, 0.2, len(t))
+    X = {n: t[n].to_numpy(float) for n in space.FACTOR_NAMES}
+    Z = design_matrix("linear", X)
+    coef = np.linalg.lstsq(Z, t["y"].to_numpy(), rcond=None)[0]
+
+    class Ols:
+        pass
+
+    fit = Ols()
+    fit.coef, fit.dof = coef, len(t) - np.linalg.matrix_rank(Z)
+    got = lack_of_fit(X, t["y"].to_numpy(), Z, fit, log=False)
+    t["group"] = t[list(space.FACTOR_NAMES)].astype(str).agg("/".join, axis=1)
+    t["l016"], t["l020"] = (t["layer"] == 0.16) * 1.0, (t["layer"] == 0.2) * 1.0
+    reduced = smf.ols("y ~ density + length + width + height + l016 + l020 + C(raster)", t).fit()
+    full = smf.ols("y ~ C(group)", t).fit()
+    ref = anova_lm(reduced, full)
+    assert got["df_pure_error"] == ref["df_resid"][1]
+    assert got["f"] == pytest.approx(ref["F"][1], rel=1e-9)
+    assert got["p_value"] == pytest.approx(ref["Pr(>F)"][1], rel=1e-9)
+
+
+def test_replicated_runs_fit_and_report_pure_error():
+    """A DOE with every design run three times (pure error) fits; the lack-of-fit test is reported."""
+    import pandas as pd
+
+    rng = np.random.default_rng(5)
+    base = data.load_table().iloc[::4]  # 11 designs spanning every factor
+    t = pd.concat([base] * 3, ignore_index=True)
+    t["k_x"] = t["k_x"] * np.exp(rng.normal(0, 0.05, len(t)))
+    t["c_x"] = t["c_x"] * np.exp(rng.normal(0, 0.05, len(t)))
+    sur = Surrogate().fit(t, nested=False)
+    for m in sur.models.values():
+        assert m.lack_of_fit["df_pure_error"] == 22 and m.lack_of_fit["replicated_designs"] == 11
+        assert 0 <= m.lack_of_fit["p_value"] <= 1
+
+
+def test_constant_factor_is_named():
+    t = data.load_table()
+    t["raster"] = 0.0
+    with pytest.raises(DesignerError, match="raster is 0 deg in every run"):
+        Surrogate().fit(t)
+
+
 def test_leave_one_out_is_an_honest_refit():
     """One LOO prediction equals a fit without that run, predicted at that run."""
     t = data.load_table()
