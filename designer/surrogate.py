@@ -149,6 +149,9 @@ def _ridge_fit(Z: np.ndarray, y: np.ndarray, alpha: float, Zg: np.ndarray | None
     constraints, adding the newly violated ones until none is; the result is the optimum of the
     fully constrained problem, with a few rows instead of hundreds. The QP is solved for y scaled
     to unit mean magnitude (qrqp's tolerances are absolute: damping in N.s/mm is ~1e-3).
+
+    Raises:
+        DesignerError: the constraints cannot be met (the runs contradict positivity).
     """
     p = Z.shape[1]
     H = 2 * (Z.T @ Z + alpha * _penalty(p))
@@ -160,22 +163,24 @@ def _ridge_fit(Z: np.ndarray, y: np.ndarray, alpha: float, Zg: np.ndarray | None
     beta, lower = beta / scale, lower / scale
     active = np.zeros(len(Zg), dtype=bool)
     opts = {"print_iter": False, "print_header": False, "print_info": False, "error_on_fail": False}
-    opts["max_iter"] = 5000
-    solved = True
     for _ in range(len(Zg)):
-        violated = Zg @ beta < lower * (1 - 1e-9)
-        if solved and not violated.any():
+        # rows already constrained count as held (within the QP's tolerance)
+        violated = (Zg @ beta < lower * (1 - 1e-9)) & ~active
+        if not violated.any():
             return beta * scale
-        active |= violated  # an unsolved QP is solved again, warm-started where it stopped
+        active |= violated
         A = Zg[active]
         solver = ca.conic(
             "ridge", "qrqp", {"h": ca.Sparsity.dense(p, p), "a": ca.Sparsity.dense(*A.shape)}, opts
         )
         sol = solver(h=H, g=g, a=A, lba=lower, uba=np.inf, x0=beta)
-        solved = bool(solver.stats()["success"])
-        beta = np.asarray(sol["x"]).ravel()
+        # qrqp can cycle on degenerate grid rows: then the exact NNLS route on the same rows
+        beta = np.asarray(sol["x"]).ravel() if solver.stats()["success"] else _qp_by_nnls(H, g, A, lower)
+        if beta is None:
+            break
     raise DesignerError(
-        "the constrained surrogate fit did not converge", "check the table for extreme values"
+        "the surrogate cannot be held positive over the tested grid for this table",
+        "check the table for extreme or mistyped values",
     )
 
 
@@ -440,6 +445,31 @@ class ResponseSurface:
 def _lower_bound(y: np.ndarray, transform: str) -> float:
     """Positivity floor on the tested grid for raw-space forms: a thousandth of the smallest run."""
     return -np.inf if transform == "log" else 1e-3 * float(np.min(y))
+
+
+def _qp_by_nnls(H: np.ndarray, g: np.ndarray, A: np.ndarray, lower: float) -> np.ndarray | None:
+    """min 1/2 b'Hb + g'b subject to A b >= lower, through least distance programming and NNLS.
+
+    The fallback when qrqp cycles on degenerate grid constraints (Lawson and Hanson, Solving Least
+    Squares Problems, ch. 23): with H = R'R and b0 = -H^-1 g, u = R (b - b0) turns the problem into
+    min |u| subject to G u >= h (G = A R^-1, h = lower - A b0), whose solution is u = -r[:p] / r[p]
+    for the residual r of the non-negative least squares min |E w - f|, E = [G'; h'], f = e_(p+1).
+    Returns None when the constraints are infeasible.
+    """
+    from scipy.optimize import nnls
+
+    R = np.linalg.cholesky(H).T
+    b0 = np.linalg.solve(H, -g)
+    G = np.linalg.solve(R.T, A.T).T
+    h = lower - A @ b0
+    E = np.vstack([G.T, h[None, :]])
+    f = np.zeros(len(E))
+    f[-1] = 1.0
+    w = nnls(E, f, maxiter=50 * E.shape[1])[0]
+    r = E @ w - f
+    if abs(r[-1]) < 1e-12:
+        return None
+    return b0 + np.linalg.solve(R, -r[:-1] / r[-1])
 
 
 @functools.cache

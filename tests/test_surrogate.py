@@ -7,7 +7,7 @@ import pytest
 
 from designer import data, space
 from designer.errors import DesignerError
-from designer.surrogate import FORMAT, Surrogate, _ridge_fit, design_matrix, leave_one_out
+from designer.surrogate import FORMAT, Surrogate, _grid, _ridge_fit, design_matrix, leave_one_out
 
 
 @pytest.fixture(scope="module")
@@ -157,7 +157,6 @@ def test_vectorised_prediction_matches_single(refit):
 
 def test_positivity_is_enforced_on_the_tested_grid():
     """A table whose least-squares fit dips below zero on the grid comes back clipped at the floor."""
-    from designer.surrogate import _grid
 
     rng = np.random.default_rng(1)
     t = data.load_table()
@@ -168,6 +167,32 @@ def test_positivity_is_enforced_on_the_tested_grid():
     assert (Zg @ free).min() < 0
     beta = _ridge_fit(Z, y, 0.0, Zg, 1e-3)
     assert (Zg @ beta).min() >= 1e-3 * (1 - 1e-6)
+    # the same optimum as qpOASES (another QP solver) with every grid row as a constraint
+    import casadi as ca
+
+    H, g = 2 * Z.T @ Z, -2 * Z.T @ y
+    qp = ca.conic("ref", "qpoases", {"h": ca.Sparsity.dense(*H.shape), "a": ca.Sparsity.dense(*Zg.shape)})
+    ref = np.asarray(qp(h=H, g=g, a=Zg, lba=1e-3, uba=np.inf)["x"]).ravel()
+    np.testing.assert_allclose(Z @ beta, Z @ ref, atol=1e-7)
+
+
+def test_degenerate_positivity_qp_falls_back_to_nnls():
+    """qrqp cycles on some degenerate grid rows; the NNLS route gives qpOASES's optimum."""
+    import casadi as ca
+
+    from designer.surrogate import _qp_by_nnls
+
+    rng = np.random.default_rng(2)
+    t = data.load_table()
+    Z = design_matrix("linear", t)
+    Zg = design_matrix("linear", _grid())
+    y = 0.01 + np.abs(rng.normal(0, 1, len(t))) * (t["width"].to_numpy() < 3)
+    H, g = 2 * (Z.T @ Z + 0.1 * np.eye(Z.shape[1])), -2 * Z.T @ y
+    beta = _qp_by_nnls(H, g, Zg, 0.01)
+    qp = ca.conic("ref", "qpoases", {"h": ca.Sparsity.dense(*H.shape), "a": ca.Sparsity.dense(*Zg.shape)})
+    ref = np.asarray(qp(h=H, g=g, a=Zg, lba=0.01, uba=np.inf)["x"]).ravel()
+    np.testing.assert_allclose(beta, ref, atol=1e-8)
+    assert (Zg @ beta).min() >= 0.01 - 1e-12
 
 
 def test_save_load_round_trip_and_bad_files(tmp_path, refit):
