@@ -774,13 +774,14 @@ def _nearest_runs(surrogate: Surrogate, q: str, axis: str, target: float) -> lis
 
 
 def _reachable_range(problem: _Problem, q: str, box: _Box) -> tuple[float, float]:
-    """Smallest and largest predicted value of one response over the search box (IPOPT, per combo)."""
+    """Smallest and largest predicted value of one response over the search box (IPOPT, per combo),
+    each extreme evaluated as printed (solid where the walls fill the section)."""
     solver, f = problem.extreme_solver(q), problem.functions[q]
     values = []
     for combo in box.combos:
         for sign in (1.0, -1.0):
             p = np.concatenate([combo, box.lows, box.spans, [sign]])
             sol = solver(x0=np.clip(0.5, box.lbu, box.ubu), lbx=box.lbu, ubx=box.ubu, p=p)
-            u = np.asarray(sol["x"]).ravel()
-            values.append(float(f(np.concatenate([box.lows + box.spans * u, combo]))[0]))
+            design = _solid(box.design(np.asarray(sol["x"]).ravel(), combo))  # as printed
+            values.append(float(f([design[n] for n in space.FACTOR_NAMES])[0]))
     return min(values), max(values)
