@@ -176,7 +176,7 @@ def predict(
     from designer import space, units
     from designer.suggest import predictability
 
-    params = space.validate(
+    params = space.check_design(
         dict(density=density, length=length, width=width, height=height, layer=layer, raster=raster),
         allow_extrapolation,
     )

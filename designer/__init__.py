@@ -39,20 +39,26 @@ _PUBLIC = {
     "export_mjcf": "export",
     "export_urdf": "export",
     "identify": "rig.identify",
-    "cosim": "cosim",
 }
+#: public names that are subpackages
+_SUBPACKAGES = ("cosim",)
 
-__all__ = ["DesignerError", "__version__", *_PUBLIC]
+__all__ = ["DesignerError", "__version__", *_PUBLIC, *_SUBPACKAGES]
 
 
 def __getattr__(name: str) -> Any:
+    if name in _SUBPACKAGES:
+        return importlib.import_module(f".{name}", __name__)
     module = _PUBLIC.get(name)
     if module is None:
         raise AttributeError(f"module 'designer' has no attribute {name!r}")
     mod = importlib.import_module(f".{module}", __name__)
-    value = mod if name == module else getattr(mod, name)
-    globals()[name] = value
-    return value
+    # importing a submodule binds its name on the package (designer.suggest, the module, would
+    # hide designer.suggest, the function): bind every public name it defines again
+    for public, home in _PUBLIC.items():
+        if home == module:
+            globals()[public] = getattr(mod, public)
+    return globals()[name]
 
 
 def __dir__() -> list[str]:

@@ -127,7 +127,7 @@ class Joint:
             DesignerError: a factor missing or out of its tested range (unless `allow_extrapolation`),
                 an axis the surrogate cannot give.
         """
-        params = space.validate(params, allow_extrapolation)
+        params = space.check_design(params, allow_extrapolation)
         if surrogate is None:
             from .surrogate import Surrogate
 
@@ -180,7 +180,7 @@ class Joint:
                 f"choose 1 to {n}" if n else "the suggestion has no candidates",
             )
         cand = suggestion.candidates[candidate - 1]
-        params = space.validate(cand.params, allow_extrapolation=True)
+        params = space.check_design(cand.params, allow_extrapolation=True)
         a = suggestion.axis
         base = {
             a: AxisCoefficients(

@@ -351,7 +351,7 @@ class Suggestion:
         except (KeyError, TypeError, ValueError, AttributeError) as exc:
             raise DesignerError(
                 f"{where} is not a suggestion (missing or malformed {exc})",
-                "use the output of designer.suggest(...).to_dict() (designer suggest --json)",
+                "use the output of designer.suggest(...).to_dict()",
             ) from None
 
     @classmethod
@@ -365,10 +365,12 @@ class Suggestion:
         except (OSError, ValueError) as exc:
             raise DesignerError(
                 f"cannot read a suggestion from path={str(path)!r}: {exc}",
-                "give a JSON file written from Suggestion.to_dict() (designer suggest --json)",
+                "give a JSON file written from Suggestion.to_dict()",
             ) from None
         if not isinstance(data, dict):
-            raise DesignerError(f"{path.name} is not a suggestion", "give designer suggest --json output")
+            raise DesignerError(
+                f"{path.name} is not a suggestion", "give a JSON file written from Suggestion.to_dict()"
+            )
         return cls.from_dict(data, where=path.name)
 
 
@@ -520,7 +522,8 @@ def suggest(
     if axis not in surrogate.axes:
         raise DesignerError(
             f"the surrogate has no axis '{axis}'",
-            f"it has {', '.join(surrogate.axes) or 'none'}; fit one on a table with that axis",
+            f"it has {', '.join(surrogate.axes) or 'none'}; "
+            "fit one on a table with that axis: Surrogate().fit(table)",
         )
     if k is None and c is None:
         raise DesignerError("no target given", "give k and/or c: a value, 'min' or 'max'")

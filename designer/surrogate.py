@@ -679,7 +679,7 @@ class Surrogate:
         except KeyError:
             raise DesignerError(
                 f"the surrogate has no response '{response}'",
-                f"it has {', '.join(self.models)}; fit one on a table with that axis (designer fit --data)",
+                f"it has {', '.join(self.models)}; fit one on a table with that axis: Surrogate().fit(table)",
             ) from None
 
     def predict(

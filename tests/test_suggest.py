@@ -32,7 +32,7 @@ def test_flagship_target(sur):
     assert any("c_x is not predictable" in s and "probability" in s for s in r.statements)
     assert any("reached within +-10 %" in s and "probability" in s for s in r.statements)
     assert 0.30 <= r.predictability["k"]["q2"] <= 0.34  # nested
-    space.validate(top.params)  # printable and in range
+    space.check_design(top.params)  # printable and in range
     assert len(r.candidates) == 5
     p = [c.p_within for c in r.candidates]
     assert p == sorted(p, reverse=True) and top.p_within == max(p)
