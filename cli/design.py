@@ -86,6 +86,8 @@ def fit(
     from designer.data import load_table
     from designer.surrogate import Surrogate
 
+    if out is not None:
+        _check_output(out)
     table = load_table(data)
     sur = Surrogate().fit(table)
     if out is not None:
@@ -102,6 +104,21 @@ def fit(
         return
     _print_fit(report, len(table))
     console.print(f"surrogate id {sur.id}" + (f", written to {out}" if out else " (not saved: give -o FILE)"))
+
+
+def _check_output(out: Path) -> None:
+    """Refuse an output the fit could not be written to, before the fit's seconds are spent."""
+    import os
+
+    if out.is_dir():
+        raise DesignerError(f"-o {out} is a folder", "give a file path ending in .json")
+    if out.suffix.lower() != ".json":
+        raise DesignerError(f"-o {out} does not end in .json", "the surrogate is JSON: give e.g. -o my.json")
+    parent = out.resolve().parent
+    if not parent.is_dir():
+        raise DesignerError(f"cannot write {out}: folder {parent} does not exist", "create it first")
+    if not os.access(parent, os.W_OK):
+        raise DesignerError(f"cannot write {out}: folder {parent} is not writable", "choose another path")
 
 
 def _fit_report(sur, m) -> dict:

@@ -110,6 +110,8 @@ def test_fit_json_reports_nested_loo(tmp_path):
             "not a finite number",
         ),
         (["fit", "--data", "/nonexistent.csv"], "no such table"),
+        (["fit", "-o", "/"], "is a folder"),
+        (["fit", "-o", "surrogate.txt"], "does not end in .json"),
         (["suggest", "--k", "0.8", "--fix", "width=3", "--fix", "width=5"], "--fix width is given twice"),
         (["suggest", "--k", "0.8", "--fix", "colour=red"], "unknown factor 'colour'"),
         (["suggest", "--k", "stiff"], "--k 'stiff' is not a number, min or max"),
