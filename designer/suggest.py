@@ -521,21 +521,7 @@ def suggest(
             non-positive target, importance or weight, bounds not enclosing a target, top < 1, or
             tolerance not in (0, 1).
     """
-    units.check_axis(axis)
-    if axis not in surrogate.axes:
-        raise DesignerError(
-            f"the surrogate has no axis '{axis}'",
-            f"it has {', '.join(surrogate.axes) or 'none'}; "
-            "fit one on a table with that axis: Surrogate().fit(table)",
-        )
-    if k is None and c is None:
-        raise DesignerError("no target given", "give k and/or c: a value, 'min' or 'max'")
-    if top < 1:
-        raise DesignerError(f"top={top} must be at least 1", "give a positive number of candidates")
-    if not 0 < tolerance < 1:
-        raise DesignerError(
-            f"tolerance={tolerance:g} is not between 0 and 1", "give e.g. tolerance=0.1 (+-10 %)"
-        )
+    _check_request(surrogate, axis, k is None and c is None, top, tolerance)
     importance, bounds, weight = importance or {}, bounds or {}, weight or {}
     targets = {
         q: make_target(
@@ -558,10 +544,8 @@ def suggest(
     spans = {f.name: float(s) for f, s in zip(space.CONTINUOUS, box.spans, strict=True)}
     picked: list[Candidate] = []
     for cand in ranked:
-        if all(_distance(cand.params, other.params, spans) > DISTINCT for other in picked):
+        if len(picked) < top and all(_distance(cand.params, o.params, spans) > DISTINCT for o in picked):
             picked.append(cand)
-        if len(picked) == top:
-            break
     sug = Suggestion(axis, targets, picked, True, [], info, surrogate.id, fixed, tolerance)
     _assess(sug, surrogate, problem, box)
     if len(picked) < top:
@@ -570,6 +554,25 @@ def suggest(
             "ended at one of these" + (" (the fixed factors leave little to choose)" if fixed else "")
         )
     return sug
+
+
+def _check_request(surrogate: Surrogate, axis: str, no_goal: bool, top: int, tolerance: float) -> None:
+    """Raise DesignerError for an axis the surrogate lacks, no goal, top < 1 or a tolerance not in (0, 1)."""
+    units.check_axis(axis)
+    if axis not in surrogate.axes:
+        raise DesignerError(
+            f"the surrogate has no axis '{axis}'",
+            f"it has {', '.join(surrogate.axes) or 'none'}; "
+            "fit one on a table with that axis: Surrogate().fit(table)",
+        )
+    if no_goal:
+        raise DesignerError("no target given", "give k= and/or c= (a value, 'min' or 'max')")
+    if top < 1:
+        raise DesignerError(f"top={top} must be at least 1", "give a positive number of candidates")
+    if not 0 < tolerance < 1:
+        raise DesignerError(
+            f"tolerance={tolerance:g} is not between 0 and 1", "give e.g. tolerance=0.1 (+-10 %)"
+        )
 
 
 def _weights(targets: Mapping[str, Target], info: Mapping[str, Mapping[str, Any]]) -> np.ndarray:
