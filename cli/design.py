@@ -160,8 +160,9 @@ def _print_fit(report: dict, n_runs: int) -> None:
     for r, m in report["responses"].items():
         for d in m["influence"]:
             console.print(
-                f"- {r}: without run {d['run']} the procedure picks the {d['form']} form "
-                f"(its LOO Q2 {d['q2']:.2f}, {d['delta_q2']:+.2f})"
+                f"- {r}: run {d['run']} ({100 * d['press_share']:.0f} % of the LOO squared error): "
+                f"without it the procedure {'keeps' if d['form'] == m['form'] else 'picks'} the "
+                f"{d['form']} form (its LOO Q2 {d['q2']:.2f}, {d['delta_q2']:+.2f})"
             )
         lof = m["lack_of_fit"]
         if lof and lof["p_value"] is not None:

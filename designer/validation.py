@@ -36,14 +36,16 @@ def nested_loo(
 
     Returns:
         (the nested predictions, shape (n,), and the influential
-        runs as [{"row", "form", "q2", "delta_q2"}] with `row` 0-based and `q2` the LOO Q2 of the
-        form chosen without that run, over the remaining runs).
+        runs as [{"row", "form", "q2", "delta_q2", "press_share"}] with `row` 0-based, `q2` the LOO
+        Q2 of the form chosen without that run over the remaining runs, and `press_share` the
+        run's share of the chosen form's LOO squared error on all runs).
     """
     from .surrogate import Prediction, _point_metrics, select_on
 
     y = folds.y
     n = len(y)
     full_q2 = _point_metrics(y, full.loo[full.form])["q2"]
+    sq = (y - full.loo[full.form]) ** 2
     value, low, high = np.empty(n), np.empty(n), np.empty(n)
     influence = []
     for i in range(n):
@@ -53,7 +55,10 @@ def nested_loo(
         value[i], low[i], high[i] = p[0][0], p[1][0], p[2][0]
         q2 = _point_metrics(y[rows], sel.loo[sel.form])["q2"]
         if sel.form != full.form or abs(q2 - full_q2) > INFLUENCE_Q2:
-            influence.append({"row": i, "form": sel.form, "q2": q2, "delta_q2": q2 - full_q2})
+            share = float(sq[i] / sq.sum())
+            influence.append(
+                {"row": i, "form": sel.form, "q2": q2, "delta_q2": q2 - full_q2, "press_share": share}
+            )
     return Prediction(value, low, high), influence
 
 
