@@ -16,7 +16,7 @@ import typer  # noqa: E402
 
 from designer.errors import DesignerError  # noqa: E402
 
-from . import cosim, design, export, plots, rig  # noqa: E402
+from . import cosim, design, export, plots, rig, sweep  # noqa: E402
 from .common import flag_message  # noqa: E402
 
 SETTINGS = dict(
@@ -36,6 +36,7 @@ rig.register(app)
 export.register(app)
 cosim.register(app)
 plots.register(app)
+sweep.register(app)
 
 
 def main() -> None:

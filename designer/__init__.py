@@ -38,10 +38,12 @@ _PUBLIC = {
     "export_modelica": "export",
     "export_mjcf": "export",
     "export_urdf": "export",
+    "export_sdf": "export",
+    "export_ssp": "export",
     "identify": "rig.identify",
 }
 #: public names that are subpackages
-_SUBPACKAGES = ("cosim",)
+_SUBPACKAGES = ("cosim", "sweep")
 
 __all__ = ["DesignerError", "__version__", *_PUBLIC, *_SUBPACKAGES]
 
