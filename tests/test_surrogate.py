@@ -51,13 +51,14 @@ def test_nested_figures_are_the_headline(refit):
     assert refit.training["run"][20] == 21
 
 
-BLACK_BOX_ROWS = {"k_x": range(44), "c_x": (0, 2, 3, 8, 15, 20, 30, 43)}
+BLACK_BOX_ROWS = {"k_x": (*range(0, 44, 2), 15, 20, 24), "c_x": (0, 2, 3, 8, 15, 20, 30, 43)}
 
 
 @pytest.mark.parametrize("response", ["k_x", "c_x"])
 def test_nested_loo_equals_refits_without_each_run(refit, response):
     """The reported nested prediction of a run is what the whole `fit`, run on the table without that
-    run, predicts there (black box; every run for k_x, 8 runs for c_x among them influential ones)."""
+    run, predicts there (black box, for time on 25 runs of k_x: every other one and the three
+    influential ones, and 8 of c_x; each refit takes ~0.3 s)."""
     t = data.load_table()
     nested = refit.models[response].nested_predictions
     y = t[response].to_numpy(float)
