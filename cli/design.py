@@ -295,6 +295,7 @@ def suggest(
     """
     from designer.suggest import suggest as run_suggest
 
+    _positive(importance_k=importance_k, importance_c=importance_c, weight_k=weight_k, weight_c=weight_c)
     result = run_suggest(
         _load(surrogate),
         k=_parse_goal(k, "--k"),
@@ -315,6 +316,14 @@ def suggest(
         _print_suggestion(data)
     if not data["reachable"]:
         raise typer.Exit(1)
+
+
+def _positive(**values: float) -> None:
+    """Refuse a non-positive importance or weight, naming its flag."""
+    for name, v in values.items():
+        if not v > 0:
+            flag = "--" + name.replace("_", "-")
+            raise DesignerError(f"{flag} {v:g} must be positive", f"give e.g. {flag} 1")
 
 
 def _tolerance(percent: float) -> float:

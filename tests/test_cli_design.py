@@ -116,6 +116,7 @@ def test_fit_json_reports_nested_loo(tmp_path):
         (["suggest", "--k", "0.8", "--fix", "colour=red"], "unknown factor 'colour'"),
         (["suggest", "--k", "stiff"], "--k 'stiff' is not a number, min or max"),
         (["suggest", "--k", "0.8", "--tolerance", "0"], "--tolerance 0 is not between"),
+        (["suggest", "--k", "0.8", "--weight-k", "-1"], "--weight-k -1 must be positive"),
         (["suggest", "--k", "0.8", "--fix", "height=1", "--allow-extrapolation"], "cannot be printed"),
     ],
 )
