@@ -192,7 +192,7 @@ def predict(
     Example: designer predict --density 60 --length 24 --width 4.5 --height 9 --layer 0.16 --raster 0
     """
     from designer import space, units
-    from designer.suggest import predictability
+    from designer.suggestions import predictability
 
     params = space.check_design(
         dict(density=density, length=length, width=width, height=height, layer=layer, raster=raster),
@@ -293,7 +293,7 @@ def suggest(
 
     Example: designer suggest --k 0.8 --c 2e-3 --fix raster=0 --top 3
     """
-    from designer.suggest import suggest as run_suggest
+    from designer.suggestions import suggest as run_suggest
 
     _positive(importance_k=importance_k, importance_c=importance_c, weight_k=weight_k, weight_c=weight_c)
     result = run_suggest(

@@ -8,7 +8,7 @@ from scipy import stats
 
 from designer import space
 from designer.errors import DesignerError
-from designer.suggest import (
+from designer.suggestions import (
     Suggestion,
     Target,
     probability_within,
