@@ -169,6 +169,13 @@ def register(app: typer.Typer) -> None:
         fmi: Annotated[int, typer.Option("--fmi", help="FMI version, 2 or 3")] = 2,
         interface: Annotated[str, typer.Option(help="force (element) or body")] = "force",
         source_only: Annotated[bool, typer.Option("--source-only", help="no binary: sources/ only")] = False,
+        platforms: Annotated[
+            str | None,
+            typer.Option(
+                help="binaries for: all, host, or a comma list of x86_64-linux, aarch64-linux, "
+                "x86_64-windows, x86_64-darwin, aarch64-darwin (default: all when ziglang is installed)"
+            ),
+        ] = None,  # noqa: UP007
         axis: Annotated[
             list[str] | None, typer.Option(help="x y z theta phi psi; repeat for several")
         ] = None,  # noqa: UP007
@@ -198,6 +205,7 @@ def register(app: typer.Typer) -> None:
 
         Example: designer export fmu --k 0.8 --c 2e-3 --m 0.01 --interface body --fmi 3 -o joint.fmu
         """
+        from designer.export import build
         from designer.export.fmu import export_fmu
         from designer.files import check_output
 
@@ -218,8 +226,9 @@ def register(app: typer.Typer) -> None:
             name,
             allow_extrapolation,
         )
+        platforms = platforms or ("all" if build.zig_available() else "host")
         with progress("exporting FMU (compiling on first use)") as tick:
-            path = export_fmu(joint, output, fmi, interface, source_only, progress=tick)
+            path = export_fmu(joint, output, fmi, interface, source_only, progress=tick, platforms=platforms)
         if json_out:
             print_json(
                 {
@@ -227,11 +236,14 @@ def register(app: typer.Typer) -> None:
                     "fmi_version": fmi,
                     "interface": interface,
                     "source_only": source_only,
+                    "platforms": [] if source_only else build.resolve_platforms(platforms),
                     "joint": joint.to_dict(),
                 }
             )
             return
         _print_joint(joint, f"FMI {fmi} FMU ({interface} interface)", path)
+        if not source_only:
+            console.print("  binaries: " + ", ".join(build.resolve_platforms(platforms)))
         if source_only:
             console.print(
                 "  no binary: build it from sources/ with 'python -m fmpy compile " + str(path) + "'"

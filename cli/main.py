@@ -14,18 +14,26 @@ Every failure ends as one line on stderr naming the problem and the fix, never a
 from __future__ import annotations
 
 import errno
+import os
 import signal
 import sys
 import traceback
 import warnings
 from typing import Annotated
 
-import typer
+#: fit, predict and suggest do small dense algebra: OpenBLAS's thread pool costs more to start
+#: (~50 ms) than it saves; set before numpy loads, and only when the user has not chosen
+DESIGN_COMMANDS = ("fit", "predict", "suggest")
+_DESIGN = sys.argv[1:2] != [] and sys.argv[1] in DESIGN_COMMANDS
+if _DESIGN:
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-from designer.errors import DesignerError
+import typer  # noqa: E402
 
-from . import cosim, design, export, plots, rig, sweep
-from .common import flag_message
+from designer.errors import DesignerError  # noqa: E402
+
+from . import cosim, design, export, plots, rig, sweep  # noqa: E402
+from .common import flag_message  # noqa: E402
 
 try:  # typer 0.28 vendors click
     from typer._click import exceptions as _click_errors
@@ -34,7 +42,7 @@ except ImportError:  # pragma: no cover - older typer on click
 
 REPORT_HINT = "this is a bug in designer: rerun with --debug and report the traceback"
 
-app = typer.Typer(
+SETTINGS = dict(
     help="Design 3D-printed TPU flexible joints: predict and choose stiffness and damping, export FMUs.\n\n"
     "Exit codes: 0 success, 1 negative answer (a check failed, no design meets the target), 2 bad input "
     "or environment, 3 internal error; 130, 143, 129 when stopped by Ctrl-C, SIGTERM, SIGHUP.",
@@ -43,6 +51,10 @@ app = typer.Typer(
     add_completion=False,
     rich_markup_mode="rich",
 )
+app = typer.Typer(**SETTINGS)
+#: typer builds the click tree of every registered command on each call: a design command gets an
+#: app with only fit, predict and suggest (the help of `designer` itself still lists everything)
+design_app = typer.Typer(**SETTINGS)
 
 
 def _version(value: bool) -> None:
@@ -53,6 +65,7 @@ def _version(value: bool) -> None:
         raise typer.Exit(0)
 
 
+@design_app.callback()
 @app.callback()
 def _options(
     version: Annotated[
@@ -65,6 +78,7 @@ def _options(
     """Options of the `designer` command itself (--debug is also accepted after a sub-command)."""
 
 
+design.register(design_app)
 design.register(app)
 rig.register(app)
 export.register(app)
@@ -129,7 +143,8 @@ def run(argv: list[str] | None = None) -> int:
 
 def _run(args: list[str], debug: bool) -> int:
     try:
-        code = app(args=args, prog_name="designer", standalone_mode=False)
+        chosen = design_app if args[:1] and args[0] in DESIGN_COMMANDS else app
+        code = chosen(args=args, prog_name="designer", standalone_mode=False)
         return code if isinstance(code, int) else 0
     except Stopped as exc:
         print(f"stopped by {signal.Signals(exc.signum).name}; partial files removed", file=sys.stderr)

@@ -31,8 +31,8 @@ _PUBLIC = {
     "load_table": "data",
     "Surrogate": "surrogate",
     "Prediction": "surrogate",
-    "suggest": "suggest",
-    "Suggestion": "suggest",
+    "suggest": "suggestions",
+    "Suggestion": "suggestions",
     "Joint": "joint",
     "export_fmu": "export",
     "export_modelica": "export",
@@ -55,12 +55,9 @@ def __getattr__(name: str) -> Any:
     if module is None:
         raise AttributeError(f"module 'designer' has no attribute {name!r}")
     mod = importlib.import_module(f".{module}", __name__)
-    # importing a submodule binds its name on the package (designer.suggest, the module, would
-    # hide designer.suggest, the function): bind every public name it defines again
-    for public, home in _PUBLIC.items():
-        if home == module:
-            globals()[public] = getattr(mod, public)
-    return globals()[name]
+    value = getattr(mod, name)
+    globals()[name] = value
+    return value
 
 
 def __dir__() -> list[str]:

@@ -135,7 +135,7 @@ def test_interrupted_run_leaves_complete_files_or_none(tmp_path, monkeypatch):
     names = sorted(p.name for p in out.iterdir())
     assert names == ["metrics.json", "timeseries.csv", "timeseries.parquet"]
     assert len(np.loadtxt(out / "timeseries.csv", delimiter=",", skiprows=1)) == 201
-    monkeypatch.setattr(cosim_run.Master, "run", interrupt)
+    monkeypatch.setattr(cosim_run, "run_master", interrupt)
     with pytest.raises(KeyboardInterrupt):
         write_outputs(run(sc), tmp_path / "none")
     assert not (tmp_path / "none").exists()
@@ -160,7 +160,7 @@ DESIGN_TOML = "design = { density = 60, length = 24, width = 4.5, height = 9, la
 
 
 def _suggestion(tmp_path):
-    from designer.suggest import suggest
+    from designer.suggestions import suggest
     from designer.surrogate import Surrogate
 
     doc = suggest(Surrogate.load(), k=0.8, fixed={"length": 24}, top=2).to_dict()

@@ -19,7 +19,7 @@ from imagecheck import assert_picture
 from scipy import stats
 
 from designer import space
-from designer.suggest import make_target
+from designer.suggestions import make_target
 from designer.surrogate import Surrogate
 
 pytest.importorskip("websocket", reason="the browser tests speak to Chromium with websocket-client")

@@ -12,7 +12,7 @@ import json
 import math
 import uuid
 import zipfile
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
@@ -22,6 +22,7 @@ from ..errors import DesignerError
 from ..files import atomic_path, check_suffix
 from ..joint import AxisCoefficients, Joint
 from . import build
+from .layout import layout
 
 INTERFACES = ("force", "body")
 FMI_VERSIONS = (2, 3)
@@ -29,8 +30,6 @@ GENERATOR = f"flexjoint designer {__version__}"
 _ZIP_DATE = (1980, 1, 1, 0, 0, 0)
 _TOKEN = "@TOKEN@"
 
-#: value reference of a variable: 100 * (axis index + 1) + field (fmus/FlexJoint/config.h)
-_FIELDS = ("m", "c", "k", "offset", "enabled", "s", "v", "f", "a")
 
 # SI units and their base-unit exponents, for UnitDefinitions
 _BASE_UNITS: dict[str, dict[str, int]] = {
@@ -54,8 +53,8 @@ _BASE_ORDER = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
 
 
 def value_reference(axis: str, field: str) -> int:
-    """The fixed value reference of `axis.field`, the same in every FlexJoint FMU."""
-    return 100 * (units.AXES.index(axis) + 1) + _FIELDS.index(field)
+    """The fixed value reference of `axis.field` in every FlexJoint FMU (fmus/FlexJoint/config.h)."""
+    return layout().value_reference(axis, field)
 
 
 @dataclass(frozen=True)
@@ -72,7 +71,8 @@ class Variable:
     unit: str | None = None
     initial: str | None = None
     derivative_of: str | None = None  # name of the state this variable is the derivative of
-    depends_on: tuple[str, ...] | None = None  # for Outputs and derivatives
+    depends_on: tuple[str, ...] | None = None  # for Outputs and derivatives: inputs and states
+    parameters: tuple[str, ...] = ()  # the tunable parameters it depends on (FMI 3 dependencies)
 
 
 def _pi_text(ac: AxisCoefficients, quantity: str) -> str:
@@ -156,6 +156,7 @@ def _variables(joint: Joint, interface: str) -> list[Variable]:
                     f"{what} of the joint, -(k (s - offset) + c v)",
                     unit=f,
                     depends_on=(f"{a}.s", f"{a}.v"),
+                    parameters=(f"{a}.c", f"{a}.k", f"{a}.offset"),
                 )
             )
         else:
@@ -197,6 +198,7 @@ def _variables(joint: Joint, interface: str) -> list[Variable]:
                     unit=f"{r}/s^2",
                     derivative_of=f"{a}.v",
                     depends_on=(f"{a}.s", f"{a}.v", f"{a}.f"),
+                    parameters=(f"{a}.m", f"{a}.c", f"{a}.k", f"{a}.offset"),
                 )
             )
     return out
@@ -220,6 +222,17 @@ def _unit_definitions(variables: list[Variable]) -> list[str]:
         base = " ".join(f'{k}="{_BASE_UNITS[u][k]}"' for k in _BASE_ORDER if k in _BASE_UNITS[u])
         lines += [f"    <Unit name={quoteattr(u)}>", f"      <BaseUnit {base}/>", "    </Unit>"]
     return lines + ["  </UnitDefinitions>"]
+
+
+def _log_categories() -> list[str]:
+    """The categories the runtime logs in (runtime/instance.c setLogCategory)."""
+    return [
+        "  <LogCategories>",
+        '    <Category name="logEvents" description="life-cycle events"/>',
+        '    <Category name="logStatusDiscard" description="calls answered with Discard"/>',
+        '    <Category name="logStatusError" description="errors"/>',
+        "  </LogCategories>",
+    ]
 
 
 def _default_experiment(joint: Joint, interface: str) -> str:
@@ -255,28 +268,31 @@ def _fmi2_description(joint: Joint, interface: str, variables: list[Variable]) -
     variables = [v for v in variables if v.causality != "independent"]
     index = {v.name: i + 1 for i, v in enumerate(variables)}
     sources = "\n".join(f'      <File name="{Path(p).name}"/>' for p in build.c_sources(2))
+    lay = layout()
     caps = (
-        'canGetAndSetFMUstate="true" canSerializeFMUstate="true" providesDirectionalDerivative="true" '
+        f'canGetAndSetFMUstate="{lay.flag("CAN_GET_AND_SET_FMU_STATE")}" '
+        f'canSerializeFMUstate="{lay.flag("CAN_SERIALIZE_FMU_STATE")}" '
+        f'providesDirectionalDerivative="{lay.flag("PROVIDES_DIRECTIONAL_DERIVATIVES")}" '
         'canNotUseMemoryManagementFunctions="true"'
     )
+    not_needed = "false" if lay.capabilities["NEEDS_COMPLETED_INTEGRATOR_STEP"] else "true"
+    variable_step = lay.flag("CAN_HANDLE_VARIABLE_COMMUNICATION_STEP_SIZE")
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<fmiModelDescription fmiVersion="2.0" modelName={quoteattr(joint.name)} guid="{_TOKEN}"',
         f"  description={quoteattr(_description(joint, interface))}",
-        f'  generationTool="{GENERATOR}" variableNamingConvention="structured" numberOfEventIndicators="0">',
-        f'  <ModelExchange modelIdentifier="{build.MODEL_IDENTIFIER}" {caps} '
-        'completedIntegratorStepNotNeeded="true">',
+        f'  generationTool="{GENERATOR}" variableNamingConvention="structured" '
+        f'numberOfEventIndicators="{lay.capabilities["N_EVENT_INDICATORS"]}">',
+        f'  <ModelExchange modelIdentifier="{lay.model_identifier}" {caps} '
+        f'completedIntegratorStepNotNeeded="{not_needed}">',
         f"    <SourceFiles>\n{sources}\n    </SourceFiles>",
         "  </ModelExchange>",
-        f'  <CoSimulation modelIdentifier="{build.MODEL_IDENTIFIER}" {caps} '
-        'canHandleVariableCommunicationStepSize="true">',
+        f'  <CoSimulation modelIdentifier="{lay.model_identifier}" {caps} '
+        f'canHandleVariableCommunicationStepSize="{variable_step}">',
         f"    <SourceFiles>\n{sources}\n    </SourceFiles>",
         "  </CoSimulation>",
         *_unit_definitions(variables),
-        "  <LogCategories>",
-        '    <Category name="logEvents" description="life-cycle events"/>',
-        '    <Category name="logStatusError" description="errors"/>',
-        "  </LogCategories>",
+        *_log_categories(),
         _default_experiment(joint, interface),
         "  <ModelVariables>",
     ]
@@ -326,22 +342,26 @@ def _fmi2_description(joint: Joint, interface: str, variables: list[Variable]) -
 
 def _fmi3_description(joint: Joint, interface: str, variables: list[Variable]) -> str:
     vr = {v.name: v.vr for v in variables}
-    caps = 'canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="true"'
+    lay = layout()
+    caps = (
+        f'canGetAndSetFMUState="{lay.flag("CAN_GET_AND_SET_FMU_STATE")}" '
+        f'canSerializeFMUState="{lay.flag("CAN_SERIALIZE_FMU_STATE")}" '
+        f'providesDirectionalDerivatives="{lay.flag("PROVIDES_DIRECTIONAL_DERIVATIVES")}" '
+        f'providesAdjointDerivatives="{lay.flag("PROVIDES_ADJOINT_DERIVATIVES")}"'
+    )
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<fmiModelDescription fmiVersion="3.0" modelName={quoteattr(joint.name)}',
         f'  instantiationToken="{_TOKEN}"',
         f"  description={quoteattr(_description(joint, interface))}",
         f'  generationTool="{GENERATOR}" variableNamingConvention="structured">',
-        f'  <ModelExchange modelIdentifier="{build.MODEL_IDENTIFIER}" {caps} '
-        'needsCompletedIntegratorStep="false"/>',
-        f'  <CoSimulation modelIdentifier="{build.MODEL_IDENTIFIER}" {caps} '
-        'canHandleVariableCommunicationStepSize="true" hasEventMode="false"/>',
+        f'  <ModelExchange modelIdentifier="{lay.model_identifier}" {caps} '
+        f'needsCompletedIntegratorStep="{lay.flag("NEEDS_COMPLETED_INTEGRATOR_STEP")}"/>',
+        f'  <CoSimulation modelIdentifier="{lay.model_identifier}" {caps} '
+        f'canHandleVariableCommunicationStepSize="{lay.flag("CAN_HANDLE_VARIABLE_COMMUNICATION_STEP_SIZE")}" '
+        f'hasEventMode="{lay.flag("HAS_EVENT_MODE")}"/>',
         *_unit_definitions(variables),
-        "  <LogCategories>",
-        '    <Category name="logEvents" description="life-cycle events"/>',
-        '    <Category name="logStatusError" description="errors"/>',
-        "  </LogCategories>",
+        *_log_categories(),
         _default_experiment(joint, interface),
         "  <ModelVariables>",
     ]
@@ -365,7 +385,10 @@ def _fmi3_description(joint: Joint, interface: str, variables: list[Variable]) -
     lines += ["  </ModelVariables>", "  <ModelStructure>"]
 
     def unknown(tag: str, v: Variable, deps: bool = True) -> str:
-        d = f' dependencies="{" ".join(str(vr[n]) for n in v.depends_on)}"' if deps and v.depends_on else ""
+        # FMI 3 dependencies include the tunable parameters an unknown depends on (leaving them out
+        # would declare those partial derivatives identically zero)
+        known = sorted(vr[n] for n in (*(v.depends_on or ()), *v.parameters) if n in vr)
+        d = f' dependencies="{" ".join(map(str, known))}"' if deps and v.depends_on else ""
         return f'    <{tag} valueReference="{v.vr}"{d}/>'
 
     lines += [unknown("Output", v) for v in variables if v.causality == "output"]
@@ -385,7 +408,7 @@ def _build_description() -> str:
         [
             '<?xml version="1.0" encoding="UTF-8"?>',
             '<fmiBuildDescription fmiVersion="3.0">',
-            f'  <BuildConfiguration modelIdentifier="{build.MODEL_IDENTIFIER}">',
+            f'  <BuildConfiguration modelIdentifier="{layout().model_identifier}">',
             '    <SourceFileSet language="C99">',
             files,
             "    </SourceFileSet>",
@@ -427,9 +450,14 @@ def _check(joint: Joint, fmi_version: int, interface: str) -> None:
 
 
 def archive_entries(
-    joint: Joint, fmi_version: int = 2, interface: str = "force", source_only: bool = False
+    joint: Joint,
+    fmi_version: int = 2,
+    interface: str = "force",
+    source_only: bool = False,
+    platforms: str | Sequence[str] = "host",
 ) -> dict[str, bytes]:
-    """The files of the FMU archive, by name in the archive."""
+    """The files of the FMU archive, by name in the archive; binaries for `platforms` (see
+    `build.resolve_platforms`: "all", "host" or FMI 3 platform tuples) unless `source_only`."""
     _check(joint, fmi_version, interface)
     variables = _variables(joint, interface)
     describe = _fmi2_description if fmi_version == 2 else _fmi3_description
@@ -456,8 +484,9 @@ def archive_entries(
     if fmi_version == 3:
         entries["sources/buildDescription.xml"] = _build_description().encode()
     if not source_only:
-        binary = build.build_binary(fmi_version)
-        entries[f"binaries/{build.platform_folder(fmi_version)}/{build.library_name()}"] = binary.read_bytes()
+        for platform in build.resolve_platforms(platforms):
+            folder, name = build.platform_folder(fmi_version, platform), build.library_name(platform)
+            entries[f"binaries/{folder}/{name}"] = build.build_binary(fmi_version, platform).read_bytes()
     return entries
 
 
@@ -468,10 +497,18 @@ def export_fmu(
     interface: str = "force",
     source_only: bool = False,
     progress: Callable[[float], None] | None = None,
+    platforms: str | Sequence[str] = "host",
 ) -> Path:
-    """Write `joint` as an FMU at `path` (atomically); the same joint always gives the same bytes."""
+    """Write `joint` as an FMU at `path` (atomically); the same joint always gives the same bytes.
+
+    `platforms`: "host" (this machine, the default), "all" (linux, windows and macOS on x86_64 and
+    aarch64 as build.PLATFORMS lists; needs the ziglang package) or a list of FMI 3 platform tuples.
+
+    Raises:
+        DesignerError: bad arguments, or a binary that cannot be built.
+    """
     path = check_suffix(path, (".fmu",), what="an FMU")
-    entries = archive_entries(joint, fmi_version, interface, source_only)
+    entries = archive_entries(joint, fmi_version, interface, source_only, platforms)
     if progress:
         progress(0.5)
     with atomic_path(path) as tmp, zipfile.ZipFile(tmp, "w") as z:

@@ -207,7 +207,7 @@ def candidate_sets(suggestion, *, axes: list[str] | None = None, name: str = "Fl
     Raises:
         DesignerError: the suggestion cannot be read or has no candidates.
     """
-    from ..suggest import Suggestion
+    from ..suggestions import Suggestion
 
     if not isinstance(suggestion, Suggestion):
         suggestion = Suggestion.load(suggestion)

@@ -136,7 +136,7 @@ def suggestion(spec: Spec) -> list[Case]:
     from ..joint import Joint
 
     path: Path = spec.cases.file
-    from ..suggest import Suggestion
+    from ..suggestions import Suggestion
 
     n = len(Suggestion.load(path).candidates)
     numbers = spec.cases.candidates or tuple(range(1, n + 1))

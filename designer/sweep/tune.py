@@ -295,7 +295,7 @@ def _designs(
     tuned: TuneResult, spec: Spec, surrogate: Surrogate, draws: int, seed: int, ex: Executor
 ) -> None:
     """Suggest designs for each tuned joint, then a Monte Carlo sweep over the best designs' PIs."""
-    from ..suggest import suggest
+    from ..suggestions import suggest
     from .cases import make_cases
     from .run import table
     from .summary import summarize
