@@ -139,7 +139,7 @@ def _make_logs(folder: Path) -> None:
 
 
 def _make_suggestions(folder: Path) -> None:
-    from designer.suggest import suggest
+    from designer.suggestions import suggest
     from designer.surrogate import Surrogate
 
     good = suggest(Surrogate.load(), k=0.8, top=2).to_dict()

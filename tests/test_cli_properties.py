@@ -191,7 +191,7 @@ _GOOD = {}
 
 def _good_suggestion() -> dict:
     if not _GOOD:
-        from designer.suggest import suggest
+        from designer.suggestions import suggest
         from designer.surrogate import Surrogate
 
         _GOOD.update(suggest(Surrogate.load(), k=0.8, top=2).to_dict())
