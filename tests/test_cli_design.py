@@ -111,7 +111,7 @@ def test_fit_json_reports_nested_loo(tmp_path):
         ),
         (["fit", "--data", "/nonexistent.csv"], "no such table"),
         (["fit", "-o", "/"], "is a folder"),
-        (["fit", "-o", "surrogate.txt"], "does not end in .json"),
+        (["fit", "-o", "surrogate.txt"], "the suffix '.txt' is not .json"),
         (["suggest", "--k", "0.8", "--fix", "width=3", "--fix", "width=5"], "--fix width is given twice"),
         (["suggest", "--k", "0.8", "--fix", "colour=red"], "unknown factor 'colour'"),
         (["suggest", "--k", "stiff"], "--k 'stiff' is not a number, min or max"),

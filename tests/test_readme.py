@@ -39,7 +39,6 @@ def test_readme_names_its_commands():
 def test_readme_commands_run_verbatim(tmp_path):
     shutil.copytree(ROOT / "examples", tmp_path / "examples")
     env = dict(os.environ, PATH=f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}")
-    env["XDG_CACHE_HOME"] = str(tmp_path.parent / "cache")
     env.pop("PYTHONPATH", None)
     timings = []
     for cmd in readme_commands(README.read_text()):
