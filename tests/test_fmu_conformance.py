@@ -16,7 +16,7 @@ import pytest
 from fmi_calls import CS, DISCARD, ERROR, ME, OK, Fmu, doubles, unpack, vrs
 
 from designer.export.fmu import export_fmu, value_reference
-from designer.joint import from_coefficients
+from designer.joint import Joint
 
 M, C_SI, K_SI = 0.01, 2.0, 800.0  # kg, N.s/m, N/m
 VR = {f: value_reference("x", f) for f in ("m", "c", "k", "offset", "enabled", "s", "v", "f", "a")}
@@ -33,7 +33,7 @@ def cache(tmp_path_factory):
 @pytest.fixture(scope="module")
 def paths(tmp_path_factory):
     d = tmp_path_factory.mktemp("fmus")
-    joint = from_coefficients({"x": {"k": K_SI / 1e3, "c": C_SI / 1e3, "m": M}})
+    joint = Joint.from_coefficients({"x": {"k": K_SI / 1e3, "c": C_SI / 1e3, "m": M}})
     return {(v, i): export_fmu(joint, d / f"j{v}{i}.fmu", v, i) for v in (2, 3) for i in ("force", "body")}
 
 

@@ -15,7 +15,7 @@ from fmpy.fmi2 import FMU2Slave
 from designer.cosim.fmu import FmuSystem
 from designer.cosim.master import Master
 from designer.export.fmu import export_fmu
-from designer.joint import from_coefficients
+from designer.joint import Joint
 
 K, C, M = 3.0, 0.5, 2e-3  # SI on theta: N.m/rad, N.m.s/rad, kg.m^2 (the third-party FMU's values)
 STEP, DURATION = 1e-3, 0.3
@@ -34,7 +34,7 @@ def cache(tmp_path_factory):
 def fmus(tmp_path_factory):
     d = tmp_path_factory.mktemp("fmus")
     # rig units: N.mm/rad and N.mm.s/rad
-    joint = from_coefficients({"theta": {"k": K * 1e3, "c": C * 1e3, "m": M}})
+    joint = Joint.from_coefficients({"theta": {"k": K * 1e3, "c": C * 1e3, "m": M}})
     return {(v, i): export_fmu(joint, d / f"j{v}{i}.fmu", v, i) for v in (2, 3) for i in ("force", "body")}
 
 

@@ -20,7 +20,7 @@ from fmpy.validation import validate_fmu
 from designer.errors import DesignerError
 from designer.export import build
 from designer.export.fmu import export_fmu
-from designer.joint import from_coefficients
+from designer.joint import Joint
 
 pytestmark = pytest.mark.skipif(not build.zig_available(), reason="ziglang is not installed")
 
@@ -40,7 +40,7 @@ def fmus(tmp_path_factory):
     default_zig = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "zig"
     mp.setenv("ZIG_GLOBAL_CACHE_DIR", os.environ.get("ZIG_GLOBAL_CACHE_DIR", str(default_zig)))
     mp.setenv("XDG_CACHE_HOME", str(d / "cache"))
-    joint = from_coefficients({"theta": {"k": 330, "c": 0.83, "m": 2e-6}})
+    joint = Joint.from_coefficients({"theta": {"k": 330, "c": 0.83, "m": 2e-6}})
     yield {v: export_fmu(joint, d / f"all{v}.fmu", v, "force", platforms="all") for v in (2, 3)}, joint, d
     mp.undo()
 
@@ -139,6 +139,14 @@ def test_platform_list_and_refusals(fmus):
         }
     with pytest.raises(DesignerError, match="unknown platform"):
         export_fmu(joint, d / "bad.fmu", 3, "force", platforms="riscv64-linux")
+
+
+def test_cli_default_is_all_platforms_with_ziglang(fmus, tmp_path):
+    cmd = "from designer_cli.main import main; main()"
+    args = ["export", "fmu", "--k", "0.8", "--c", "2e-3", "-o", str(tmp_path / "j.fmu"), "--json"]
+    done = subprocess.run([sys.executable, "-I", "-c", cmd, *args], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["platforms"] == list(build.PLATFORMS)
 
 
 def test_cli_platforms_option(fmus, tmp_path):

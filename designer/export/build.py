@@ -162,12 +162,12 @@ def find_compiler() -> list[str]:
 
 def _compiler(platform: str) -> tuple[list[str], list[str]]:
     """The compiler command and its extra flags for `platform`: the system one for the host (Zig if
-    there is none), Zig for the others."""
+    there is none and $CC names none), Zig for the others."""
     if platform == host_platform():
         try:
             return find_compiler(), []
         except DesignerError:
-            if not zig_available():
+            if os.environ.get("CC", "").strip() or not zig_available():
                 raise
     extra = [*_ZIG_FLAGS, "-target", PLATFORMS[platform]]
     if platform.endswith("darwin"):
