@@ -12,6 +12,7 @@ from .units import rig_unit
 
 def check_dataset(ctx: Context) -> CheckResult:
     """The table holds the six factors at tested values and positive coefficients, with no gaps."""
+    from .plots.common import save_figure
     from .plots.heatmap import plot_heatmap
 
     t = ctx.table
@@ -44,7 +45,7 @@ def check_dataset(ctx: Context) -> CheckResult:
                 "runs per level": f"median {v.median():.4g}, CV {v.std() / v.mean():.0%}",
             }
         )
-    fig = plot_heatmap(t, coefs, ctx.figures / "dataset_heatmap.png")
+    fig = save_figure(plot_heatmap(t, responses=coefs), ctx.figures / "dataset_heatmap.png")
     summary = (
         f"{len(t)} runs from the {ctx.source} (sha256 {table_hash(t)[:12]}), responses {', '.join(coefs)}"
         + ("; " + "; ".join(problems) if problems else "; every factor within its tested range")

@@ -11,12 +11,13 @@ from .errors import DesignerError
 def check_table4(ctx: Context) -> CheckResult:
     """Our type III ANOVA of k_x against the study's Table 4: F and p side by side."""
     from .plots.checks import plot_table4
+    from .plots.common import save_figure
     from .stats import TABLE4_NOTE, compare_table4
 
     if "k_x" not in ctx.table.columns:
         raise DesignerError("the table has no k_x column", "Table 4 is the ANOVA of k_x: give c_x, k_x")
     cmp = compare_table4(ctx.table)
-    fig = plot_table4(cmp, ctx.figures / "table4.png")
+    fig = save_figure(plot_table4(cmp), ctx.figures / "table4.png")
     ours = {s for s, sig in zip(cmp.source, cmp.significant, strict=True) if sig}
     summary = (
         f"{int(cmp.agrees.sum())} of {len(cmp)} sources agree (F within 10 % where the paper's F > 1, same "
@@ -44,6 +45,7 @@ SIGNIFICANT_K_X = ("width", "height", "layer")
 
 def check_main_effects(ctx: Context) -> CheckResult:
     """Medians move as the study's effect plots say, for each factor its Table 4 finds significant."""
+    from .plots.common import save_figure
     from .plots.effects import main_effects, plot_effects
 
     responses = [r for r in ("c_x", "k_x") if r in ctx.table.columns]
@@ -73,7 +75,7 @@ def check_main_effects(ctx: Context) -> CheckResult:
         )
     table = pd.DataFrame(rows)
     binding = table[table["counts"] == "yes"]
-    fig = plot_effects(ctx.table, responses, ctx.figures / "main_effects.png")
+    fig = save_figure(plot_effects(ctx.table, responses=responses), ctx.figures / "main_effects.png")
     summary = (
         f"{int(binding.agrees.sum())} of {len(binding)} directions the study finds significant agree; "
         f"{int(table.agrees.sum())} of {len(table)} stated directions agree in all"

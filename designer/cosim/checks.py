@@ -20,6 +20,7 @@ def check_cosim(ctx: Context) -> CheckResult:
     """The arm co-simulated with two joint FMUs converges to the in-engine reference with the macro step."""
     from ..joint import Joint
     from ..plots.checks import plot_convergence
+    from ..plots.common import save_figure
     from ..plots.timeseries import plot_timeseries
     from .references import Sine, Step
     from .run import robot_reference, run
@@ -46,21 +47,23 @@ def check_cosim(ctx: Context) -> CheckResult:
         and (steps["order"].iloc[1:] >= COSIM_ORDER).all()
     )
     figs = [
-        plot_convergence(
-            steps[["step", "max_error", "max_error_same_step"]].rename(
-                columns={
-                    "max_error": f"against RK4 at {min(COSIM_STEPS) / 4:g} s",
-                    "max_error_same_step": "against MuJoCo in-engine",
-                }
+        save_figure(
+            plot_convergence(
+                steps[["step", "max_error", "max_error_same_step"]].rename(
+                    columns={
+                        "max_error": f"against RK4 at {min(COSIM_STEPS) / 4:g} s",
+                        "max_error_same_step": "against MuJoCo in-engine",
+                    }
+                ),
+                unit="rad",
             ),
             ctx.figures / "cosim_convergence.png",
-            "rad",
         ),
-        plot_timeseries(
-            cosim,
+        save_figure(
+            plot_timeseries(
+                cosim, columns=["robot.j1.q", "robot.j2.q", "j1.theta.f", "j2.theta.f"], reference=reference
+            ),
             ctx.figures / "cosim_arm.png",
-            ["robot.j1.q", "robot.j2.q", "j1.theta.f", "j2.theta.f"],
-            reference=reference,
         ),
     ]
     summary = (

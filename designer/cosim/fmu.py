@@ -18,8 +18,12 @@ How each FMU is driven (FMI 2.0 sections 3.2.3 and 4.2.4, FMI 3.0 sections 3.2 a
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
+import functools
+import itertools
 import shutil
+from collections import deque
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -28,6 +32,40 @@ import numpy as np
 from ..errors import DesignerError
 
 PARAMETERS = ("m", "c", "k", "offset")
+STATUS = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
+#: the log categories the FMI standard suggests for problems, enabled where an FMU declares them
+PROBLEM_CATEGORIES = ("logStatusWarning", "logStatusDiscard", "logStatusError", "logStatusFatal")
+#: how many of an FMU's last log messages are kept to explain an error
+LOG_LINES = 50
+
+
+#: FMI 2 instances' logs by their componentEnvironment token
+_LOGS: dict[int, deque[str]] = {}
+_TOKENS = itertools.count(1)
+
+
+def log_line(status: int, category: bytes | None, message: bytes | None) -> str:
+    """One FMU log message as a line: [status] category: message."""
+    label = STATUS[status] if 0 <= status < len(STATUS) else str(status)
+    text = (message or b"").decode(errors="replace")
+    return f"[{label}] {(category or b'').decode(errors='replace')}: {text}"
+
+
+@functools.cache
+def _fmi2_router():
+    """The process's one FMI 2 logger: a message goes to the log its componentEnvironment names;
+    one from an instance made elsewhere (fmpy's own callbacks) is printed as fmpy would."""
+    from fmpy.fmi1 import printLogMessage
+    from fmpy.fmi2 import fmi2CallbackLoggerTYPE
+
+    def route(env, instance, status, category, message) -> None:
+        log = _LOGS.get(env or 0)
+        if log is None:
+            printLogMessage(env, instance, status, category, message)
+        else:
+            log.append(log_line(status, category, message))
+
+    return fmi2CallbackLoggerTYPE(route)
 
 
 def _axes_of(md) -> set[str]:
@@ -116,6 +154,7 @@ class FmuSystem:
             self.outputs = [f"{a}.{v}" for a in axes for v in ("s", "v", "a")]
         self._needs_cis = me and md.modelExchange.needsCompletedIntegratorStep
         self._dir = extract(str(path))
+        self.log: deque[str] = deque(maxlen=LOG_LINES)
         self.fmu = self._instantiate(md, name, me)
         refs = {v.name: v.valueReference for v in md.modelVariables}
         for key, value in (parameters or {}).items():
@@ -139,7 +178,10 @@ class FmuSystem:
             from fmpy.fmi2 import FMU2Model, FMU2Slave
 
             fmu = (FMU2Model if me else FMU2Slave)(**kwargs)
-        fmu.instantiate()
+        self._instantiate_logging(fmu)
+        problems = [c.name for c in md.logCategories if c.name in PROBLEM_CATEGORIES]
+        if problems:  # only problems: an FMU logging every call would slow each step
+            fmu.setDebugLogging(True, problems)
         return fmu
 
     def _initialize(self, me: bool) -> None:
@@ -159,10 +201,7 @@ class FmuSystem:
         for _ in range(1000):
             more, terminate, *_ = update()
             if terminate:
-                raise DesignerError(
-                    f"FMU instance {self.fmu.instanceName} asked to terminate the simulation",
-                    "check the FMU's inputs and parameters",
-                )
+                raise self._terminated()
             if not more:
                 break
         self.fmu.enterContinuousTimeMode()
@@ -177,6 +216,7 @@ class FmuSystem:
         self._in_ptr = self._in.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         self._out_ptr = self._out.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         self._steps = 0
+        self._h = 0.0  # the last macro step, s (0 before the first)
         f, ni, no = self.fmu, len(self.inputs), len(self.outputs)
         if self.version == 3:
             self._set = lambda: f.fmi3SetFloat64(f.component, self._in_vr, ni, self._in_ptr, ni)
@@ -185,6 +225,30 @@ class FmuSystem:
             self._set = lambda: f.fmi2SetReal(f.component, self._in_vr, ni, self._in_ptr)
             self._get = lambda: f.fmi2GetReal(f.component, self._out_vr, no, self._out_ptr)
 
+    def _instantiate_logging(self, fmu) -> None:
+        """Instantiate with a logger that keeps the FMU's last messages in `self.log` (none printed)."""
+        if self.version == 3:  # fmpy keeps one callback per instance
+
+            def record(env, status, category, message) -> None:
+                self.log.append(log_line(status, category, message))
+
+            fmu.instantiate(logMessage=record)
+            return
+        from fmpy.fmi2 import defaultCallbacks, fmi2CallbackFunctions
+        from fmpy.logging import addLoggerProxy
+
+        # fmpy's proxy (it formats FMI 2's printf-style messages) keeps ONE logger for the process, so
+        # the instance is told apart by its componentEnvironment, a token naming its log
+        self._token = next(_TOKENS)
+        _LOGS[self._token] = self.log
+        self._callbacks = fmi2CallbackFunctions()
+        self._callbacks.logger = _fmi2_router()
+        self._callbacks.allocateMemory = defaultCallbacks.allocateMemory
+        self._callbacks.freeMemory = defaultCallbacks.freeMemory
+        self._callbacks.componentEnvironment = self._token
+        addLoggerProxy(ctypes.byref(self._callbacks))
+        fmu.instantiate(callbacks=self._callbacks)
+
     def _set_scalar(self, vr: int, value: float) -> None:
         if self.version == 3:
             self.fmu.setFloat64([vr], [value])
@@ -192,37 +256,83 @@ class FmuSystem:
             self.fmu.setReal([vr], [value])
 
     def get(self) -> np.ndarray:
-        self._get()
+        try:
+            self._get()
+        except Exception as exc:
+            self._surface(exc)
         return self._out.copy()
 
     def set(self, values: np.ndarray) -> None:
         self._in[:] = values
-        self._set()
+        try:
+            self._set()
+        except Exception as exc:
+            self._surface(exc)
 
     def do_step(self, h: float) -> None:
         """Co-simulation: DoStep(n h, h). Model Exchange (no states): SetTime((n + 1) h), then
         CompletedIntegratorStep if the FMU needs it, and an event iteration if it asks for one."""
-        if self.kind == "co-simulation":
-            self.fmu.doStep(self._steps * h, h)
+        self._h = h
+        try:
+            if self.kind == "co-simulation":
+                self.fmu.doStep(self._steps * h, h)
+                self._steps += 1
+                return
             self._steps += 1
-            return
-        self._steps += 1
-        self.fmu.setTime(self._steps * h)
-        if self._needs_cis:
-            enter, terminate = self.fmu.completedIntegratorStep()
-            if terminate:
-                raise DesignerError(
-                    f"FMU instance {self.fmu.instanceName} asked to terminate the simulation",
-                    "check the FMU's inputs and parameters",
-                )
-            if enter:
-                self.fmu.enterEventMode()
-                self._event_iteration()
+            self.fmu.setTime(self._steps * h)
+            if self._needs_cis:
+                self.completed(*self.fmu.completedIntegratorStep())
+        except Exception as exc:
+            self._surface(exc)
+
+    def _surface(self, exc: Exception) -> None:
+        """Called in an except block: fmpy's exception for a status above Warning becomes a
+        DesignerError carrying the FMU's log; anything else goes on as it was."""
+        from fmpy.fmi1 import FMICallException
+
+        if isinstance(exc, FMICallException):
+            raise self.status_error(exc.function, exc.status, self._steps * self._h) from None
+        raise  # the exception being handled
+
+    def status_error(self, call: str, status: int, t: float) -> DesignerError:
+        """The error for FMI function `call` returning `status` at time `t` (s), with the FMU's log."""
+        label = STATUS[status] if 0 <= status < len(STATUS) else str(status)
+        log = "\n".join(f"  {line}" for line in self.log) or "  (the FMU logged nothing)"
+        return DesignerError(
+            f"FMU {self.fmu.instanceName}: {call} returned {label} at t = {t:g} s; its log:\n{log}",
+            "check the FMU's parameters and inputs, or use a smaller step",
+        )
+
+    def completed(self, enter: bool, terminate: bool) -> None:
+        """Act on CompletedIntegratorStep's answer: stop, or an event iteration (also for the kernel).
+
+        Raises:
+            DesignerError: the FMU asked to terminate the simulation.
+        """
+        if terminate:
+            raise self._terminated()
+        if enter:
+            self.fmu.enterEventMode()
+            self._event_iteration()
+
+    def _terminated(self) -> DesignerError:
+        return DesignerError(
+            f"FMU instance {self.fmu.instanceName} asked to terminate the simulation",
+            "check the FMU's inputs and parameters",
+        )
 
     def close(self) -> None:
-        """Terminate and free the instance and remove its unpacked archive."""
+        """Terminate and free the instance and remove its unpacked archive.
+
+        An instance that returned Error may refuse Terminate (FMI 2.0 section 2.1.3); it is freed all
+        the same, and the error that stopped the run is the one that surfaces.
+        """
+        from fmpy.fmi1 import FMICallException
+
         try:
-            self.fmu.terminate()
+            with contextlib.suppress(FMICallException):
+                self.fmu.terminate()
             self.fmu.freeInstance()
         finally:
+            _LOGS.pop(getattr(self, "_token", None), None)
             shutil.rmtree(self._dir, ignore_errors=True)

@@ -101,6 +101,7 @@ def check_fmus(ctx: Context) -> CheckResult:
     from fmpy.validation import validate_fmu
 
     from ..joint import Joint
+    from ..plots.common import save_figure
     from ..plots.timeseries import plot_timeseries
     from .fmu import export_fmu
 
@@ -129,10 +130,9 @@ def check_fmus(ctx: Context) -> CheckResult:
         rows.append(_libcosim_row(Path(tmp) / "joint2body.fmu", t, exact))
     errors = {f"{name} error": curves[name] - exact for name in curves}
     frame = pd.DataFrame({"t": t, "analytic": exact, **curves}).assign(**errors)
-    fig = plot_timeseries(
-        frame,
+    fig = save_figure(
+        plot_timeseries(frame, panels={"x.s (m)": ["analytic", *curves], "error (m)": list(errors)}),
         ctx.figures / "fmu_step_response.png",
-        panels={"x.s (m)": ["analytic", *curves], "error (m)": list(errors)},
     )
     table = pd.DataFrame(rows)
     summary = (

@@ -1,19 +1,22 @@
-"""Predicted against observed under leave-one-out, with each prediction's 95 % interval."""
+"""Predicted against observed under leave-one-out, with each prediction's 95 % interval.
+
+Nested leave-one-out where the surrogate has it (the form and penalty chosen again without each run:
+the honest figure), else the selected form's own leave-one-out, labelled as such.
+"""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pandas as pd
+from matplotlib.figure import Figure
 
-from .common import response_label, save_figure
+from .common import new_figure, response_label, value_formatter
 
 
 def loo_table(surrogate, response: str) -> pd.DataFrame:
     """Per training run: observed, LOO prediction and its 95 % PI, and whether the PI covers the run."""
     model = surrogate.model(response)
-    pred = model.loo_predictions
+    pred = model.nested_predictions or model.loo_predictions
     observed = surrogate.table[response].to_numpy(float)
     return pd.DataFrame(
         {
@@ -25,11 +28,11 @@ def loo_table(surrogate, response: str) -> pd.DataFrame:
     ).assign(covered=lambda d: (d.observed >= d.lo) & (d.observed <= d.hi))
 
 
-def plot_loo(surrogate, responses: list[str], path: str | Path) -> Path:
-    """One panel per response: LOO predictions with PI bars against the measurements, 1:1 line."""
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(1, len(responses), figsize=(5.2 * len(responses), 4.8), squeeze=False)
+def plot_loo(surrogate, *, responses: list[str] | None = None, fig: Figure | None = None) -> Figure:
+    """One panel per response (default: all): LOO predictions with PI bars against the measurements."""
+    responses = surrogate.responses if responses is None else responses
+    fig = new_figure(figsize=(5.2 * len(responses), 4.8), fig=fig)
+    axes = fig.subplots(1, len(responses), squeeze=False)
     for ax, resp in zip(axes[0], responses, strict=True):
         model = surrogate.model(resp)
         d = loo_table(surrogate, resp)
@@ -53,14 +56,18 @@ def plot_loo(surrogate, responses: list[str], path: str | Path) -> Path:
         lim = [min(d.observed.min(), d.lo.min()), max(d.observed.max(), d.hi.max())]
         ax.plot(lim, lim, "k--", lw=0.8, label="predicted = observed")
         ax.set_xlabel(f"observed {response_label(resp)}")
-        ax.set_ylabel(f"leave-one-out prediction {response_label(resp)}")
-        loo = model.loo
+        nested = model.nested_predictions is not None
+        ax.set_ylabel(f"{'nested ' if nested else ''}leave-one-out prediction {response_label(resp)}")
+        loo = model.accuracy
         ax.set_title(
-            f"{resp}: {model.form}, Q2 {loo['q2']:.2f}, RMSE {loo['rmse']:.3g} {model.unit}\n"
+            f"{resp}: {model.form}, {'nested ' if nested else 'selected form, '}Q2 {loo['q2']:.2f}, "
+            f"RMSE {loo['rmse']:.3g} {model.unit}\n"
             f"95 % PI coverage {loo['coverage95']:.0%} of {len(d)} runs",
             fontsize=10,
         )
+        ax.xaxis.set_major_formatter(value_formatter())
+        ax.yaxis.set_major_formatter(value_formatter())
+        ax.tick_params(labelsize=9)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="upper left")
-    fig.tight_layout()
-    return save_figure(fig, path)
+    return fig

@@ -22,6 +22,7 @@ IDENTIFY_TOLERANCE_PCT = 1.0
 def check_identification(ctx: Context) -> CheckResult:
     """The virtual rig's log (1 % force noise, dropouts), identified, gives back k and c within 1 %."""
     from ..plots.checks import plot_identification
+    from ..plots.common import save_figure
     from ..rig.identify import identify
     from ..rig.logs import validate_frame
     from .simulate import simulate
@@ -45,7 +46,9 @@ def check_identification(ctx: Context) -> CheckResult:
             }
         )
     table = pd.DataFrame(rows)
-    fig = plot_identification(table, IDENTIFY_TOLERANCE_PCT, ctx.figures / "identification.png")
+    fig = save_figure(
+        plot_identification(table, tolerance_pct=IDENTIFY_TOLERANCE_PCT), ctx.figures / "identification.png"
+    )
     worst = table[["k error %", "c error %"]].abs().max()
     summary = (
         f"{int(table.within.sum())} of {len(table)} sets within {IDENTIFY_TOLERANCE_PCT:g} % on "
