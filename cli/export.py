@@ -81,6 +81,14 @@ def _print_joint(joint, what: str, path: Path) -> None:
         )
 
 
+Platforms = Annotated[
+    str | None,  # noqa: UP007
+    typer.Option(
+        help="binaries for: all, host, or a comma list of x86_64-linux, aarch64-linux, "
+        "x86_64-windows, x86_64-darwin, aarch64-darwin (default: all when ziglang is installed)"
+    ),
+]
+
 JOINT_HELP = "rig units: --k N/mm (N.mm/rad), --c N.s/mm (N.mm.s/rad), --m kg (kg.m^2)"
 
 
@@ -169,13 +177,7 @@ def register(app: typer.Typer) -> None:
         fmi: Annotated[int, typer.Option("--fmi", help="FMI version, 2 or 3")] = 2,
         interface: Annotated[str, typer.Option(help="force (element) or body")] = "force",
         source_only: Annotated[bool, typer.Option("--source-only", help="no binary: sources/ only")] = False,
-        platforms: Annotated[
-            str | None,
-            typer.Option(
-                help="binaries for: all, host, or a comma list of x86_64-linux, aarch64-linux, "
-                "x86_64-windows, x86_64-darwin, aarch64-darwin (default: all when ziglang is installed)"
-            ),
-        ] = None,  # noqa: UP007
+        platforms: Platforms = None,
         axis: Annotated[
             list[str] | None, typer.Option(help="x y z theta phi psi; repeat for several")
         ] = None,  # noqa: UP007

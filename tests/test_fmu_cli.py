@@ -19,6 +19,8 @@ def run(*args, env=None):
     import os
 
     e = dict(os.environ, **(env or {}))
+    if args[:2] == ("export", "fmu") and "--platforms" not in args:
+        args = (*args, "--platforms", "host")  # the default, all platforms, is tested in test_fmu_platforms
     return subprocess.run(
         [sys.executable, "-I", "-c", "from designer_cli.main import main; main()", *args],
         capture_output=True,

@@ -8,6 +8,8 @@ import ctypes as C
 import math
 import re
 import struct
+import subprocess
+import sys
 import zipfile
 from xml.etree import ElementTree
 
@@ -16,7 +18,7 @@ import pytest
 from fmi_calls import CS, DISCARD, ERROR, ME, OK, Fmu, doubles, unpack, vrs
 
 from designer.export.fmu import export_fmu, value_reference
-from designer.joint import from_coefficients
+from designer.joint import Joint
 
 M, C_SI, K_SI = 0.01, 2.0, 800.0  # kg, N.s/m, N/m
 VR = {f: value_reference("x", f) for f in ("m", "c", "k", "offset", "enabled", "s", "v", "f", "a")}
@@ -33,7 +35,7 @@ def cache(tmp_path_factory):
 @pytest.fixture(scope="module")
 def paths(tmp_path_factory):
     d = tmp_path_factory.mktemp("fmus")
-    joint = from_coefficients({"x": {"k": K_SI / 1e3, "c": C_SI / 1e3, "m": M}})
+    joint = Joint.from_coefficients({"x": {"k": K_SI / 1e3, "c": C_SI / 1e3, "m": M}})
     return {(v, i): export_fmu(joint, d / f"j{v}{i}.fmu", v, i) for v in (2, 3) for i in ("force", "body")}
 
 
@@ -67,6 +69,29 @@ def test_d1_fmi2_log_messages_are_safe_printf_formats(fmu):
         name in (C.create_string_buffer(m.replace("%%", "%").encode()).value.decode()) for _, _, m in f.log
     )
     f.free(c)
+
+
+LIBCOSIM = """
+import sys
+from libcosimpy.CosimExecution import CosimExecution
+from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+from libcosimpy.CosimSlave import CosimLocalSlave
+log_output_level(CosimLogLevel.ERROR)
+ex = CosimExecution.from_step_size(step_size=1_000_000)
+ex.add_local_slave(local_slave=CosimLocalSlave(fmu_path=sys.argv[1], instance_name="joint%s%s%s%s"))
+for _ in range(10):
+    ex.step()
+print("stepped")
+"""
+
+
+def test_d1_libcosim_runs_an_instance_named_with_percent_signs(paths):
+    """Before: libcosim (a printf-style FMI 2 logger) crashed with SIGSEGV inside fmi2Instantiate."""
+    pytest.importorskip("libcosimpy")
+    done = subprocess.run(
+        [sys.executable, "-I", "-c", LIBCOSIM, str(paths[(2, "body")])], capture_output=True, text=True
+    )
+    assert done.returncode == 0 and done.stdout.strip() == "stepped", done.stderr[-2000:]
 
 
 def _me_at(f: Fmu, interface: str, *, s=1.5e-3, v=-0.02, offset=2e-4, load=0.3):

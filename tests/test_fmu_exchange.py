@@ -203,3 +203,20 @@ def test_gauss_seidel_never_reads_a_state_system_between_set_and_step():
     Master(systems, [("a.y", "f.u"), ("f.y", "a.u")]).run(2e-3, 1e-3)
     one = [("a", "get"), ("f", "set"), ("f", "get"), ("a", "set"), ("a", "step"), ("f", "step")]
     assert log == one * 2 + one[:4]
+
+
+def test_cosim_run_states_the_delay_of_a_cs_only_joint_in_its_notes(third_party, tmp_path):
+    """designer.cosim.run on the example arm with one joint the third-party co-simulation-only FMU."""
+    import dataclasses
+
+    from designer import cosim
+    from designer.cosim.scenario import JointSource
+
+    sc = cosim.load(Path(__file__).parents[1] / "examples" / "two_link_arm.toml")
+    # the example joints' law (about 0.33 N.m/rad, 8e-4 N.m.s/rad), in the third party's parameters
+    spring = JointSource(axis="theta", fmu=third_party, parameters={"theta.k": 0.333, "theta.c": 8e-4})
+    joints = dict(sc.joints, j2=spring)
+    sc = dataclasses.replace(sc, joints=joints, duration=0.05)
+    result = cosim.run(sc)
+    assert len(result.notes) == 1 and "j2" in result.notes[0] and "one step" in result.notes[0]
+    assert result.summary()["notes"] == list(result.notes)

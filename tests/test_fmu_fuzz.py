@@ -14,7 +14,7 @@ import pytest
 
 from designer.export import build
 from designer.export.fmu import export_fmu
-from designer.joint import from_coefficients
+from designer.joint import Joint
 
 HARNESS = Path(__file__).parent / "fuzz" / "fmi_fuzz.c"
 CI_CALLS = 300_000  # per seed, two seeds: about 4 s with the sanitizers
@@ -29,7 +29,7 @@ def setup(tmp_path_factory):
     d = tmp_path_factory.mktemp("fuzz")
     mp = pytest.MonkeyPatch()
     mp.setenv("XDG_CACHE_HOME", str(d / "cache"))
-    joint = from_coefficients(
+    joint = Joint.from_coefficients(
         {"x": {"k": 0.8, "c": 2e-3, "m": 0.01}, "theta": {"k": 300, "c": 0.8, "m": 2e-6}}
     )
     args = []

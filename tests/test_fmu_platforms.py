@@ -20,7 +20,7 @@ from fmpy.validation import validate_fmu
 from designer.errors import DesignerError
 from designer.export import build
 from designer.export.fmu import export_fmu
-from designer.joint import from_coefficients
+from designer.joint import Joint
 
 pytestmark = pytest.mark.skipif(not build.zig_available(), reason="ziglang is not installed")
 
@@ -40,7 +40,7 @@ def fmus(tmp_path_factory):
     default_zig = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "zig"
     mp.setenv("ZIG_GLOBAL_CACHE_DIR", os.environ.get("ZIG_GLOBAL_CACHE_DIR", str(default_zig)))
     mp.setenv("XDG_CACHE_HOME", str(d / "cache"))
-    joint = from_coefficients({"theta": {"k": 330, "c": 0.83, "m": 2e-6}})
+    joint = Joint.from_coefficients({"theta": {"k": 330, "c": 0.83, "m": 2e-6}})
     yield {v: export_fmu(joint, d / f"all{v}.fmu", v, "force", platforms="all") for v in (2, 3)}, joint, d
     mp.undo()
 
@@ -87,26 +87,35 @@ def exported(path: Path, fmt: str) -> set[str]:
     return {n[1:] if fmt == "Mach-O" else n for n in names}
 
 
-@pytest.mark.parametrize("version", [2, 3])
-def test_every_platform_binary_has_its_format_and_all_fmi_functions(fmus, version, tmp_path):
-    path = fmus[0][version]
+def _binaries(path: Path) -> dict[str, tuple[str, bytes]]:
+    """{platform folder: (archive name, bytes)} of the FMU's binaries."""
     with zipfile.ZipFile(path) as z:
-        binaries = {n.split("/")[1]: n for n in z.namelist() if n.startswith("binaries/")}
-        assert set(binaries) == FOLDERS[version]
-        tools = shutil.which("llvm-nm") and shutil.which("llvm-objdump")
-        for folder, name in binaries.items():
-            data = z.read(name)
-            fmt, arch = object_format(data)
-            system = folder.split("-")[-1] if "-" in folder else re.sub(r"\d+$", "", folder)
-            expected = {"linux": ("ELF", ".so"), "win": ("PE", ".dll"), "windows": ("PE", ".dll")}
-            assert (fmt, Path(name).suffix) == expected.get(system, ("Mach-O", ".dylib")), name
-            assert arch == ARCH.get(folder, folder.split("-")[0]), name
-            if tools:
-                (tmp_path / folder).write_bytes(data)
-                missing = required_functions(version) - exported(tmp_path / folder, fmt)
-                assert not missing, (name, sorted(missing))
+        return {n.split("/")[1]: (n, z.read(n)) for n in z.namelist() if n.startswith("binaries/")}
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_every_platform_binary_has_its_object_format_and_architecture(fmus, version):
+    binaries = _binaries(fmus[0][version])
+    assert set(binaries) == FOLDERS[version]
+    for folder, (name, data) in binaries.items():
+        fmt, arch = object_format(data)
+        system = folder.split("-")[-1] if "-" in folder else re.sub(r"\d+$", "", folder)
+        expected = {"linux": ("ELF", ".so"), "win": ("PE", ".dll"), "windows": ("PE", ".dll")}
+        assert (fmt, Path(name).suffix) == expected.get(system, ("Mach-O", ".dylib")), name
+        assert arch == ARCH.get(folder, folder.split("-")[0]), name
+    assert validate_fmu(str(fmus[0][version])) == []
+
+
+@pytest.mark.skipif(
+    not (shutil.which("llvm-nm") and shutil.which("llvm-objdump")), reason="no llvm-nm/objdump"
+)
+@pytest.mark.parametrize("version", [2, 3])
+def test_every_platform_binary_exports_every_fmi_function(fmus, version, tmp_path):
     assert len(required_functions(version)) == (44 if version == 2 else 75)
-    assert validate_fmu(str(path)) == []
+    for folder, (name, data) in _binaries(fmus[0][version]).items():
+        (tmp_path / folder).write_bytes(data)
+        missing = required_functions(version) - exported(tmp_path / folder, object_format(data)[0])
+        assert not missing, (name, sorted(missing))
 
 
 def test_windows_dll_imports_only_the_c_runtime_and_kernel32(fmus, tmp_path):
@@ -139,6 +148,14 @@ def test_platform_list_and_refusals(fmus):
         }
     with pytest.raises(DesignerError, match="unknown platform"):
         export_fmu(joint, d / "bad.fmu", 3, "force", platforms="riscv64-linux")
+
+
+def test_cli_default_is_all_platforms_with_ziglang(fmus, tmp_path):
+    cmd = "from designer_cli.main import main; main()"
+    args = ["export", "fmu", "--k", "0.8", "--c", "2e-3", "-o", str(tmp_path / "j.fmu"), "--json"]
+    done = subprocess.run([sys.executable, "-I", "-c", cmd, *args], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["platforms"] == list(build.PLATFORMS)
 
 
 def test_cli_platforms_option(fmus, tmp_path):

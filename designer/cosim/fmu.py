@@ -204,6 +204,11 @@ class FmuSystem:
                 raise self._terminated()
             if not more:
                 break
+        else:
+            raise DesignerError(
+                f"FMU instance {self.fmu.instanceName} kept asking for discrete-state updates (1000 times)",
+                "check the FMU: its event iteration does not settle",
+            )
         self.fmu.enterContinuousTimeMode()
 
     def _bind(self, refs: Mapping[str, int]) -> None:

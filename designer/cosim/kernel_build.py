@@ -11,12 +11,11 @@ from __future__ import annotations
 import hashlib
 import shlex
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 
 from ..errors import DesignerError
-from ..export.build import cache_dir, find_compiler, source_dir
+from ..export.build import cache_dir, compile_c, find_compiler, source_dir
 from ..files import atomic_path
 
 #: -ffp-contract=off and no sin/cos builtins: the arithmetic of the Python master, bit for bit
@@ -103,15 +102,5 @@ def build_kernel() -> Path:
             f"-Wl,-rpath,{lib.parent}",
             "-lm",
         ]
-        try:
-            done = subprocess.run(cmd, capture_output=True, text=True, check=False)
-        except OSError as exc:
-            raise DesignerError(
-                f"could not run the C compiler '{compiler[0]}': {exc}", "check $CC, or use engine='python'"
-            ) from None
-        if done.returncode != 0:
-            raise DesignerError(
-                f"compiling the co-simulation kernel failed:\n{done.stderr.strip()}",
-                "check the compiler with 'cc --version', or use engine='python'",
-            )
+        compile_c(cmd, name=compiler[0], what="the co-simulation kernel", instead="use engine='python'")
     return target

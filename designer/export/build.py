@@ -162,12 +162,12 @@ def find_compiler() -> list[str]:
 
 def _compiler(platform: str) -> tuple[list[str], list[str]]:
     """The compiler command and its extra flags for `platform`: the system one for the host (Zig if
-    there is none), Zig for the others."""
+    there is none and $CC names none), Zig for the others."""
     if platform == host_platform():
         try:
             return find_compiler(), []
         except DesignerError:
-            if not zig_available():
+            if os.environ.get("CC", "").strip() or not zig_available():
                 raise
     extra = [*_ZIG_FLAGS, "-target", PLATFORMS[platform]]
     if platform.endswith("darwin"):
@@ -223,15 +223,22 @@ def build_binary(fmi_version: int, platform: str | None = None) -> Path:
 
 
 def _run(cmd: list[str], name: str) -> None:
-    """Run a compiler command; a failure is a DesignerError with the compiler's message."""
+    compile_c(cmd, name=name, what="the FMU binary", instead="export with source_only=True")
+
+
+def compile_c(cmd: list[str], *, name: str, what: str, instead: str) -> None:
+    """Run a compiler command building `what`; a failure is a DesignerError with the compiler's message.
+
+    `instead` says what the caller can do without a compiler (e.g. "export with source_only=True").
+    """
     try:
         done = subprocess.run(cmd, capture_output=True, text=True, check=False)
     except OSError as exc:
         raise DesignerError(
-            f"could not run the C compiler '{name}': {exc}", "check $CC, or export with source_only=True"
+            f"could not run the C compiler '{name}': {exc}", f"check $CC, or {instead}"
         ) from None
     if done.returncode != 0:
         raise DesignerError(
-            f"compiling the FMU binary failed:\n{done.stderr.strip()}",
-            f"check the compiler with '{name} --version', or export with source_only=True",
+            f"compiling {what} failed:\n{done.stderr.strip()}",
+            f"check the compiler with '{name} --version', or {instead}",
         )

@@ -84,123 +84,146 @@ def _pi_text(ac: AxisCoefficients, quantity: str) -> str:
     return f", 95 % PI {lo:.4g} to {hi:.4g} {units.si_unit(quantity, axis)}"
 
 
+def _var(axis: str, field: str, *args, **kw) -> Variable:
+    """The variable `axis.field` with its fixed value reference."""
+    return Variable(f"{axis}.{field}", value_reference(axis, field), *args, **kw)
+
+
+def _parameter_variables(a: str, ac: AxisCoefficients) -> list[Variable]:
+    """The tunable parameters of axis `a`: m (if known), c, k, offset, enabled."""
+    si = ac.si()
+    rot = units.is_rotational(a)
+    out: list[Variable] = []
+
+    def var(field: str, *args, **kw) -> Variable:
+        return _var(a, field, *args, **kw)
+
+    if si["m"] is not None:
+        out.append(
+            var(
+                "m",
+                "Real",
+                "parameter",
+                "tunable",
+                f"{'inertia' if rot else 'mass'} on {a}; {ac.origin}",
+                si["m"],
+                units.si_unit("m", a),
+            )
+        )
+    out.append(
+        var(
+            "c",
+            "Real",
+            "parameter",
+            "tunable",
+            f"damping on {a}; {ac.origin}" + _pi_text(ac, "c"),
+            si["c"],
+            units.si_unit("c", a),
+        )
+    )
+    out.append(
+        var(
+            "k",
+            "Real",
+            "parameter",
+            "tunable",
+            f"stiffness on {a}; {ac.origin}" + _pi_text(ac, "k"),
+            si["k"],
+            units.si_unit("k", a),
+        )
+    )
+    r = units.si_unit("r", a)
+    out.append(var("offset", "Real", "parameter", "tunable", f"rest position on {a}", 0.0, r))
+    out.append(var("enabled", "Boolean", "parameter", "tunable", f"spring-damper on {a} active", True))
+    return out
+
+
+def _io_variables(a: str, interface: str) -> list[Variable]:
+    """Inputs, outputs and states of axis `a` for the force or the body interface."""
+    r, f = units.si_unit("r", a), units.si_unit("F", a)
+    rot = units.is_rotational(a)
+    what = "torque" if rot else "force"
+    out: list[Variable] = []
+
+    def var(field: str, *args, **kw) -> Variable:
+        return _var(a, field, *args, **kw)
+
+    if interface == "force":
+        out.append(
+            var(
+                "s",
+                "Real",
+                "input",
+                "continuous",
+                f"relative {'angle' if rot else 'displacement'}",
+                0.0,
+                r,
+            )
+        )
+        out.append(var("v", "Real", "input", "continuous", "relative velocity", 0.0, f"{r}/s"))
+        out.append(
+            var(
+                "f",
+                "Real",
+                "output",
+                "continuous",
+                f"{what} of the joint, -(k (s - offset) + c v)",
+                unit=f,
+                depends_on=(f"{a}.s", f"{a}.v"),
+                parameters=(f"{a}.c", f"{a}.k", f"{a}.offset"),
+            )
+        )
+    else:
+        out.append(
+            var(
+                "s",
+                "Real",
+                "output",
+                "continuous",
+                f"{'angle' if rot else 'displacement'} (state)",
+                0.0,
+                r,
+                "exact",
+                depends_on=(f"{a}.s",),
+            )
+        )
+        out.append(
+            var(
+                "v",
+                "Real",
+                "output",
+                "continuous",
+                "velocity (state), der(s)",
+                0.0,
+                f"{r}/s",
+                "exact",
+                derivative_of=f"{a}.s",
+                depends_on=(f"{a}.v",),
+            )
+        )
+        out.append(var("f", "Real", "input", "continuous", f"load {what} on the body", 0.0, f))
+        out.append(
+            var(
+                "a",
+                "Real",
+                "output",
+                "continuous",
+                "acceleration, der(v)",
+                unit=f"{r}/s^2",
+                derivative_of=f"{a}.v",
+                depends_on=(f"{a}.s", f"{a}.v", f"{a}.f"),
+                parameters=(f"{a}.m", f"{a}.c", f"{a}.k", f"{a}.offset"),
+            )
+        )
+    return out
+
+
 def _variables(joint: Joint, interface: str) -> list[Variable]:
+    """Every model variable of the joint: time, then per declared axis its parameters and I/O."""
     out = [Variable("time", 0, "Real", "independent", "continuous", "simulation time", unit="s")]
     for a in units.AXES:
-        if a not in joint.axes:
-            continue
-        ac: AxisCoefficients = joint.axes[a]
-        si = ac.si()
-        r, f = units.si_unit("r", a), units.si_unit("F", a)
-        rot = units.is_rotational(a)
-        what = "torque" if rot else "force"
-
-        def var(field: str, *args, **kw) -> Variable:
-            return Variable(f"{a}.{field}", value_reference(a, field), *args, **kw)  # noqa: B023
-
-        if si["m"] is not None:
-            out.append(
-                var(
-                    "m",
-                    "Real",
-                    "parameter",
-                    "tunable",
-                    f"{'inertia' if rot else 'mass'} on {a}; {ac.origin}",
-                    si["m"],
-                    units.si_unit("m", a),
-                )
-            )
-        out.append(
-            var(
-                "c",
-                "Real",
-                "parameter",
-                "tunable",
-                f"damping on {a}; {ac.origin}" + _pi_text(ac, "c"),
-                si["c"],
-                units.si_unit("c", a),
-            )
-        )
-        out.append(
-            var(
-                "k",
-                "Real",
-                "parameter",
-                "tunable",
-                f"stiffness on {a}; {ac.origin}" + _pi_text(ac, "k"),
-                si["k"],
-                units.si_unit("k", a),
-            )
-        )
-        out.append(var("offset", "Real", "parameter", "tunable", f"rest position on {a}", 0.0, r))
-        out.append(var("enabled", "Boolean", "parameter", "tunable", f"spring-damper on {a} active", True))
-        if interface == "force":
-            out.append(
-                var(
-                    "s",
-                    "Real",
-                    "input",
-                    "continuous",
-                    f"relative {'angle' if rot else 'displacement'}",
-                    0.0,
-                    r,
-                )
-            )
-            out.append(var("v", "Real", "input", "continuous", "relative velocity", 0.0, f"{r}/s"))
-            out.append(
-                var(
-                    "f",
-                    "Real",
-                    "output",
-                    "continuous",
-                    f"{what} of the joint, -(k (s - offset) + c v)",
-                    unit=f,
-                    depends_on=(f"{a}.s", f"{a}.v"),
-                    parameters=(f"{a}.c", f"{a}.k", f"{a}.offset"),
-                )
-            )
-        else:
-            out.append(
-                var(
-                    "s",
-                    "Real",
-                    "output",
-                    "continuous",
-                    f"{'angle' if rot else 'displacement'} (state)",
-                    0.0,
-                    r,
-                    "exact",
-                    depends_on=(f"{a}.s",),
-                )
-            )
-            out.append(
-                var(
-                    "v",
-                    "Real",
-                    "output",
-                    "continuous",
-                    "velocity (state), der(s)",
-                    0.0,
-                    f"{r}/s",
-                    "exact",
-                    derivative_of=f"{a}.s",
-                    depends_on=(f"{a}.v",),
-                )
-            )
-            out.append(var("f", "Real", "input", "continuous", f"load {what} on the body", 0.0, f))
-            out.append(
-                var(
-                    "a",
-                    "Real",
-                    "output",
-                    "continuous",
-                    "acceleration, der(v)",
-                    unit=f"{r}/s^2",
-                    derivative_of=f"{a}.v",
-                    depends_on=(f"{a}.s", f"{a}.v", f"{a}.f"),
-                    parameters=(f"{a}.m", f"{a}.c", f"{a}.k", f"{a}.offset"),
-                )
-            )
+        if a in joint.axes:
+            out += _parameter_variables(a, joint.axes[a]) + _io_variables(a, interface)
     return out
 
 
