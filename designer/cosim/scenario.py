@@ -9,7 +9,6 @@ keys and types and names the file and key of the first problem. The README docum
 from __future__ import annotations
 
 import math
-import os
 import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -33,8 +32,6 @@ FMI_VERSIONS = (2, 3)
 OUTPUTS = ("csv", "parquet", "plot")
 #: the FMU parameters a scenario may override, per axis ("theta.k")
 PARAMETER_FIELDS = ("m", "c", "k", "offset", "enabled")
-#: a run's results may take at most this share of the memory available when it starts
-MEMORY_SHARE = 0.5
 
 
 @dataclass(frozen=True)
@@ -212,34 +209,14 @@ def check_memory(sc: Scenario) -> None:
     Raises:
         DesignerError: with the estimate and what is available.
     """
+    from ..limits import check_memory as check
+
     rows = sc.duration / sc.step + 1
-    need = 8.0 * rows * (sc.signals() + 1)
-    avail = _available_memory()
-    if need > MEMORY_SHARE * avail:
-        raise DesignerError(
-            f"duration = {sc.duration:g} s at step = {sc.step:g} s is {rows:.3g} steps, about "
-            f"{_size(need)} of results; {_size(avail)} of memory is available",
-            "shorten the duration or lengthen the step",
-        )
-
-
-def _available_memory() -> float:
-    try:
-        with open("/proc/meminfo") as fh:
-            for line in fh:
-                if line.startswith("MemAvailable:"):
-                    return float(line.split()[1]) * 1024.0
-    except OSError:
-        pass
-    return float(os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
-
-
-def _size(n: float) -> str:
-    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
-        if n < 1024 or unit == "PiB":
-            return f"{n:.3g} {unit}"
-        n /= 1024
-    return f"{n:.3g} PiB"
+    check(
+        8.0 * rows * (sc.signals() + 1),
+        what=f"duration = {sc.duration:g} s at step = {sc.step:g} s ({rows:.3g} steps)",
+        fix="shorten the duration or lengthen the step",
+    )
 
 
 def _finite(value: Any, what: str) -> float:
