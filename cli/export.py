@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import inspect
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -151,12 +152,15 @@ def _snippet(
             written = result.to_dict() if hasattr(result, "to_dict") else {"path": str(result)}
             print_json({"format": fmt, "joint": joint.to_dict()} | written)
             return
-        _print_joint(joint, title, output)
+        _print_joint(joint, title.format(**options), output)
         for n, a in advice.items():
             console.print(f"  {n}: {a.text()}")
+        for line in getattr(result, "notes", ()):
+            console.print(f"  {line}")
 
     command.__doc__ = (
-        f"Write the joint as {title}, SI units, provenance in a comment.\n\n"
+        f"Write the joint as {title.format(fmi='2|3', interface='force|body')}, SI units, "
+        "provenance inside.\n\n"
         f"The joint comes from --k/--c [--m] ({JOINT_HELP}), the six print settings, or --from.\n\n"
         f"Example: {example}"
     )
@@ -168,89 +172,6 @@ def _snippet(
 
 def register(app: typer.Typer) -> None:
     """Add the `export` command group to the app."""
-
-    @export_app.command("fmu")
-    def fmu(
-        output: Annotated[Path, typer.Option("-o", "--output", help="the .fmu file to write")] = Path(
-            "joint.fmu"
-        ),
-        fmi: Annotated[int, typer.Option("--fmi", help="FMI version, 2 or 3")] = 2,
-        interface: Annotated[str, typer.Option(help="force (element) or body")] = "force",
-        source_only: Annotated[bool, typer.Option("--source-only", help="no binary: sources/ only")] = False,
-        platforms: Platforms = None,
-        axis: Annotated[
-            list[str] | None, typer.Option(help="x y z theta phi psi; repeat for several")
-        ] = None,  # noqa: UP007
-        k: Floats = None,
-        c: Floats = None,
-        m: Floats = None,
-        density: Number = None,
-        length: Number = None,
-        width: Number = None,
-        height: Number = None,
-        layer: Number = None,
-        raster: Number = None,
-        from_: Annotated[
-            Path | None, typer.Option("--from", help="output of designer suggest --json")
-        ] = None,  # noqa: UP007
-        candidate: Annotated[int, typer.Option(help="candidate in --from, 1 = best")] = 1,
-        name: Annotated[str, typer.Option(help="joint (model) name")] = "FlexJoint",
-        allow_extrapolation: Annotated[
-            bool, typer.Option(help="accept a design outside the tested ranges")
-        ] = False,
-        json_out: Annotated[bool, typer.Option("--json", help="print the result as JSON")] = False,
-    ) -> None:
-        """Write the joint as an FMU (Co-Simulation and Model Exchange), SI units, provenance inside.
-
-        The joint comes from --k/--c [--m] (rig units, repeat with --axis for several axes), from the six
-        print settings via the surrogate, or from --from suggestion.json. The body interface needs a mass.
-
-        Example: designer export fmu --k 0.8 --c 2e-3 --m 0.01 --interface body --fmi 3 -o joint.fmu
-        """
-        from designer.export import build
-        from designer.export.fmu import export_fmu
-        from designer.files import check_output
-
-        check_output(output, suffixes=[".fmu"])
-        joint = _joint(
-            axis,
-            k,
-            c,
-            m,
-            density,
-            length,
-            width,
-            height,
-            layer,
-            raster,
-            from_,
-            candidate,
-            name,
-            allow_extrapolation,
-        )
-        platforms = platforms or ("all" if build.zig_available() else "host")
-        with progress("exporting FMU (compiling on first use)") as tick:
-            path = export_fmu(joint, output, fmi, interface, source_only, progress=tick, platforms=platforms)
-        if json_out:
-            print_json(
-                {
-                    "path": str(path),
-                    "fmi_version": fmi,
-                    "interface": interface,
-                    "source_only": source_only,
-                    "platforms": [] if source_only else build.resolve_platforms(platforms),
-                    "joint": joint.to_dict(),
-                }
-            )
-            return
-        _print_joint(joint, f"FMI {fmi} FMU ({interface} interface)", path)
-        if not source_only:
-            console.print("  binaries: " + ", ".join(build.resolve_platforms(platforms)))
-        if source_only:
-            console.print(
-                "  no binary: build it from sources/ with 'python -m fmpy compile " + str(path) + "'"
-            )
-
     _formats(_snippet)
     app.add_typer(export_app, name="export")
 
@@ -328,6 +249,71 @@ def _sdf(joint: Joint, output: Path, _from: Source):
     return export_sdf(joint, output)
 
 
+@dataclass(frozen=True)
+class _FmuWritten:
+    """What `export fmu` wrote: for --json and the lines printed under the joint."""
+
+    path: Path
+    fmi_version: int
+    interface: str
+    source_only: bool
+    platforms: list[str]
+
+    def to_dict(self) -> dict:
+        return {
+            "path": str(self.path),
+            "fmi_version": self.fmi_version,
+            "interface": self.interface,
+            "source_only": self.source_only,
+            "platforms": self.platforms,
+        }
+
+    @property
+    def notes(self) -> list[str]:
+        if self.source_only:
+            return [f"no binary: build it from sources/ with 'python -m fmpy compile {self.path}'"]
+        return ["binaries: " + ", ".join(self.platforms)]
+
+
+def _fmu(
+    joint: Joint,
+    output: Path,
+    _from: Source,
+    *,
+    fmi: int,
+    interface: str,
+    source_only: bool,
+    platforms: str | None,
+) -> _FmuWritten:
+    """The FMU (co-simulation and model exchange), compiled on first use for the chosen platforms."""
+    from designer.export import build
+    from designer.export.fmu import export_fmu
+
+    platforms = platforms or ("all" if build.zig_available() else "host")
+    with progress("exporting FMU (compiling on first use)") as tick:
+        path = export_fmu(
+            joint,
+            output,
+            fmi_version=fmi,
+            interface=interface,
+            source_only=source_only,
+            progress=tick,
+            platforms=platforms,
+        )
+    built = [] if source_only else build.resolve_platforms(platforms)
+    return _FmuWritten(path, fmi, interface, source_only, built)
+
+
+FMU_OPTIONS = (
+    _option("fmi", Annotated[int, typer.Option("--fmi", help="FMI version, 2 or 3")], 2),
+    _option("interface", Annotated[str, typer.Option(help="force (element) or body")], "force"),
+    _option(
+        "source_only", Annotated[bool, typer.Option("--source-only", help="no binary: sources/ only")], False
+    ),
+    _option("platforms", Platforms, None),
+)
+
+
 def _ssp(joint: Joint, output: Path, suggestion: Source, *, interface: str) -> Path:
     """The SSP archive; from a suggestion, every candidate becomes an SSV parameter set."""
     from designer.export.ssp import candidate_sets, export_ssp
@@ -342,6 +328,14 @@ def _formats(snippet: Callable[..., None]) -> None:
     """The robot and Modelica sub-commands of `export`, each with its own options."""
     from designer.export.modelica import export_modelica
 
+    snippet(
+        "fmu",
+        ".fmu",
+        "an FMI {fmi} FMU ({interface} interface; co-simulation and model exchange)",
+        _fmu,
+        "designer export fmu --k 0.8 --c 2e-3 --m 0.01 --interface body --fmi 3 -o joint.fmu",
+        FMU_OPTIONS,
+    )
     snippet(
         "modelica",
         ".mo",
