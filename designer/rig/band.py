@@ -23,12 +23,12 @@ import numpy as np
 PRE_RATE = 100.0
 #: the block-mean stage is used only when its rate is at least this multiple of the band's top
 PRE_MARGIN = 10.0
-#: fractions of the position's excess power below the band's bottom and top edges (the top sets the filter)
-BAND_QUANTILES = (0.02, 0.995)
+#: fraction of the record tapered (half at each end) in the periodogram that finds the band
+TAPER = 0.04
 #: stop edge over pass edge of the low-pass
 STOP_RATIO = 1.5
 #: rate of the filtered grid over the stop edge
-GRID_RATIO = 2.5
+GRID_RATIO = 4.0
 #: rows within this many 1 / (transition width) of an end or of a filled sample are left out
 GUARD_TRANSITIONS = 2.5
 #: samples averaged at each end to take out the straight line that joins the ends before the FFT
@@ -124,14 +124,27 @@ def _ends_line(values: np.ndarray) -> None:
 
 
 def estimate_band(power: np.ndarray, rate: float, n: int, floor: float) -> Band | None:
-    """The band holding 99 % of the position's power above the noise floor; None when there is none."""
+    """The band of the position's power above the noise floor; None when there is none.
+
+    The top is the 99.5 % quantile of that power (it sets the filter, so it errs high). The bottom
+    is where the power density, smoothed over 0.02 Hz, first reaches a tenth of its median over the
+    middle 80 % of the power (the 1 % quantile when that median is zero, as between the lines of a
+    multisine): a chirp's power spreads a little below its start, which a quantile would count.
+    """
+    from scipy.ndimage import uniform_filter1d
+
     excess = np.clip(power[1:] - floor, 0.0, None)
     total = float(excess.sum())
     if not np.isfinite(total) or total <= 0:
         return None
     cumulative = np.cumsum(excess) / total
-    lo, hi = (int(np.searchsorted(cumulative, q)) + 1 for q in BAND_QUANTILES)
-    return Band(low=lo * rate / n, high=max(hi, lo + 1) * rate / n)
+    q_lo, q10, q90, hi = (int(np.searchsorted(cumulative, q)) for q in (0.01, 0.1, 0.9, 0.995))
+    level = float(np.median(excess[q10 : q90 + 1]))
+    lo = q_lo
+    if level > 0:
+        smooth = uniform_filter1d(excess[: q10 + 1], size=max(1, int(0.02 * n / rate)))
+        lo = int(np.argmax(smooth >= 0.1 * level))
+    return Band(low=(lo + 1) * rate / n, high=(max(hi, lo) + 1) * rate / n)
 
 
 def _noise_floor(power: np.ndarray, rate: float, n: int, top: float) -> float:
@@ -140,6 +153,28 @@ def _noise_floor(power: np.ndarray, rate: float, n: int, top: float) -> float:
     hi = int(0.9 * power.size)
     region = power[lo:hi] if hi - lo >= 16 else power[-max(power.size // 4, 1) :]
     return float(np.median(region) / np.log(2.0))
+
+
+def _band_and_noise(r: np.ndarray, rate: float) -> tuple[Band | None, float]:
+    """Excitation band and white-noise variance per sample, from a tapered periodogram.
+
+    The taper (cosine over the first and last 2 % of the record) keeps the ends of the record
+    from leaking power below the band, while leaving most of a chirp's start and end, where its
+    lowest and highest frequencies are, at full weight. The noise floor is the median power well
+    above the band, and the noise variance that floor over the window's sum of squares.
+    """
+    from scipy.fft import next_fast_len, rfft
+    from scipy.signal.windows import tukey
+
+    window = tukey(r.size, TAPER)
+    n = next_fast_len(r.size, real=True)
+    spectrum = rfft((r - r.mean()) * window, n=n)
+    power = spectrum.real**2 + spectrum.imag**2
+    rough = estimate_band(power, rate, n, 0.0)
+    if rough is None:
+        return None, 0.0
+    floor = _noise_floor(power, rate, n, STOP_RATIO * 3.0 * rough.high)
+    return estimate_band(power, rate, n, floor), floor / float(window @ window)
 
 
 def spectra(r: np.ndarray, f: np.ndarray, bad: np.ndarray, rate: float, factor: int) -> Spectra:
@@ -153,14 +188,11 @@ def spectra(r: np.ndarray, f: np.ndarray, bad: np.ndarray, rate: float, factor: 
     scale_f = float(np.max(np.abs(fb))) or 1.0
     rb /= scale_r
     fb /= scale_f
-    _ends_line(rb), _ends_line(fb)
     srate = rate / factor
+    band, noise_var = _band_and_noise(rb, srate)
+    _ends_line(rb), _ends_line(fb)
     n = next_fast_len(rb.size, real=True)
     pos, load = rfft(rb, n=n), rfft(fb, n=n)
-    power = pos.real**2 + pos.imag**2
-    rough = estimate_band(power, srate, n, 0.0)
-    floor = _noise_floor(power, srate, n, STOP_RATIO * 3.0 * rough.high) if rough else 0.0
-    band = estimate_band(power, srate, n, floor) if rough else None
     return Spectra(
         rate=srate,
         n=n,
@@ -170,7 +202,7 @@ def spectra(r: np.ndarray, f: np.ndarray, bad: np.ndarray, rate: float, factor: 
         filled=bad_r,
         scale_r=scale_r,
         scale_f=scale_f,
-        noise_var=floor / rb.size,
+        noise_var=noise_var,
         band=band,
     )
 

@@ -51,6 +51,8 @@ LAG_TRANSITIONS = 1.5
 #: sanity limits
 MIN_RATE_OVER_BAND = 10.0
 MIN_CYCLES = 10.0
+#: fewest usable rows of the filtered grid (about 6 per cycle at the band's top)
+MIN_ROWS = 60
 MIN_VALID = 0.5
 MIN_R2 = 0.5
 PLAUSIBLE_RATE_HZ = (10.0, 1e6)
@@ -178,11 +180,6 @@ def _spectra(log: RigLog, axis: str) -> bandlib.Spectra:
         spec = bandlib.spectra(r, f, log.dropouts[axis], log.rate, 1)
     if spec.band is None or not np.isfinite([spec.scale_r, spec.scale_f]).all():
         raise AxisFailed(f"no motion on {axis}: the position is constant or not finite")
-    if log.rate < MIN_RATE_OVER_BAND * spec.band.high:
-        raise AxisFailed(
-            f"sampling rate {log.rate:.4g} Hz is under {MIN_RATE_OVER_BAND:g} x the highest excitation "
-            f"frequency {spec.band.high:.3g} Hz (or the excitation is aliased)"
-        )
     return spec
 
 
@@ -208,8 +205,12 @@ def _cycles(ch: bandlib.Channels) -> float:
 
 
 def _fit(spec: bandlib.Spectra, pass_edge: float, delay: float):
+    """Filter at `pass_edge` and fit; fail a log with too few cycles or usable rows."""
     ch = bandlib.filtered(spec, pass_edge, delay)
-    if ch.keep.sum() < 20 * 5:
+    cycles = _cycles(ch)
+    if cycles < MIN_CYCLES:
+        raise AxisFailed(f"only {cycles:.3g} cycles of excitation (at least {MIN_CYCLES:g} needed)")
+    if ch.keep.sum() < MIN_ROWS:
         raise AxisFailed(
             f"only {int(ch.keep.sum())} usable rows after leaving out the ends and dropouts; record longer"
         )
@@ -223,9 +224,11 @@ def fit_axis(log: RigLog, axis: str, *, load_delay_s: float = 0.0) -> AxisFit:
     top = spec.band.high
     scale = spec.scale_f / spec.scale_r
     ch, main = _fit(spec, PASS_EDGES[0] * top, load_delay_s)
-    cycles = _cycles(ch)
-    if cycles < MIN_CYCLES:
-        raise AxisFailed(f"only {cycles:.3g} cycles of excitation (at least {MIN_CYCLES:g} needed)")
+    if log.rate < MIN_RATE_OVER_BAND * top:
+        raise AxisFailed(
+            f"sampling rate {log.rate:.4g} Hz is under {MIN_RATE_OVER_BAND:g} x the highest excitation "
+            f"frequency {top:.3g} Hz (or the excitation is aliased)"
+        )
     m_log, c, k = (float(v) * scale for v in main.beta[:3])
     m_se_log, c_se, k_se = (float(v) * scale for v in main.se[:3])
     if not np.isfinite([m_log, c, k, c_se, k_se, main.r2]).all():
