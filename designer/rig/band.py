@@ -103,17 +103,31 @@ def block_means(values: np.ndarray, bad: np.ndarray, factor: int) -> tuple[np.nd
 
 
 def fill(values: np.ndarray, bad: np.ndarray) -> None:
-    """Replace the `bad` entries in place: a cubic spline through the good ones (held flat past the ends)."""
+    """Replace the `bad` entries in place: the cubic through the two good samples either side.
+
+    (Held flat past the ends.) Over a gap of a few samples of a slow signal the cubic's error is
+    of the fourth order in the gap's length; filled rows are left out of the fit anyway.
+    """
     if not bad.any():
         return
-    from scipy.interpolate import CubicSpline
-
     good = np.flatnonzero(~bad)
     rows = np.flatnonzero(bad)
     values[rows] = np.interp(rows, good, values[good])
-    inner = rows[(rows > good[0]) & (rows < good[-1])]
-    if inner.size and good.size >= 4:
-        values[inner] = CubicSpline(good, values[good])(inner)
+    j = np.searchsorted(good, rows)
+    inner = (j >= 2) & (j <= good.size - 2)
+    if not inner.any():
+        return
+    x = rows[inner].astype(np.float64)
+    nodes = good[np.stack([j[inner] + d for d in (-2, -1, 0, 1)])].astype(np.float64)
+    ys = values[nodes.astype(np.int64)]
+    out = np.zeros_like(x)
+    for a in range(4):
+        weight = np.ones_like(x)
+        for b in range(4):
+            if b != a:
+                weight *= (x - nodes[b]) / (nodes[a] - nodes[b])
+        out += weight * ys[a]
+    values[rows[inner]] = out
 
 
 def _ends_line(values: np.ndarray) -> None:
@@ -131,8 +145,6 @@ def estimate_band(power: np.ndarray, rate: float, n: int, floor: float) -> Band 
     middle 80 % of the power (the 1 % quantile when that median is zero, as between the lines of a
     multisine): a chirp's power spreads a little below its start, which a quantile would count.
     """
-    from scipy.ndimage import uniform_filter1d
-
     excess = np.clip(power[1:] - floor, 0.0, None)
     total = float(excess.sum())
     if not np.isfinite(total) or total <= 0:
@@ -142,7 +154,8 @@ def estimate_band(power: np.ndarray, rate: float, n: int, floor: float) -> Band 
     level = float(np.median(excess[q10 : q90 + 1]))
     lo = q_lo
     if level > 0:
-        smooth = uniform_filter1d(excess[: q10 + 1], size=max(1, int(0.02 * n / rate)))
+        width = max(1, int(0.02 * n / rate))
+        smooth = np.convolve(excess[: q10 + 1], np.full(width, 1.0 / width), mode="same")
         lo = int(np.argmax(smooth >= 0.1 * level))
     return Band(low=(lo + 1) * rate / n, high=(max(hi, lo) + 1) * rate / n)
 
@@ -164,9 +177,12 @@ def _band_and_noise(r: np.ndarray, rate: float) -> tuple[Band | None, float]:
     above the band, and the noise variance that floor over the window's sum of squares.
     """
     from scipy.fft import next_fast_len, rfft
-    from scipy.signal.windows import tukey
 
-    window = tukey(r.size, TAPER)
+    window = np.ones(r.size)
+    edge = int(TAPER / 2 * r.size)
+    if edge:
+        window[:edge] = 0.5 * (1 - np.cos(np.pi * np.arange(edge) / edge))
+        window[r.size - edge :] = window[:edge][::-1]
     n = next_fast_len(r.size, real=True)
     spectrum = rfft((r - r.mean()) * window, n=n)
     power = spectrum.real**2 + spectrum.imag**2

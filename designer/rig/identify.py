@@ -204,8 +204,8 @@ def _cycles(ch: bandlib.Channels) -> float:
     return float(np.count_nonzero(s[1:] != s[:-1]) / 2)
 
 
-def _fit(spec: bandlib.Spectra, pass_edge: float, delay: float):
-    """Filter at `pass_edge` and fit; fail a log with too few cycles or usable rows."""
+def _fit(spec: bandlib.Spectra, pass_edge: float, delay: float, *, hac: bool = True):
+    """Filter at `pass_edge` and fit (HAC covariance if `hac`); fail a log with too few cycles or rows."""
     ch = bandlib.filtered(spec, pass_edge, delay)
     cycles = _cycles(ch)
     if cycles < MIN_CYCLES:
@@ -215,7 +215,7 @@ def _fit(spec: bandlib.Spectra, pass_edge: float, delay: float):
             f"only {int(ch.keep.sum())} usable rows after leaving out the ends and dropouts; record longer"
         )
     x, noise = _design(ch)
-    return ch, solve(x, ch.y, ch.keep, noise, _lags(ch))
+    return ch, solve(x, ch.y, ch.keep, noise, _lags(ch) if hac else None)
 
 
 def fit_axis(log: RigLog, axis: str, *, load_delay_s: float = 0.0) -> AxisFit:
@@ -239,7 +239,10 @@ def fit_axis(log: RigLog, axis: str, *, load_delay_s: float = 0.0) -> AxisFit:
             f"c = {c:.4g} {units.rig_unit('c', axis)}, R2 = {main.r2:.3g} "
             f"(needs k > 0, c >= 0, R2 >= {MIN_R2:g})"
         )
-    c_skew = float(_fit(spec, PASS_EDGES[0] * top, load_delay_s + 1.0 / log.rate)[1].beta[1]) * scale - c
+    c_skew = (
+        float(_fit(spec, PASS_EDGES[0] * top, load_delay_s + 1.0 / log.rate, hac=False)[1].beta[1]) * scale
+        - c
+    )
     wide = [(ch, main)] + [_fit(spec, p * top, load_delay_s) for p in PASS_EDGES[1:]]
     m_rows = [
         {

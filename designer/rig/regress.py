@@ -53,14 +53,18 @@ def newey_west(scores: np.ndarray, lags: int, rows: int) -> np.ndarray:
     return out / (1.0 - b + b * b / 3.0)
 
 
-def solve(x: np.ndarray, y: np.ndarray, keep: np.ndarray, noise_cov: np.ndarray, lags: int) -> Solution:
+def solve(
+    x: np.ndarray, y: np.ndarray, keep: np.ndarray, noise_cov: np.ndarray, lags: int | None
+) -> Solution:
     """Bias-compensated least squares of y on the columns of x over the rows `keep`.
 
     x: (rows, p) in time order; noise_cov: (p, p) covariance of the noise in one row of x (zeros
-    for exact columns); lags: Newey-West truncation in rows. Rows outside `keep` count as gaps in
-    time (their contributions are zero), so the lag structure of the kept rows is kept.
-    Raises numpy.linalg.LinAlgError only if the scaled system is singular (the caller checks that
-    the columns are excited first).
+    for exact columns); lags: Newey-West truncation in rows (None: coefficients only, cov NaN).
+    Rows outside `keep` count as gaps in time (their contributions are zero), so the lag
+    structure of the kept rows is kept.
+
+    Raises:
+        numpy.linalg.LinAlgError: the scaled system is singular (a column carries no signal).
     """
     xk, yk = x[keep], y[keep]
     n, p = xk.shape
@@ -71,10 +75,11 @@ def solve(x: np.ndarray, y: np.ndarray, keep: np.ndarray, noise_cov: np.ndarray,
     a_inv = np.linalg.inv(a)
     beta_s = a_inv @ (xs.T @ yk)
     resid = yk - xs @ beta_s
-    scores = np.zeros((x.shape[0], p))
-    scores[keep] = xs * resid[:, None]
-    q = newey_west(scores, lags, n) * n / max(n - p, 1)
-    cov_s = a_inv @ q @ a_inv
+    cov_s = np.full((p, p), np.nan)
+    if lags is not None:
+        scores = np.zeros((x.shape[0], p))
+        scores[keep] = xs * resid[:, None]
+        cov_s = a_inv @ (newey_west(scores, lags, n) * n / max(n - p, 1)) @ a_inv
     full = np.zeros(x.shape[0])
     full[keep] = resid
     return Solution(
@@ -89,7 +94,7 @@ def solve(x: np.ndarray, y: np.ndarray, keep: np.ndarray, noise_cov: np.ndarray,
 
 def equality_p(values: np.ndarray, cov: np.ndarray) -> float:
     """p-value of the Wald test that all `values` are equal, given their covariance."""
-    from scipy.stats import chi2
+    from scipy.special import chdtrc
 
     k = values.size
     if k < 2:
@@ -101,4 +106,4 @@ def equality_p(values: np.ndarray, cov: np.ndarray) -> float:
         stat = float(d @ np.linalg.solve(v, d))
     except np.linalg.LinAlgError:
         return float("nan")
-    return float(chi2.sf(stat, k - 1))
+    return float(chdtrc(k - 1, stat))
