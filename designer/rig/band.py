@@ -66,6 +66,8 @@ class Spectra:
     scale_f: float
     noise_var: float
     band: Band | None
+    #: the straight line taken out of the position before the FFT, at its first and last sample
+    r_line: tuple[float, float] = (0.0, 0.0)
 
     @property
     def freqs(self) -> np.ndarray:
@@ -88,6 +90,8 @@ class Channels:
     pass_edge: float
     #: instantaneous frequency of the filtered motion per row, Hz (from its analytic signal)
     inst_freq: np.ndarray
+    #: the line taken out of the position before filtering, per row: r + r_line is the deflection
+    r_line: np.ndarray
 
 
 def block_means(values: np.ndarray, bad: np.ndarray, factor: int) -> tuple[np.ndarray, np.ndarray]:
@@ -130,11 +134,15 @@ def fill(values: np.ndarray, bad: np.ndarray) -> None:
     values[rows[inner]] = out
 
 
-def _ends_line(values: np.ndarray) -> None:
-    """Subtract, in place, the straight line through the means of the first and last few samples."""
+def _ends_line(values: np.ndarray) -> tuple[float, float]:
+    """Subtract, in place, the straight line through the means of the first and last few samples.
+
+    Returns the line's values at the first and the last sample.
+    """
     k = min(END_SAMPLES, values.size // 2)
-    a, b = values[:k].mean(), values[-k:].mean()
+    a, b = float(values[:k].mean()), float(values[-k:].mean())
     values -= a + (b - a) * np.linspace(0.0, 1.0, values.size)
+    return a, b
 
 
 def estimate_band(power: np.ndarray, rate: float, n: int, floor: float) -> Band | None:
@@ -206,7 +214,8 @@ def spectra(r: np.ndarray, f: np.ndarray, bad: np.ndarray, rate: float, factor: 
     fb /= scale_f
     srate = rate / factor
     band, noise_var = _band_and_noise(rb, srate)
-    _ends_line(rb), _ends_line(fb)
+    r_line = _ends_line(rb)
+    _ends_line(fb)
     n = next_fast_len(rb.size, real=True)
     pos, load = rfft(rb, n=n), rfft(fb, n=n)
     return Spectra(
@@ -220,6 +229,7 @@ def spectra(r: np.ndarray, f: np.ndarray, bad: np.ndarray, rate: float, factor: 
         scale_f=scale_f,
         noise_var=noise_var,
         band=band,
+        r_line=r_line,
     )
 
 
@@ -258,6 +268,7 @@ def filtered(spec: Spectra, pass_edge: float, delay_s: float = 0.0) -> Channels:
     load = spec.load[:bins] * gain * np.exp(1j * w * delay_s)
     cols = irfft(np.stack([-(w**2) * pos, 1j * w * pos, pos, load]), n=nd, axis=1) * (nd / spec.n)
     grid_rate = nd * spec.rate / spec.n
+    a, b = spec.r_line
     # analytic signal z of the filtered motion and its derivative: f = Im(z' conj z) / (2 pi |z|^2)
     one_sided = np.zeros((2, nd), dtype=complex)
     one_sided[:, :bins] = 2 * np.stack([pos, 1j * w * pos])
@@ -283,4 +294,5 @@ def filtered(spec: Spectra, pass_edge: float, delay_s: float = 0.0) -> Channels:
         rate=grid_rate,
         pass_edge=pass_edge,
         inst_freq=np.nan_to_num(inst),
+        r_line=a + (b - a) * np.arange(nd) * (spec.n / nd) / max(spec.samples - 1, 1),
     )

@@ -57,7 +57,8 @@ def _which(values: np.ndarray, edges: np.ndarray) -> np.ndarray:
 def amplitude_table(ch: Channels, lags: int, scale: float, r_scale: float) -> BandTable:
     """k per band of |r - mean r| (secant stiffness), c and m shared; in rig units via `scale`."""
     r = ch.x[:, 2]
-    dev = np.abs(r - r[ch.keep].mean())
+    deflection = r + ch.r_line
+    dev = np.abs(deflection - deflection[ch.keep].mean())
     edges = _edges(dev, ch.keep)
     band = _which(dev, edges)
     split = np.stack([r * (band == b) for b in range(BANDS)], axis=1)
