@@ -87,9 +87,9 @@ def main() -> None:
     from pythonfmu.builder import FmuBuilder
 
     from designer.export.fmu import export_fmu
-    from designer.joint import from_coefficients
+    from designer.joint import Joint
 
-    joint = from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}})
+    joint = Joint.from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}})
     path = work / "joint.fmu"
     cold = timed(lambda: export_fmu(joint, path, 2, "body"))
     warm = timed(lambda: export_fmu(joint, path, 2, "body"), repeat=20)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import json
 import math
+import re
 import sys
 from collections.abc import Callable, Iterator
 from typing import Any
@@ -52,3 +53,23 @@ def progress(description: str, enabled: bool = True) -> Iterator[Callable[[float
     ) as bar:
         task = bar.add_task(description, total=1.0)
         yield lambda fraction: bar.update(task, completed=min(max(fraction, 0.0), 1.0))
+
+
+#: Python arguments named in library messages, and the flags the CLI spells them with: the library
+#: speaks to Python callers, the command line to its users, so the one error path translates
+FLAGS: tuple[tuple[str, str], ...] = (
+    (r"\bsource_only=True\b", "--source-only"),
+    (r"\bfmi_version=", "--fmi "),
+    (r"\binterface=", "--interface "),
+    (r"\ballow_extrapolation=True\b", "--allow-extrapolation"),
+    (r"\btop=", "--top "),
+    (r"\bk= and/or c=", "--k and/or --c"),
+    (r"\btargets=\{'k': 0\.8\}", "--target k=0.8"),
+)
+
+
+def flag_message(text: str) -> str:
+    """A library message with its Python argument names replaced by the CLI's flags."""
+    for pattern, flag in FLAGS:
+        text = re.sub(pattern, flag, text)
+    return text

@@ -12,7 +12,7 @@ from .common import console, print_json, progress
 
 def cosim(
     scenario: Annotated[Path, typer.Argument(help="scenario file (TOML); see the README for its format")],
-    out: Annotated[Path, typer.Option("-o", "--out", help="folder for the results")] = Path("results"),
+    out: Annotated[Path, typer.Option("-o", "--output", help="folder for the results")] = Path("results"),
     validate: Annotated[
         bool, typer.Option("--validate", help="compare with the reference at four steps")
     ] = False,
@@ -22,11 +22,15 @@ def cosim(
 
     Example: designer cosim examples/two_link_arm.toml -o results/ --validate
     """
-    from designer.cosim import load, simulate
+    from designer.cosim import load, run, write_outputs
+    from designer.files import check_output_folder
 
     sc = load(scenario)
+    check_output_folder(out)
     with progress(f"co-simulating {scenario.name}", enabled=not json_out) as bar:
-        summary = simulate(sc, out, with_validation=validate, progress=bar)
+        result = run(sc, validate=validate, progress=bar)
+    files = write_outputs(result, out)
+    summary = result.summary() | {"files": [str(f) for f in files]}
     if json_out:
         print_json(summary)
         return

@@ -22,7 +22,7 @@ JsonOpt = Annotated[bool, typer.Option("--json", help="Print machine-readable JS
 def _load(path: Path | None):
     from designer.surrogate import Surrogate
 
-    return Surrogate.load_default() if path is None else Surrogate.load(path)
+    return Surrogate.load() if path is None else Surrogate.load(path)
 
 
 def _parse_fix(items: list[str]) -> dict[str, float]:
@@ -42,8 +42,9 @@ def _parse_fix(items: list[str]) -> dict[str, float]:
     return fixed
 
 
-def _pi(value: float, pi: list[float]) -> str:
-    return f"{value:.4g} [{pi[0]:.3g}, {pi[1]:.3g}]"
+def _pi(p: dict) -> str:
+    """A prediction's to_dict() as 'value [low, high]'."""
+    return f"{p['value']:.4g} [{p['low']:.3g}, {p['high']:.3g}]"
 
 
 def fit(
@@ -127,18 +128,17 @@ def predict(
     from designer import space, units
     from designer.suggest import predictability
 
-    params = space.validate(
+    params = space.check_design(
         dict(density=density, length=length, width=width, height=height, layer=layer, raster=raster),
         allow_extrapolation,
     )
     sur = _load(surrogate)
     units.check_axis(axis)
-    preds = sur.predict(params, [f"k_{axis}", f"c_{axis}"])
+    preds = sur.predict(params, responses=[f"k_{axis}", f"c_{axis}"], allow_extrapolation=allow_extrapolation)
     info = predictability(sur, axis)
     predicted = {
-        q: {
-            "value": float(preds[f"{q}_{axis}"].value[0]),
-            "pi95": [float(preds[f"{q}_{axis}"].lo[0]), float(preds[f"{q}_{axis}"].hi[0])],
+        q: preds[f"{q}_{axis}"].at(0).to_dict()
+        | {
             "unit": units.rig_unit(q, axis),
             "loo_q2": info[q]["q2"],
             "predictable": info[q]["predictable"],
@@ -153,10 +153,7 @@ def predict(
         return
     for q in ("k", "c"):
         p = predicted[q]
-        console.print(
-            f"{q}_{axis} = {_pi(p['value'], p['pi95'])} {p['unit']}  "
-            f"(value [95 % PI]; LOO Q2 = {p['loo_q2']:.2f})"
-        )
+        console.print(f"{q}_{axis} = {_pi(p)} {p['unit']}  (value [95 % PI]; LOO Q2 = {p['loo_q2']:.2f})")
         if not p["predictable"]:
             console.print(f"  [yellow]{info[q]['statement']}[/yellow]")
     for note in notes:
@@ -251,7 +248,7 @@ def _print_suggestion(data: dict) -> None:
             f"{p['height']:g}",
             f"{p['layer']:g}",
             f"{p['raster']:g}",
-            *[_pi(pr[q]["value"], pr[q]["pi95"]) for q in shown],
+            *[_pi(pr[q]) for q in shown],
             f"{cand['desirability']:.3f}",
         )
     console.print(tab)

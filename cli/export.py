@@ -23,7 +23,7 @@ def _joint(
     axis, k, c, m, density, length, width, height, layer, raster, from_, candidate, name, allow_extrapolation
 ):
     """The joint from exactly one source: --k/--c numbers, a design (six factors) or --from."""
-    from designer.export import sources
+    from designer.joint import from_one_source
 
     design = {
         "density": density,
@@ -33,23 +33,34 @@ def _joint(
         "layer": layer,
         "raster": raster,
     }
-    given = [n for n, v in design.items() if v is not None]
-    chosen = [
-        s
-        for s, on in (("--k/--c", bool(k or c)), ("a design", bool(given)), ("--from", from_ is not None))
-        if on
-    ]
-    if len(chosen) != 1:
+    design = {n: v for n, v in design.items() if v is not None}
+    coefficients = None
+    if k or c or m:
+        axes = axis or ["x"]
+        if len(k or []) != len(axes) or len(c or []) != len(axes) or len(m or []) not in (0, len(axes)):
+            raise DesignerError(
+                f"{len(axes)} axis/axes but {len(k or [])} --k, {len(c or [])} --c and {len(m or [])} --m",
+                "give one --k and one --c per --axis (and one --m per axis, or none), in the same order",
+            )
+        if len(set(axes)) != len(axes):
+            raise DesignerError(f"an axis is given twice in --axis {' '.join(axes)}", "give each --axis once")
+        coefficients = {a: {"k": k[i], "c": c[i]} | ({"m": m[i]} if m else {}) for i, a in enumerate(axes)}
+    sources = [n for n, v in (("--k/--c", coefficients), ("a design", design), ("--from", from_)) if v]
+    if len(sources) != 1:
         raise DesignerError(
-            "give the joint one way: " + ("none given" if not chosen else f"got {' and '.join(chosen)}"),
+            "give the joint one way: " + ("none given" if not sources else f"got {' and '.join(sources)}"),
             "use --k and --c (rig units, N/mm and N.s/mm), or the six print settings --density ... --raster, "
             "or --from suggestion.json",
         )
-    if from_ is not None:
-        return sources.from_suggestion(from_, candidate, axis or None, name)
-    if given:
-        return sources.from_design(design, axis or ["x"], name, allow_extrapolation)
-    return sources.from_numbers(axis or ["x"], k or [], c or [], m or [], name)
+    return from_one_source(
+        coefficients=coefficients,
+        design=design or None,
+        suggestion=from_,
+        candidate=candidate,
+        axes=None if coefficients else axis or (None if from_ else ["x"]),
+        name=name,
+        allow_extrapolation=allow_extrapolation,
+    )
 
 
 def _print_joint(joint, what: str, path: Path) -> None:

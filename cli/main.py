@@ -9,6 +9,7 @@ import typer
 from designer.errors import DesignerError
 
 from . import cosim, design, export, plots, rig
+from .common import flag_message
 
 app = typer.Typer(
     help="Design 3D-printed TPU flexible joints: predict and choose stiffness and damping, export FMUs.",
@@ -29,7 +30,7 @@ def main() -> None:
     try:
         app()
     except DesignerError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"error: {flag_message(str(exc))}", file=sys.stderr)
         sys.exit(2)
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)

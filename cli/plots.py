@@ -54,7 +54,7 @@ def effects_cmd(
     common.check_image_path(output)
     t = load_table(table)
     responses = common.responses_for(t, _quantities(response), axis)
-    path = effects.plot_effects(t, responses, output)
+    path = common.save_figure(effects.plot_effects(t, responses=responses), output)
     if as_json:
         print_json({"figure": str(path), "medians": effects.main_effects(t, responses).to_dict("records")})
     else:
@@ -82,7 +82,7 @@ def heatmap_cmd(
     common.check_image_path(output)
     t = load_table(table)
     responses = common.responses_for(t, None, axis)
-    path = heatmap.plot_heatmap(t, responses, output)
+    path = common.save_figure(heatmap.plot_heatmap(t, responses=responses), output)
     if as_json:
         print_json({"figure": str(path), "correlations": correlation(t, responses).to_dict()})
     else:
@@ -98,23 +98,27 @@ Surrogate = Annotated[
 def _surrogate(path: Path | None):
     from designer.surrogate import Surrogate as _S
 
-    return _S.load_default() if path is None else _S.load(path)
+    return _S.load() if path is None else _S.load(path)
 
 
-def _fixed(pairs: list[str]) -> dict[str, float]:
-    """['density=60', 'raster=45'] -> {'density': 60.0, 'raster': 45.0}."""
+def _fixed(pairs: list[str], flag: str = "--fix", example: str = "density=60") -> dict[str, float]:
+    """['density=60', 'raster=45'] -> {'density': 60.0, 'raster': 45.0}; a name given twice is an error."""
     from designer.errors import DesignerError
 
     out = {}
     for pair in pairs:
         name, sep, value = pair.partition("=")
         if not sep:
-            raise DesignerError(f"--fix '{pair}' is not NAME=VALUE", "write it as --fix density=60")
+            raise DesignerError(f"{flag} '{pair}' is not NAME=VALUE", f"write it as {flag} {example}")
+        if name.strip() in out:
+            raise DesignerError(
+                f"{flag} gives {name.strip()} twice", f"give each name once, e.g. {flag} {example}"
+            )
         try:
             out[name.strip()] = float(value)
         except ValueError:
             raise DesignerError(
-                f"--fix {pair}: '{value}' is not a number", "write it as --fix density=60"
+                f"{flag} {pair}: '{value}' is not a number", f"write it as {flag} {example}"
             ) from None
     return out
 
@@ -144,23 +148,31 @@ def space_cmd(
     Example: designer plot space --x width --y height --response k --target 0.8 -o space.png --html space.html
     """
     from designer.errors import DesignerError
-    from designer.plots import common, space
+    from designer.plots import common, html3d, space
 
     common.check_image_path(output)
+    if html is not None and html.suffix.lower() not in (".html", ".htm"):
+        raise DesignerError(f"cannot write an HTML scene to '{html.name}'", "end --html in .html")
     sur = _surrogate(surrogate)
     resp = f"{response}_{axis}"
+    fixed = _fixed(fix or [])
     with progress_bar("rendering") as bar:
         if volume:
             if z is None:
                 raise DesignerError("--volume needs a third factor", "add --z, e.g. --z density")
-            view = space.plot_volume(sur, resp, [x, y, z], output, _fixed(fix or []), target, html)
+            view = space.volume_view(sur, resp, factors=[x, y, z], fixed=fixed, target=target)
         else:
             if z is not None:
                 raise DesignerError("--z draws only with --volume", "add --volume or drop --z")
-            view = space.plot_surface(sur, resp, x, y, output, _fixed(fix or []), target, html)
+            view = space.surface_view(sur, resp, x=x, y=y, fixed=fixed, target=target)
+        plotter = space.render(view)
+        files = [space.save_screenshot(plotter, output)]
+        plotter.close()
+        if html is not None:
+            files.append(html3d.write_scene(view.scene, html))
         bar(1.0)
     if as_json:
-        print_json(view.to_dict())
+        print_json(view.to_dict() | {"files": [str(f) for f in files]})
         return
     held = ", ".join(f"{k} {v:g}" for k, v in view.held.items())
     console.print(
@@ -170,7 +182,7 @@ def space_cmd(
         console.print(
             f"target {target:g} {view.unit} lies inside the 95 % PI over {view.target_in_pi:.0%} of the plot"
         )
-    for f in view.files:
+    for f in files:
         _saved(f)
 
 
@@ -195,7 +207,7 @@ def loo_cmd(
         raise DesignerError(
             f"the surrogate has no response on axis {axis}", f"it has {', '.join(sur.responses)}"
         )
-    path = loo.plot_loo(sur, responses, output)
+    path = common.save_figure(loo.plot_loo(sur, responses=responses), output)
     metrics = {r: dict(sur.model(r).loo, form=sur.model(r).form) for r in responses}
     if as_json:
         print_json({"figure": str(path), "loo": metrics})
@@ -230,7 +242,7 @@ def timeseries_cmd(
     frame = _read_series(series)
     ref = None if reference is None else _read_series(reference)
     cols = None if columns is None else [c.strip() for c in columns.split(",") if c.strip()]
-    _saved(timeseries.plot_timeseries(frame, output, cols, reference=ref))
+    _saved(common.save_figure(timeseries.plot_timeseries(frame, columns=cols, reference=ref), output))
 
 
 def _read_series(path: Path):
@@ -241,7 +253,9 @@ def _read_series(path: Path):
     if not path.is_file():
         raise DesignerError(f"no such file: {path}", "give a CSV or Parquet time series")
     try:
-        return pd.read_parquet(path) if path.suffix.lower() in (".parquet", ".pq") else pd.read_csv(path)
+        from designer.data import read_frame
+
+        return read_frame(path)
     except (ValueError, OSError, pd.errors.ParserError, UnicodeDecodeError) as exc:
         raise DesignerError(
             f"cannot read {path}: {str(exc).splitlines()[0]}", "give a CSV or Parquet file"
@@ -262,7 +276,7 @@ def validate_cmd(
     from designer.report import validate
 
     with progress_bar("validating") as bar:
-        results, page, md, seconds = validate(output, table, progress=bar)
+        results, page, md, seconds = validate(output, table=table, progress=bar)
     failed = [r for r in results if not r.passed]
     if as_json:
         print_json(
@@ -285,7 +299,73 @@ def validate_cmd(
         raise typer.Exit(1)
 
 
+def profile_cmd(
+    output: Annotated[Path, typer.Option("-o", "--output", help="page to write (.html)")] = Path(
+        "profiler.html"
+    ),
+    surrogate: Surrogate = None,
+    axis: Axis = "x",
+    target: Annotated[
+        list[str] | None,
+        typer.Option("--target", help="target in rig units, QUANTITY=VALUE (repeat): k=0.8, c=2e-3"),
+    ] = None,
+    tolerance: Annotated[
+        float, typer.Option("--tolerance", help="a joint meets its target within this many %")
+    ] = 10.0,
+    suggestion: Annotated[
+        Path | None,
+        typer.Option("--suggestion", help="output of designer suggest --json: candidates to click"),
+    ] = None,
+    design: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--design", help="open at NAME=VALUE (repeat); default 60 %, 24, 4.5, 9, 0.16 mm, 0 deg"
+        ),
+    ] = None,
+    as_json: Json = False,
+) -> None:
+    """An interactive prediction profiler: one self-contained HTML page (no server, no network).
+
+    Sliders per factor, per response the prediction and its 95 % PI against each factor, targets with
+    the probability of meeting them, suggestions to click.
+
+    Example: designer profile --target k=0.8 -o profiler.html
+    """
+    from designer import space
+    from designer.errors import DesignerError
+    from designer.plots import profile
+
+    if not 0 < tolerance < 100:
+        raise DesignerError(
+            f"--tolerance {tolerance:g} is not a percentage in (0, 100)", "give e.g. --tolerance 10"
+        )
+    sur = _surrogate(surrogate)
+    targets = _fixed(target or [], "--target", "k=0.8")
+    start = _fixed(design or [], "--design", "width=3.5")
+    page = profile.build_profiler(
+        sur, axis=axis, targets=targets, tolerance=tolerance / 100, suggestion=suggestion, design=start
+    )
+    path = profile.write_profiler(page, output)
+    opened = page.data["design"]
+    if as_json:
+        preds = sur.predict(opened, responses=[r["name"] for r in page.data["responses"]])
+        print_json(
+            {
+                "page": str(path),
+                "design": opened,
+                "predicted": {r: p.at(0).to_dict() for r, p in preds.items()},
+                "accuracy": {r["name"]: r["accuracy"] for r in page.data["responses"]},
+                "suggestions": len(page.data["suggestions"]),
+            }
+        )
+        return
+    _saved(path)
+    at = ", ".join(f"{k} {v:g} {space.factor(k).unit}" for k, v in opened.items())
+    console.print(f"open it in a browser; it starts at {at}")
+
+
 def register(app: typer.Typer) -> None:
-    """Add `designer plot` to the main app."""
+    """Add `designer plot` and `designer profile` to the main app."""
     app.add_typer(plot_app, name="plot")
     app.command("validate")(validate_cmd)
+    app.command("profile")(profile_cmd)

@@ -113,10 +113,10 @@ def _print_identification(res) -> None:
 
 
 def _write_csv(df, path: Path) -> None:
-    from designer.files import atomic_write
+    """A table written atomically, Parquet for .parquet/.pq, else CSV."""
+    from designer.data import write_frame
 
-    with atomic_write(path, newline="") as fh:
-        df.to_csv(fh, index=False)
+    write_frame(df, path)
 
 
 @rig_app.command("simulate")
@@ -187,13 +187,14 @@ def clean(
 
     Example: designer clean table.csv -o clean.csv
     """
-    import pandas as pd
 
     from designer.rig.clean import clean as run
 
     if not table.exists():
         raise DesignerError(f"no such table: {table}", "give the path of a CSV or Parquet table")
-    raw = pd.read_parquet(table) if table.suffix.lower() in (".parquet", ".pq") else pd.read_csv(table)
+    from designer.data import read_frame
+
+    raw = read_frame(table)
     res = run(raw, eps=eps, min_samples=min_samples, source=table.name)
     if output is not None:
         _write_csv(res.table, output)
@@ -248,19 +249,13 @@ def doe(
 
 
 def _augment(plans, n: int, k: float | None, c: float | None, axis: str, data: Path | None):
-    from designer.data import load_table
     from designer.surrogate import Surrogate
 
-    sur = Surrogate().fit(load_table(data)) if data is not None else Surrogate.load_default()
-    target = {r: v for r, v in ((f"k_{axis}", k), (f"c_{axis}", c)) if v is not None}
-    unknown = [r for r in target if r not in sur.responses]
-    if unknown:
-        raise DesignerError(f"the surrogate has no {unknown[0]}", f"it predicts {', '.join(sur.responses)}")
-    near = None
-    if target:
-        near = plans.near_target(lambda X: {r: p.value for r, p in sur.predict(X).items()}, target)
+    if n < 1:
+        raise DesignerError(f"--augment {n}", "give the number of specimens to add, 1 or more")
+    sur = Surrogate().fit(data) if data is not None else Surrogate.load()
     with progress("choosing specimens") as bar:
-        return plans.augment(n, sur.models, sur.table, target=near, progress=bar)
+        return plans.plan_next(sur, n=n, targets={"k": k, "c": c}, axis=axis, progress=bar)
 
 
 def _finish_plan(plan, output: Path | None, json_out: bool, narrowing: dict) -> None:

@@ -1,7 +1,65 @@
 """flexjoint designer: from print settings of TPU flexible joints to stiffness, damping and FMUs.
 
-The library computes and returns plain data; the `designer` command (package `designer_cli`) is a
-thin layer that parses, calls and prints.
+The public API (computing returns data; writing and plotting are separate calls)::
+
+    import designer
+    table = designer.load_table()                      # the bundled study table (rig units)
+    sur = designer.Surrogate().fit(table)              # or designer.Surrogate.load()
+    pred = sur.predict(design)["k_x"]                  # designer.Prediction: value, low, high
+    sug = designer.suggest(sur, k=0.8, c=2e-3)         # designer.Suggestion, ranked candidates
+    joint = designer.Joint.from_suggestion(sug)        # or Joint.from_design / from_coefficients
+    designer.export_fmu(joint, "joint.fmu")            # export_modelica, export_mjcf, export_urdf
+    fits = designer.identify(["run1.csv"])             # rig logs -> coefficients
+    result = designer.cosim.run(designer.cosim.load("arm.toml"))  # in memory; result.to_frame()
+
+Every bad input raises `designer.DesignerError` naming the argument and the fix. The `designer`
+command (package `designer_cli`) is a thin layer that parses, calls and prints. Names are imported
+on first use, so `import designer` stays cheap.
 """
 
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+from .errors import DesignerError
+
 __version__ = "0.1.0"
+
+#: public name -> module that defines it (imported on first access)
+_PUBLIC = {
+    "load_table": "data",
+    "Surrogate": "surrogate",
+    "Prediction": "surrogate",
+    "suggest": "suggest",
+    "Suggestion": "suggest",
+    "Joint": "joint",
+    "export_fmu": "export",
+    "export_modelica": "export",
+    "export_mjcf": "export",
+    "export_urdf": "export",
+    "identify": "rig.identify",
+}
+#: public names that are subpackages
+_SUBPACKAGES = ("cosim",)
+
+__all__ = ["DesignerError", "__version__", *_PUBLIC, *_SUBPACKAGES]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _SUBPACKAGES:
+        return importlib.import_module(f".{name}", __name__)
+    module = _PUBLIC.get(name)
+    if module is None:
+        raise AttributeError(f"module 'designer' has no attribute {name!r}")
+    mod = importlib.import_module(f".{module}", __name__)
+    # importing a submodule binds its name on the package (designer.suggest, the module, would
+    # hide designer.suggest, the function): bind every public name it defines again
+    for public, home in _PUBLIC.items():
+        if home == module:
+            globals()[public] = getattr(mod, public)
+    return globals()[name]
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)

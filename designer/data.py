@@ -142,18 +142,55 @@ def normalise(raw: pd.DataFrame, source: str = "table") -> pd.DataFrame:
     return out.reset_index(drop=True)
 
 
-def load_table(path: str | Path | None = None) -> pd.DataFrame:
-    """Load a coefficient table (CSV or Parquet); without a path, the bundled study table."""
-    p = bundled_path() if path is None else Path(path)
+def load_table(source: str | Path | pd.DataFrame | None = None) -> pd.DataFrame:
+    """A validated coefficient table: the six factors, then c_<axis>, k_<axis> (rig units).
+
+    Args:
+        source: a CSV or Parquet path (by suffix), a DataFrame, or None for the bundled study table
+            (44 runs, x axis). Column names may carry units (`k_x [N/mm]`, `length_mm`).
+
+    Returns:
+        A new DataFrame, factor columns first, floats, index 0..n-1.
+
+    Raises:
+        DesignerError: naming the first problem with its column and row (missing factor, no
+            coefficient column, a value that is not a finite number, k <= 0, c < 0, an untested level).
+    """
+    if isinstance(source, pd.DataFrame):
+        return normalise(source, source="table")
+    p = bundled_path() if source is None else Path(source)
     if not p.exists():
         raise DesignerError(f"no such table: {p}", "give the path of a CSV or Parquet file")
     try:
-        raw = pd.read_parquet(p) if p.suffix.lower() in (".parquet", ".pq") else pd.read_csv(p)
+        raw = read_frame(p)
     except (ValueError, OSError, pd.errors.ParserError, UnicodeDecodeError) as exc:
         raise DesignerError(
             f"cannot read {p}: {str(exc).splitlines()[0]}", "give a CSV or Parquet coefficient table"
         ) from None
     return normalise(raw, source=p.name)
+
+
+def is_parquet(path: str | Path) -> bool:
+    """Whether a table path names Parquet (suffix .parquet or .pq); anything else is CSV."""
+    return Path(path).suffix.lower() in (".parquet", ".pq")
+
+
+def read_frame(path: str | Path) -> pd.DataFrame:
+    """A CSV or Parquet file (by suffix) as a DataFrame, unvalidated."""
+    return pd.read_parquet(path) if is_parquet(path) else pd.read_csv(path)
+
+
+def write_frame(frame: pd.DataFrame, path: str | Path) -> Path:
+    """Write a table atomically as CSV or Parquet (by suffix)."""
+    from .files import atomic_path, atomic_write
+
+    if is_parquet(path):
+        with atomic_path(path) as tmp:
+            frame.to_parquet(tmp, index=False)
+    else:
+        with atomic_write(path) as fh:
+            frame.to_csv(fh, index=False)
+    return Path(path)
 
 
 def table_hash(table: pd.DataFrame) -> str:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable, Mapping
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -167,7 +168,7 @@ def augment(
     (in the fit's space: log for power laws) before and after, at the targets or over the grid.
     """
     if n < 1:
-        raise DesignerError(f"--augment {n}", "give the number of specimens to add, 1 or more")
+        raise DesignerError(f"n={n} specimens to add", "give the number of specimens to add, 1 or more")
     cand = printable_grid() if candidates is None else candidates.reset_index(drop=True)
     factors = list(space.FACTOR_NAMES)
     states = [
@@ -186,3 +187,32 @@ def augment(
     chosen = cand.iloc[picks].reset_index(drop=True)
     chosen.insert(0, "specimen", [f"N{i + 1:03d}" for i in range(len(chosen))])
     return chosen, {resp: s.narrowing() for resp, s in zip(models, states, strict=True)}
+
+
+def plan_next(
+    surrogate: Any,
+    *,
+    n: int,
+    targets: Mapping[str, float | None] | None = None,
+    axis: str = "x",
+    progress: Callable[[float], None] | None = None,
+) -> tuple[pd.DataFrame, dict[str, dict[str, float]]]:
+    """The `n` printable specimens that most narrow `surrogate`'s 95 % PIs (see `augment`).
+
+    With `targets` ({"k": .., "c": ..} in rig units on `axis`; None values ignored) the picks narrow
+    the PIs of the designs predicted nearest the targets (I-optimal), else the model overall
+    (D-optimal).
+
+    Raises:
+        DesignerError: `n` below 1, or a target on a response the surrogate does not predict.
+    """
+    wanted = {f"{q}_{axis}": v for q, v in (targets or {}).items() if v is not None}
+    unknown = [r for r in wanted if r not in surrogate.responses]
+    if unknown:
+        raise DesignerError(
+            f"the surrogate has no {unknown[0]}", f"it predicts {', '.join(surrogate.responses)}"
+        )
+    near = None
+    if wanted:
+        near = near_target(lambda X: {r: p.value for r, p in surrogate.predict(X).items()}, wanted)
+    return augment(n, surrogate.models, surrogate.table, target=near, progress=progress)

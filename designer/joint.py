@@ -7,13 +7,18 @@ built from coefficients typed by hand, from a design through the surrogate, or f
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
-from . import units
+from . import space, units
 from .errors import DesignerError
 from .mass import specimen_mass
+
+if TYPE_CHECKING:
+    from .suggest import Suggestion
+    from .surrogate import Prediction, Surrogate
 
 #: Howell's pseudo-rigid-body characteristic radius factor for a fixed-guided/cantilever beam
 PRB_GAMMA = 0.85
@@ -27,8 +32,8 @@ class AxisCoefficients:
     k: float
     c: float
     m: float | None = None
-    k_pi95: tuple[float, float] | None = None
-    c_pi95: tuple[float, float] | None = None
+    #: "k" and "c" as predicted by the surrogate (value and 95 % PI), when they come from it
+    predicted: Mapping[str, Prediction] = field(default_factory=dict)
     #: where these numbers come from, e.g. "measured", "surrogate", "derived (PRB model)"
     origin: str = "entered by hand"
 
@@ -63,12 +68,140 @@ class Joint:
 
     def __post_init__(self) -> None:
         if not self.axes:
-            raise DesignerError("a joint needs at least one axis", "give --k and --c for an axis")
+            raise DesignerError("a joint needs at least one axis", "give axes={'x': JointAxis(...)}")
         if not self.name.isidentifier():
             raise DesignerError(
                 f"joint name '{self.name}' is not an identifier",
                 "use letters, digits and underscores, starting with a letter",
             )
+
+    @classmethod
+    def from_coefficients(
+        cls, coefficients: Mapping[str, Mapping[str, float | None]], *, name: str = "FlexJoint"
+    ) -> Joint:
+        """A joint from numbers in rig units: {axis: {"k": .., "c": .., "m": ..}} (m optional).
+
+        k in N/mm (N.mm/rad), c in N.s/mm (N.mm.s/rad), m in kg (kg.m^2) per DESIGN.md.
+
+        Raises:
+            DesignerError: an unknown axis, a missing k or c, or a value that is not finite and positive.
+        """
+        axes = {}
+        for a, v in coefficients.items():
+            if not isinstance(v, Mapping) or not {"k", "c"} <= set(v):
+                raise DesignerError(
+                    f"coefficients[{a!r}] = {v!r} needs k and c",
+                    "give coefficients={'x': {'k': 0.8, 'c': 2e-3}} in rig units",
+                )
+            unknown = set(v) - {"k", "c", "m"}
+            if unknown:
+                raise DesignerError(
+                    f"coefficients[{a!r}] has unknown key(s) {', '.join(sorted(unknown))}", "use k, c and m"
+                )
+            m = v.get("m")
+            axes[a] = AxisCoefficients(
+                axis=a,
+                k=_number(v["k"], f"{a}.k"),
+                c=_number(v["c"], f"{a}.c"),
+                m=None if m is None else _number(m, f"{a}.m"),
+            )
+        return cls(name=name, axes=axes, provenance={"source": "entered by hand"})
+
+    @classmethod
+    def from_design(
+        cls,
+        params: Mapping[str, float],
+        *,
+        surrogate: Surrogate | None = None,
+        axes: Sequence[str] = ("x",),
+        name: str = "FlexJoint",
+        allow_extrapolation: bool = False,
+    ) -> Joint:
+        """A joint predicted by the surrogate for the six print settings `params` (rig units).
+
+        The surrogate's 95 % PIs, the print settings and the mass from geometry go into the joint; a
+        rotational axis asked of a translational surrogate comes from the pseudo-rigid-body model.
+        `surrogate` None: the shipped default.
+
+        Raises:
+            DesignerError: a factor missing or out of its tested range (unless `allow_extrapolation`),
+                an axis the surrogate cannot give.
+        """
+        params = space.check_design(params, allow_extrapolation)
+        if surrogate is None:
+            from .surrogate import Surrogate
+
+            surrogate = Surrogate.load()
+        pred = surrogate.predict({n: [v] for n, v in params.items()}, allow_extrapolation=True)
+        base = {
+            a: AxisCoefficients(
+                axis=a,
+                k=float(pred[f"k_{a}"].value[0]),
+                c=float(pred[f"c_{a}"].value[0]),
+                predicted={q: pred[f"{q}_{a}"].at(0) for q in ("k", "c")},
+                origin=f"predicted by surrogate {surrogate.id} from the print settings",
+            )
+            for a in surrogate.axes
+        }
+        prov = {
+            "source": f"surrogate {surrogate.id} prediction from print settings",
+            "params": params,
+            "surrogate": surrogate.id,
+            "notes": ["extrapolation allowed: the design may lie outside the data"]
+            if allow_extrapolation
+            else [],
+        }
+        return cls(name=name, axes=_axes_from(base, axes, params["length"]), provenance=prov).with_masses()
+
+    @classmethod
+    def from_suggestion(
+        cls,
+        suggestion: Suggestion | str | Path,
+        *,
+        candidate: int = 1,
+        axes: Sequence[str] | None = None,
+        name: str = "FlexJoint",
+    ) -> Joint:
+        """A joint from candidate `candidate` (1 = best) of a suggestion, or of its saved JSON file.
+
+        Raises:
+            DesignerError: the file is not a suggestion, or the candidate does not exist.
+        """
+        from .suggest import Suggestion
+
+        where = "the suggestion"
+        if not isinstance(suggestion, Suggestion):
+            where = f"suggestion {Path(suggestion).name}"
+            suggestion = Suggestion.load(suggestion)
+        n = len(suggestion.candidates)
+        if not 1 <= candidate <= n:
+            raise DesignerError(
+                f"candidate {candidate} does not exist in {where}",
+                f"choose 1 to {n}" if n else "the suggestion has no candidates",
+            )
+        cand = suggestion.candidates[candidate - 1]
+        params = space.check_design(cand.params, allow_extrapolation=True)
+        a = suggestion.axis
+        base = {
+            a: AxisCoefficients(
+                axis=a,
+                k=float(cand.predicted["k"].value),
+                c=float(cand.predicted["c"].value),
+                predicted=dict(cand.predicted),
+                origin=f"predicted for candidate {candidate} of {where}",
+            )
+        }
+        prov = {
+            "source": f"{where.removeprefix('the ')}, candidate {candidate}",
+            "params": params,
+            "surrogate": suggestion.surrogate_id,
+            "targets": {q: t.value for q, t in suggestion.targets.items()},
+            "desirability": cand.desirability,
+            "reachable": suggestion.reachable,
+        }
+        return cls(
+            name=name, axes=_axes_from(base, axes or [a], params["length"]), provenance=prov
+        ).with_masses()
 
     def axis(self, name: str) -> AxisCoefficients:
         try:
@@ -89,7 +222,8 @@ class Joint:
             if params is None:
                 raise DesignerError(
                     f"axis {a} of joint '{self.name}' has no mass",
-                    "give --m in kg, or build the joint from a design so its mass follows from geometry",
+                    "give m (kg) in its coefficients, or build the joint with Joint.from_design so its "
+                    "mass follows from geometry",
                 )
             m = specimen_mass(params)
             if units.is_rotational(a):
@@ -108,7 +242,8 @@ class Joint:
             "name": self.name,
             "axes": {
                 a: {
-                    "rig": {"k": ac.k, "c": ac.c, "m": ac.m, "k_pi95": ac.k_pi95, "c_pi95": ac.c_pi95},
+                    "rig": {"k": ac.k, "c": ac.c, "m": ac.m},
+                    "predicted": {q: p.to_dict() for q, p in ac.predicted.items()},
                     "rig_units": {q: units.rig_unit(q, a) for q in ("k", "c", "m")},
                     "si": ac.si(),
                     "si_units": {q: units.si_unit(q, a) for q in ("k", "c", "m")},
@@ -130,27 +265,82 @@ def rotational_from_translational(ac: AxisCoefficients, axis: str, length_mm: fl
     arm_mm = PRB_GAMMA * length_mm
     scale = arm_mm**2  # N/mm * mm^2 = N.mm/rad
 
-    def pi(p):
-        return None if p is None else (p[0] * scale, p[1] * scale)
-
     return AxisCoefficients(
         axis=axis,
         k=ac.k * scale,
         c=ac.c * scale,
         m=None if ac.m is None else ac.m * (arm_mm * units.MM) ** 2,
-        k_pi95=pi(ac.k_pi95),
-        c_pi95=pi(ac.c_pi95),
+        predicted={q: p.scaled(scale) for q, p in ac.predicted.items()},
         origin=f"derived, not measured: pseudo-rigid-body model from axis {ac.axis}, "
         f"K = k (gamma L)^2, gamma = {PRB_GAMMA}, L = {length_mm:g} mm",
     )
 
 
-def from_coefficients(
-    coefficients: Mapping[str, Mapping[str, float | None]], name: str = "FlexJoint"
+def _number(value: Any, where: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise DesignerError(f"coefficient {where} = {value!r} is not a number", "give a finite number")
+    return float(value)
+
+
+def _axes_from(
+    base: Mapping[str, AxisCoefficients], wanted: Sequence[str], length_mm: float
+) -> dict[str, AxisCoefficients]:
+    """The wanted axes from the predicted ones; a rotational axis not predicted comes from the PRB model."""
+    out: dict[str, AxisCoefficients] = {}
+    for a in wanted:
+        a = units.check_axis(a)
+        if a in out:
+            raise DesignerError(f"axis {a} is asked for twice in axes={list(wanted)}", "give each axis once")
+        if a in base:
+            out[a] = base[a]
+        elif units.is_rotational(a) and any(not units.is_rotational(b) for b in base):
+            source = next(b for b in base if not units.is_rotational(b))
+            out[a] = rotational_from_translational(base[source], a, length_mm)
+        else:
+            raise DesignerError(
+                f"there are no coefficients for axis {a}",
+                f"available: {', '.join(base)} (a rotational axis can be derived from a translational one)",
+            )
+    return out
+
+
+def from_one_source(
+    *,
+    coefficients: Mapping[str, Mapping[str, float | None]] | None = None,
+    design: Mapping[str, float] | None = None,
+    suggestion: Suggestion | str | Path | None = None,
+    candidate: int = 1,
+    axes: Sequence[str] | None = None,
+    name: str = "FlexJoint",
+    allow_extrapolation: bool = False,
+    surrogate: Surrogate | None = None,
 ) -> Joint:
-    """A joint from numbers typed by hand: {axis: {"k": .., "c": .., "m": ..}} in rig units."""
-    axes = {
-        a: AxisCoefficients(axis=a, k=float(v["k"]), c=float(v["c"]), m=v.get("m"))
-        for a, v in coefficients.items()
-    }
-    return Joint(name=name, axes=axes, provenance={"source": "entered by hand"})
+    """The joint from exactly one of `coefficients`, `design` or `suggestion` (the rule every caller shares).
+
+    Raises:
+        DesignerError: none or several sources given, or the chosen source is invalid.
+    """
+    given = [
+        n for n, v in (("coefficients", coefficients), ("design", design), ("suggestion", suggestion)) if v
+    ]
+    if len(given) != 1:
+        raise DesignerError(
+            "give the joint one way: " + (f"got {' and '.join(given)}" if given else "none given"),
+            "give exactly one of coefficients=, design= or suggestion=",
+        )
+    if coefficients:
+        if axes is not None and list(axes) != list(coefficients):
+            raise DesignerError(
+                f"axes={list(axes)} differ from the axes of coefficients ({', '.join(coefficients)})",
+                "leave axes out: the coefficients name their axes",
+            )
+        return Joint.from_coefficients(coefficients, name=name)
+    if design:
+        return Joint.from_design(
+            design,
+            surrogate=surrogate,
+            axes=axes or ("x",),
+            name=name,
+            allow_extrapolation=allow_extrapolation,
+        )
+    return Joint.from_suggestion(suggestion, candidate=candidate, axes=axes, name=name)

@@ -76,14 +76,14 @@ def check_value(name: str, value: float, allow_extrapolation: bool = False) -> f
     if not allow_extrapolation and not (f.low - 1e-9 <= v <= f.high + 1e-9):
         raise DesignerError(
             f"{name} = {v:g} {f.unit} is outside the tested range {f.describe_range()}",
-            "choose a value inside it, or pass --allow-extrapolation to accept an unsupported prediction",
+            "choose a value inside it, or pass allow_extrapolation=True to accept an unsupported prediction",
         )
     if v <= 0:
         raise DesignerError(f"{name} = {v:g} {f.unit} must be positive", f"give {f.describe_range()}")
     return v
 
 
-def validate(params: Mapping[str, float], allow_extrapolation: bool = False) -> dict[str, float]:
+def check_design(params: Mapping[str, float], allow_extrapolation: bool = False) -> dict[str, float]:
     """Check a complete design (all six factors) and return it as floats in factor order."""
     unknown = [k for k in params if k not in BY_NAME]
     if unknown:
@@ -92,7 +92,7 @@ def validate(params: Mapping[str, float], allow_extrapolation: bool = False) -> 
     if missing:
         raise DesignerError(
             f"missing factor(s): {', '.join(missing)}",
-            "give all six: " + ", ".join(f"--{f.name} ({f.describe_range()})" for f in FACTORS),
+            "give all six: " + ", ".join(f"{f.name} ({f.describe_range()})" for f in FACTORS),
         )
     return {n: check_value(n, params[n], allow_extrapolation) for n in FACTOR_NAMES}
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import casadi as ca
@@ -21,7 +22,7 @@ import numpy as np
 
 from . import space, units
 from .errors import DesignerError
-from .surrogate import Surrogate
+from .surrogate import Prediction, Surrogate
 
 #: relative deviation from a target within which it counts as hit
 HIT_TOLERANCE = 0.02
@@ -99,8 +100,10 @@ def make_target(
 
 @dataclass
 class Candidate:
+    """One design: the six print settings and the predicted k and c (`Prediction`s of floats)."""
+
     params: dict[str, float]
-    predicted: dict[str, dict[str, Any]]
+    predicted: dict[str, Prediction]
     desirability: float
     rel_error: dict[str, float]
     extrapolated: bool
@@ -109,7 +112,7 @@ class Candidate:
     def to_dict(self) -> dict[str, Any]:
         return {
             "params": self.params,
-            "predicted": self.predicted,
+            "predicted": {q: p.to_dict() for q, p in self.predicted.items()},
             "desirability": self.desirability,
             "rel_error": self.rel_error,
             "extrapolated": self.extrapolated,
@@ -145,6 +148,72 @@ class Suggestion:
             "surrogate_id": self.surrogate_id,
             "candidates": [c.to_dict() for c in self.candidates],
         }
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any], *, where: str = "suggestion") -> Suggestion:
+        """Read back `to_dict` output (a `designer suggest --json` file); DesignerError when malformed."""
+        try:
+            axis = units.check_axis(d["axis"])
+            bounds = d.get("desirability_bounds") or {}
+            targets = {
+                q: Target(
+                    q,
+                    float(v),
+                    float(bounds.get(q, {}).get("low", 0.0)),
+                    float(bounds.get(q, {}).get("high", np.inf)),
+                    float(bounds.get(q, {}).get("importance", 1.0)),
+                )
+                for q, v in d["targets"].items()
+                if v is not None
+            }
+            candidates = [
+                Candidate(
+                    params=dict(c["params"]),
+                    predicted={
+                        q: Prediction.from_dict(p, where=f"{where} candidate {i + 1} {q}")
+                        for q, p in c["predicted"].items()
+                    },
+                    desirability=float(c["desirability"]),
+                    rel_error=dict(c.get("rel_error", {})),
+                    extrapolated=bool(c.get("extrapolated", False)),
+                    notes=list(c.get("notes", [])),
+                )
+                for i, c in enumerate(d["candidates"])
+            ]
+            return cls(
+                axis,
+                targets,
+                candidates,
+                bool(d.get("reachable", True)),
+                list(d.get("statements", [])),
+                dict(d.get("predictability", {})),
+                str(d.get("surrogate_id", "")),
+                dict(d.get("fixed", {})),
+            )
+        except (KeyError, TypeError, ValueError, AttributeError) as exc:
+            raise DesignerError(
+                f"{where} is not a suggestion (missing or malformed {exc})",
+                "use the output of designer.suggest(...).to_dict()",
+            ) from None
+
+    @classmethod
+    def load(cls, path: str | Path) -> Suggestion:
+        """Read a suggestion saved as JSON; DesignerError naming `path` when it cannot be read."""
+        import json
+
+        path = Path(path)
+        try:
+            data = json.loads(path.read_text())
+        except (OSError, ValueError) as exc:
+            raise DesignerError(
+                f"cannot read a suggestion from path={str(path)!r}: {exc}",
+                "give a JSON file written from Suggestion.to_dict()",
+            ) from None
+        if not isinstance(data, dict):
+            raise DesignerError(
+                f"{path.name} is not a suggestion", "give a JSON file written from Suggestion.to_dict()"
+            )
+        return cls.from_dict(data, where=path.name)
 
 
 class _Problem:
@@ -231,12 +300,12 @@ def suggest(
         raise DesignerError(
             f"the surrogate has no axis '{axis}'",
             f"it has {', '.join(surrogate.axes) or 'none'}; "
-            "fit one on a table with that axis (designer fit --data)",
+            "fit one on a table with that axis: Surrogate().fit(table)",
         )
     if k is None and c is None:
-        raise DesignerError("no target given", "give --k and/or --c")
+        raise DesignerError("no target given", "give k= and/or c=")
     if top < 1:
-        raise DesignerError(f"--top {top} must be at least 1", "give a positive number of candidates")
+        raise DesignerError(f"top={top} must be at least 1", "give a positive number of candidates")
     importance = importance or {}
     bounds = bounds or {}
     targets = {
@@ -313,13 +382,13 @@ def _rank(
 ) -> list[Candidate]:
     """Predict each design, score it, and sort by desirability, then by the narrower k interval."""
     cols = {n: np.array([d[n] for d in designs]) for n in space.FACTOR_NAMES}
-    preds = surrogate.predict(cols, [f"k_{axis}", f"c_{axis}"])
+    preds = surrogate.predict(cols, responses=[f"k_{axis}", f"c_{axis}"], allow_extrapolation=True)
     out = []
     for i, design in enumerate(designs):
         predicted, rel_error, ds, ws = {}, {}, [], []
         for q in ("k", "c"):
             p = preds[f"{q}_{axis}"]
-            predicted[q] = {"value": float(p.value[i]), "pi95": [float(p.lo[i]), float(p.hi[i])]}
+            predicted[q] = p.at(i)
             if q in targets:
                 t = targets[q]
                 rel_error[q] = float((p.value[i] - t.value) / t.value)
@@ -333,8 +402,8 @@ def _rank(
         out.append(Candidate(design, predicted, desirability, rel_error, extrapolated, notes))
 
     def k_width(c: Candidate) -> float:
-        lo, hi = c.predicted["k"]["pi95"]
-        return float(np.log(hi / lo))
+        k = c.predicted["k"]
+        return float(np.log(k.high / k.low))
 
     return sorted(out, key=lambda c: (-round(c.desirability, 6), k_width(c)))
 
@@ -357,11 +426,11 @@ def _statements(
         model = surrogate.model(f"{q}_{axis}")
         obs_lo, obs_hi = model.observed_range
         if not pred_info[q]["predictable"]:
-            lo, hi = best.predicted[q]["pi95"]
-            inside = "lies inside" if lo <= t.value <= hi else "lies outside"
+            p = best.predicted[q]
+            inside = "lies inside" if p.low <= t.value <= p.high else "lies outside"
             statements.append(
                 f"{q} = {t.value:g} {unit}: {pred_info[q]['statement']} "
-                f"({best.predicted[q]['value']:.3g} {unit}, 95 % PI {lo:.3g} to {hi:.3g} {unit}); "
+                f"({p.value:.3g} {unit}, 95 % PI {p.low:.3g} to {p.high:.3g} {unit}); "
                 f"the target {inside} that interval, so no setting can be chosen for it from this data"
             )
             continue
@@ -372,7 +441,7 @@ def _statements(
             )
         if abs(best.rel_error[q]) <= HIT_TOLERANCE:
             statements.append(
-                f"{q} = {t.value:g} {unit} is reached: predicted {best.predicted[q]['value']:.4g} {unit} "
+                f"{q} = {t.value:g} {unit} is reached: predicted {best.predicted[q].value:.4g} {unit} "
                 f"({100 * best.rel_error[q]:+.2f} %)"
             )
             continue
@@ -382,7 +451,7 @@ def _statements(
         statements.append(
             f"{q} = {t.value:g} {unit} is out of reach: within {where} the surrogate predicts "
             f"{q}_{axis} from {lo_r:.3g} to {hi_r:.3g} {unit}; the candidates below are the nearest "
-            f"designs (best {best.predicted[q]['value']:.3g} {unit}, {100 * best.rel_error[q]:+.1f} %)"
+            f"designs (best {best.predicted[q].value:.3g} {unit}, {100 * best.rel_error[q]:+.1f} %)"
         )
     return statements, reachable
 

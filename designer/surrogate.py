@@ -155,13 +155,46 @@ def _ridge_fit(Z: np.ndarray, y: np.ndarray, alpha: float, Zg: np.ndarray | None
     )
 
 
-@dataclass
+@dataclass(frozen=True)
 class Prediction:
-    """Predicted values and their 95 % prediction interval, arrays in rig units."""
+    """Predicted values and their 95 % prediction interval (`low`, `high`), in rig units.
 
-    value: np.ndarray
-    lo: np.ndarray
-    hi: np.ndarray
+    Arrays of shape (n,) for n designs, or floats for one design (`at(i)`). The one shape of a
+    prediction everywhere: surrogate, suggest, joint provenance, exports and JSON (`to_dict`).
+    """
+
+    value: Any
+    low: Any
+    high: Any
+
+    def at(self, i: int) -> Prediction:
+        """The prediction for design `i` as floats."""
+        return Prediction(float(self.value[i]), float(self.low[i]), float(self.high[i]))
+
+    def scaled(self, factor: float) -> Prediction:
+        """The same prediction in other units: every bound times `factor` (> 0)."""
+        return Prediction(self.value * factor, self.low * factor, self.high * factor)
+
+    def to_dict(self) -> dict[str, Any]:
+        """{"value", "low", "high"}: floats, or lists for several designs."""
+
+        def plain(v: Any) -> Any:
+            return np.asarray(v, dtype=float).tolist()
+
+        return {"value": plain(self.value), "low": plain(self.low), "high": plain(self.high)}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any], *, where: str = "prediction") -> Prediction:
+        """Read back `to_dict` output; raise DesignerError when a key is missing or not a number."""
+        try:
+            values = [d[k] for k in ("value", "low", "high")]
+            if all(np.ndim(v) == 0 for v in values):
+                return cls(*(float(v) for v in values))
+            return cls(*(np.asarray(v, dtype=float) for v in values))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise DesignerError(
+                f"{where} is not a prediction ({exc})", 'expected {"value": .., "low": .., "high": ..}'
+            ) from None
 
 
 @dataclass
@@ -178,7 +211,7 @@ class ResponseSurface:
     dof: float = 0.0
     t95: float = 0.0
     loo: dict[str, float] = field(default_factory=dict)
-    loo_predictions: dict[str, np.ndarray] = field(default_factory=dict)
+    loo_predictions: Prediction | None = None
     candidates: dict[str, dict[str, float]] = field(default_factory=dict)
     observed_range: tuple[float, float] = (0.0, 0.0)
 
@@ -197,6 +230,11 @@ class ResponseSurface:
     @property
     def unit(self) -> str:
         return units.rig_unit(self.quantity, self.axis)
+
+    @property
+    def fitted(self) -> bool:
+        """Whether fit (or loading) gave this surface a residual scale and dof."""
+        return self.dof > 0
 
     @property
     def predictable(self) -> bool:
@@ -228,6 +266,11 @@ class ResponseSurface:
         return self
 
     def predict(self, X: Any) -> Prediction:
+        """Value and 95 % PI at the designs X (mapping or DataFrame of factor columns, shape (n,))."""
+        if not self.fitted:
+            raise DesignerError(
+                f"the surface of {self.response} is not fitted", "call fit(X, y) first, or load a surrogate"
+            )
         Z = self.features(X)
         mean = Z @ self.coef
         half = self.t95 * self.sigma * np.sqrt(1.0 + np.einsum("ij,jk,ik->i", Z, self.vcov, Z))
@@ -261,7 +304,7 @@ class ResponseSurface:
             "t95": self.t95,
             "observed_range": list(self.observed_range),
             "loo": self.loo,
-            "loo_predictions": {k: np.asarray(v).tolist() for k, v in self.loo_predictions.items()},
+            "loo_predictions": None if self.loo_predictions is None else self.loo_predictions.to_dict(),
             "candidates": self.candidates,
         }
 
@@ -282,7 +325,7 @@ class ResponseSurface:
             dof=float(d["dof"]),
             t95=float(d["t95"]),
             loo=dict(d["loo"]),
-            loo_predictions={k: np.asarray(v, dtype=float) for k, v in d["loo_predictions"].items()},
+            loo_predictions=Prediction.from_dict(d["loo_predictions"], where=f"{response} LOO predictions"),
             candidates=dict(d["candidates"]),
             observed_range=tuple(d["observed_range"]),
         )
@@ -305,7 +348,7 @@ def _metrics(y: np.ndarray, pred: Prediction) -> dict[str, float]:
         "rmse": float(np.sqrt(np.mean(err**2))),
         "mape": float(100 * np.mean(np.abs(err / y))),
         "q2": float(1 - np.sum(err**2) / np.sum((y - y.mean()) ** 2)),
-        "coverage95": float(np.mean((y >= pred.lo) & (y <= pred.hi))),
+        "coverage95": float(np.mean((y >= pred.low) & (y <= pred.high))),
     }
 
 
@@ -317,7 +360,7 @@ def leave_one_out(form: str, X: Mapping[str, np.ndarray], y: np.ndarray, respons
         keep = np.arange(n) != i
         model = ResponseSurface(response, form).fit({k: v[keep] for k, v in X.items()}, y[keep])
         p = model.predict({k: v[i : i + 1] for k, v in X.items()})
-        value[i], lo[i], hi[i] = p.value[0], p.lo[0], p.hi[0]
+        value[i], lo[i], hi[i] = p.value[0], p.low[0], p.high[0]
     return Prediction(value, lo, hi)
 
 
@@ -343,7 +386,7 @@ def select(
     model = ResponseSurface(response, chosen).fit(X, y)
     model.loo = _metrics(y, preds[chosen])
     p = preds[chosen]
-    model.loo_predictions = {"value": p.value, "lo": p.lo, "hi": p.hi}
+    model.loo_predictions = p
     model.candidates = {form: _metrics(y, preds[form]) | {"n_params": n_params[form]} for form in forms}
     return model
 
@@ -376,12 +419,29 @@ class Surrogate:
 
         return pd.DataFrame(self.training)
 
-    def fit(self, table, responses: list[str] | None = None) -> Surrogate:
-        """Fit c and k of every axis present in a coefficient table (see designer.data)."""
-        from .data import axes_present, table_hash
+    def fit(self, table: Any, *, responses: list[str] | None = None) -> Surrogate:
+        """Fit c and k of every axis in a coefficient table (path or DataFrame, rig units).
 
+        The table goes through `designer.load_table`, so its problems are named with column and row.
+        `responses` picks columns such as ["k_x"]; None fits c and k of every axis present.
+
+        Raises:
+            DesignerError: a malformed table (missing factor, NaN, non-positive k), an unknown
+                response, or fewer than 8 runs.
+        """
+        from .data import axes_present, coefficient_columns, load_table, table_hash
+
+        table = load_table(table)
         axes = axes_present(table)
-        responses = responses or [f"{q}_{a}" for a in axes for q in ("c", "k")]
+        if responses is None:
+            responses = [f"{q}_{a}" for a in axes for q in ("c", "k")]
+        unknown = [r for r in responses if r not in coefficient_columns(table)]
+        if unknown or not responses:
+            raise DesignerError(
+                f"responses={responses} names column(s) the table lacks: "
+                f"{', '.join(unknown) or 'none given'}",
+                f"the table has {', '.join(coefficient_columns(table))}",
+            )
         if len(table) < 8:
             raise DesignerError(f"the table has {len(table)} runs", "a surrogate needs at least 8")
         X = {n: table[n].to_numpy(dtype=float) for n in space.FACTOR_NAMES}
@@ -396,11 +456,30 @@ class Surrogate:
         except KeyError:
             raise DesignerError(
                 f"the surrogate has no response '{response}'",
-                f"it has {', '.join(self.models)}; fit one on a table with that axis (designer fit --data)",
+                f"it has {', '.join(self.models)}; fit one on a table with that axis: Surrogate().fit(table)",
             ) from None
 
-    def predict(self, X: Any, responses: list[str] | None = None) -> dict[str, Prediction]:
-        """Predictions with 95 % PIs for each response at the designs X (DataFrame or mapping)."""
+    def predict(
+        self, designs: Any, *, responses: list[str] | None = None, allow_extrapolation: bool = False
+    ) -> dict[str, Prediction]:
+        """Predictions with 95 % PIs per response at the designs (rig units).
+
+        Args:
+            designs: the six factors, as a DataFrame, a mapping of arrays of shape (n,), or one design
+                as a mapping of numbers.
+            responses: which responses (e.g. ["k_x"]); None: all.
+            allow_extrapolation: accept designs outside the tested ranges (flagged by the caller).
+
+        Returns:
+            {response: Prediction} with arrays of shape (n,).
+
+        Raises:
+            DesignerError: the surrogate is not fitted, a factor is missing, not a number or out of
+                range, or a response is unknown.
+        """
+        if not self.models:
+            raise DesignerError("the surrogate is not fitted", "call fit(table) or Surrogate.load() first")
+        X = _check_designs(designs, allow_extrapolation)
         return {r: self.model(r).predict(X) for r in (responses or self.responses)}
 
     def _payload_json(self, include_id: bool = True) -> str:
@@ -432,8 +511,13 @@ class Surrogate:
         return Path(path)
 
     @classmethod
-    def load(cls, path: str | Path) -> Surrogate:
-        p = Path(path)
+    def load(cls, path: str | Path | None = None) -> Surrogate:
+        """Read a surrogate saved by `save` (None: the one shipped, fitted to the bundled table).
+
+        Raises:
+            DesignerError: the file is missing, unreadable or not a surrogate.
+        """
+        p = default_path() if path is None else Path(path)
         try:
             d = json.loads(p.read_text())
         except FileNotFoundError:
@@ -450,10 +534,33 @@ class Surrogate:
                 f"surrogate {p} is incomplete ({exc})", "refit it with designer fit"
             ) from None
 
-    @classmethod
-    def load_default(cls) -> Surrogate:
-        """The surrogate shipped with the package, fitted to the bundled study table."""
-        return cls.load(default_path())
+
+def _check_designs(designs: Any, allow_extrapolation: bool) -> dict[str, np.ndarray]:
+    """The six factor columns as float arrays of one length, each value checked against its range."""
+    if hasattr(designs, "columns"):  # a DataFrame
+        designs = {c: designs[c].to_numpy() for c in designs.columns}
+    elif hasattr(designs, "index") and hasattr(designs, "to_dict"):  # a Series: one design
+        designs = designs.to_dict()
+    if not isinstance(designs, Mapping):
+        raise DesignerError(
+            f"designs of type {type(designs).__name__} are not designs",
+            "give a DataFrame or a mapping of the six factors",
+        )
+    missing = [n for n in space.FACTOR_NAMES if n not in designs]
+    if missing:
+        raise DesignerError(
+            f"designs lack factor(s) {', '.join(missing)}", f"give all of {space.FACTOR_NAMES}"
+        )
+    try:
+        X = {n: np.atleast_1d(np.asarray(designs[n], dtype=float)) for n in space.FACTOR_NAMES}
+    except (TypeError, ValueError) as exc:
+        raise DesignerError(f"designs hold a value that is not a number ({exc})", "give numbers") from None
+    if len({len(v) for v in X.values()}) != 1:
+        raise DesignerError("the factor columns of designs differ in length", "give one value per design")
+    for n, v in X.items():
+        for value in v:
+            space.check_value(n, float(value), allow_extrapolation)
+    return X
 
 
 def default_path() -> Path:

@@ -20,7 +20,7 @@ def test_suggest_json_schema():
     cand = d["candidates"][0]
     assert set(cand["params"]) == {"density", "length", "width", "height", "layer", "raster"}
     for q in ("k", "c"):
-        assert set(cand["predicted"][q]) >= {"value", "pi95"} and len(cand["predicted"][q]["pi95"]) == 2
+        assert set(cand["predicted"][q]) == {"value", "low", "high"}
     assert 0 <= cand["desirability"] <= 1
     assert abs(cand["predicted"]["k"]["value"] / 0.8 - 1) <= 0.02
 
@@ -36,7 +36,7 @@ def test_predict_json():
     d = json.loads(designer("predict", *args, "--raster", "0", "--json", check=True).stdout)
     assert d["axis"] == "x" and d["params"]["width"] == 4.5
     k = d["predicted"]["k"]
-    assert k["pi95"][0] < k["value"] < k["pi95"][1] and k["unit"] == "N/mm"
+    assert k["low"] < k["value"] < k["high"] and k["unit"] == "N/mm"
 
 
 def test_fit_json_reports_loo(tmp_path):

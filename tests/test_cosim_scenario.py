@@ -1,5 +1,6 @@
 """Scenarios end to end through exported joint FMUs: robot, virtual rig, checks, outputs, CLI."""
 
+import importlib
 import json
 import textwrap
 from pathlib import Path
@@ -9,9 +10,11 @@ import pytest
 import typer
 from typer.testing import CliRunner
 
-from designer.cosim import load, simulate
-from designer.cosim import run as cosim_run
+from designer.cosim import load, run, write_outputs
 from designer.errors import DesignerError
+
+# the module, not the function `designer.cosim.run` that shadows it as an attribute of the package
+cosim_run = importlib.import_module("designer.cosim.run")
 
 ARM = """
 [simulation]
@@ -68,8 +71,9 @@ def test_two_link_arm_through_fmus_matches_in_engine_reference(tmp_path):
 
 def test_validation_error_falls_with_step_and_outputs(tmp_path):
     out = tmp_path / "out"
-    summary = simulate(load(arm(tmp_path, duration=1.0)), out, with_validation=True)
-    val = summary["validation"]
+    result = run(load(arm(tmp_path, duration=1.0)), validate=True)
+    write_outputs(result, out)
+    val = result.validation
     assert val["max_error"] <= 1e-9
     rows = val["steps"]
     for big, small in zip(rows, rows[1:], strict=False):
@@ -87,7 +91,9 @@ def test_rig_log_identifies_the_fmus_coefficients(tmp_path):
     from designer.rig.identify import identify
 
     out = tmp_path / "rig"
-    summary = simulate(load(write(tmp_path, RIG)), out, with_validation=True)
+    result = run(load(write(tmp_path, RIG)), validate=True)
+    write_outputs(result, out, plot=False)
+    summary = result.summary()
     fit = identify(out / "rig_log.csv")[0].axes["theta"]
     assert fit.k == pytest.approx(330, rel=5e-3)
     assert fit.c == pytest.approx(0.83, rel=5e-3)
@@ -123,15 +129,15 @@ def test_interrupted_run_leaves_complete_files_or_none(tmp_path, monkeypatch):
     def interrupt(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(cosim_run, "plot", interrupt)
+    monkeypatch.setattr(cosim_run, "plot_result", interrupt)
     with pytest.raises(KeyboardInterrupt):
-        simulate(sc, out)
+        write_outputs(run(sc), out)
     names = sorted(p.name for p in out.iterdir())
     assert names == ["metrics.json", "timeseries.csv", "timeseries.parquet"]
     assert len(np.loadtxt(out / "timeseries.csv", delimiter=",", skiprows=1)) == 201
     monkeypatch.setattr(cosim_run.Master, "run", interrupt)
     with pytest.raises(KeyboardInterrupt):
-        simulate(sc, tmp_path / "none")
+        write_outputs(run(sc), tmp_path / "none")
     assert not (tmp_path / "none").exists()
 
 
@@ -157,20 +163,20 @@ def _suggestion(tmp_path):
     from designer.suggest import suggest
     from designer.surrogate import Surrogate
 
-    doc = suggest(Surrogate.load_default(), k=0.8, fixed={"length": 24}, top=2).to_dict()
+    doc = suggest(Surrogate.load(), k=0.8, fixed={"length": 24}, top=2).to_dict()
     (tmp_path / "s.json").write_text(json.dumps(doc))
     return doc
 
 
 def test_joints_from_a_design_and_a_suggestion_run_through_the_surrogate(tmp_path):
-    from designer.export import sources
+    from designer import Joint
 
     doc = _suggestion(tmp_path)
     text = ARM.format(duration=0.3, step=1e-3, joint2='suggestion = "s.json"\ncandidate = 2')
     sc = load(write(tmp_path, text.replace("coefficients = { k = 330, c = 0.83 }", DESIGN_TOML)))
     expect = {
-        "j1": sources.from_design(DESIGN, ["theta"]).axes["theta"],
-        "j2": sources.from_suggestion(tmp_path / "s.json", 2, ["theta"]).axes["theta"],
+        "j1": Joint.from_design(DESIGN, axes=["theta"]).axes["theta"],
+        "j2": Joint.from_suggestion(tmp_path / "s.json", candidate=2, axes=["theta"]).axes["theta"],
     }
     # the suggestion's k on x (N/mm) taken to theta with the PRB model: K = k (0.85 L)^2
     k2 = doc["candidates"][1]["predicted"]["k"]["value"] * (0.85 * 24) ** 2
@@ -220,3 +226,82 @@ def test_the_arm_example_takes_its_joints_from_a_suggestion():
         )
         assert 250 < sc.joints[name].joint.axes["theta"].k < 420  # N.mm/rad
     assert "designer suggest --k 0.8 --fix length=24" in (examples / "two_link_arm.sh").read_text()
+
+
+def _coded(**changes):
+    from designer import Joint
+    from designer.cosim import JointSource, Scenario, Sine
+
+    joint = Joint.from_coefficients({"theta": {"k": 330, "c": 0.83}}, name="j1")
+    kwargs = dict(
+        duration=0.2, step=1e-3, joints={"j1": JointSource(joint=joint)}, motors={"j1": Sine(0.5, 0.5)}
+    )
+    return Scenario(**(kwargs | changes))
+
+
+def test_scenario_built_in_code_runs_in_memory_and_writes_nothing(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    sc = _coded()
+    assert sc.kind == "robot" and sc.outputs == {"csv": True, "parquet": True, "plot": True}
+    result = run(sc)
+    frame = result.to_frame()
+    assert list(frame.columns[:1]) == ["t"] and len(frame) == 201
+    assert frame["t"].iloc[-1] == pytest.approx(0.2)
+    assert "robot.j1.q" in frame and "j1.theta.f" in frame
+    assert set(result.metrics) == {"j1"} and result.laws["j1"]["k"] == pytest.approx(0.33)
+    assert list(tmp_path.iterdir()) == []
+    # the same scenario from TOML gives the same numbers, bit for bit
+    text = ARM.format(duration=0.2, step=1e-3, joint2="").split("[joints.j2]")[0]
+    np.testing.assert_array_equal(run(load(write(tmp_path, text))).values, result.values)
+
+
+@pytest.mark.parametrize(
+    "changes, message",
+    [
+        ({"step": 0}, "step = 0 must be positive"),
+        ({"duration": float("nan")}, "duration = nan is not a finite number"),
+        ({"duration": 1e-4}, "shorter than step"),
+        ({"algorithm": "newton"}, "algorithm = 'newton' is not allowed"),
+        ({"joints": {}}, "needs joints"),
+        ({"motors": {"j9": None}}, "motors name joint"),
+        ({"outputs": {"pdf": True}}, "not a set of switches"),
+        ({"duration": 1e9}, "of results; .* of memory is available"),
+        ({"validation_steps": (1e-3,)}, "fewer than two steps"),
+    ],
+)
+def test_invalid_scenario_built_in_code_is_refused_naming_the_field(changes, message):
+    with pytest.raises(DesignerError, match=message):
+        _coded(**changes)
+
+
+def test_joint_source_checks_its_fields():
+    from designer import Joint
+    from designer.cosim import JointSource
+
+    joint = Joint.from_coefficients({"theta": {"k": 330, "c": 0.83}})
+    with pytest.raises(DesignerError, match="exactly one of fmu= or joint="):
+        JointSource()
+    with pytest.raises(DesignerError, match="has no axis 'x'"):
+        JointSource(axis="x", joint=joint)
+    with pytest.raises(DesignerError, match="'theta.stiffness' is not a parameter"):
+        JointSource(joint=joint, parameters={"theta.stiffness": 1.0})
+
+
+@pytest.mark.parametrize(
+    "old, new, message",
+    [
+        ("duration = 1", "duraton = 1", "unknown key 'duraton' in \\[simulation\\].*did you mean 'duration'"),
+        ('model = "arm"', 'modle = "arm"', "unknown key 'modle' in \\[robot\\].*did you mean 'model'"),
+        ('type = "step", amplitude', 'type = "step", amplitud = 1, amplitude', "unknown key 'amplitud'"),
+        (
+            "coefficients = { k = 330, c = 0.83 }\nreference",
+            "coefficients = { k = 330, c = 0.83, stifness = 2 }\nreference",
+            "unknown key",
+        ),
+    ],
+)
+def test_typos_in_scenario_keys_are_named_with_the_closest_key(tmp_path, old, new, message):
+    text = ARM.format(duration=1, step=1e-3, joint2=J2)
+    assert old in text
+    with pytest.raises(DesignerError, match=message):
+        load(write(tmp_path, text.replace(old, new, 1)))

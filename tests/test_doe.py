@@ -111,11 +111,11 @@ def test_cli_doe_writes_plan(tmp_path):
 
 
 def test_augment_with_the_surrogate():
-    sur = Surrogate.load_default()
+    sur = Surrogate.load()
     near = near_target(lambda X: {r: p.value for r, p in sur.predict(X).items()}, {"k_x": 0.8, "c_x": 2e-3})
     plan, narrowing = augment(6, sur.models, sur.table, target=near)
     assert len(plan) == 6
-    space.validate(plan.iloc[0][list(space.FACTOR_NAMES)].to_dict())
+    space.check_design(plan.iloc[0][list(space.FACTOR_NAMES)].to_dict())
     for resp in sur.responses:
         assert narrowing[resp]["half_width_after"] < narrowing[resp]["half_width_before"]
 
@@ -130,7 +130,7 @@ def test_cli_augment_with_the_shipped_surrogate(tmp_path):
     doc = json.loads(out.stdout)
     assert len(doc["runs"]) == 4 and len(pd.read_csv(tmp_path / "next.csv")) == 4
     for run in doc["runs"]:
-        space.validate({f: run[f] for f in space.FACTOR_NAMES})
-    assert set(doc["pi_narrowing"]) == set(Surrogate.load_default().responses)
+        space.check_design({f: run[f] for f in space.FACTOR_NAMES})
+    assert set(doc["pi_narrowing"]) == set(Surrogate.load().responses)
     k = doc["pi_narrowing"]["k_x"]
     assert k["half_width_after"] < k["half_width_before"]

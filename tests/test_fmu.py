@@ -18,7 +18,7 @@ from fmpy.validation import validate_fmu
 from designer.errors import DesignerError
 from designer.export import build
 from designer.export.fmu import export_fmu, value_reference
-from designer.joint import from_coefficients
+from designer.joint import Joint
 
 M, C, K, F = 0.01, 2e-3, 0.8, 2.744  # kg, N.s/mm, N/mm, N (the study's 280 g static load)
 K_SI, C_SI = K * 1e3, C * 1e3
@@ -36,7 +36,7 @@ def cache(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def joint():
-    return from_coefficients({"x": {"k": K, "c": C, "m": M}})
+    return Joint.from_coefficients({"x": {"k": K, "c": C, "m": M}})
 
 
 @pytest.fixture(scope="module")
@@ -297,7 +297,7 @@ def test_same_joint_gives_identical_bytes_and_other_joint_another_token(joint, t
     a = export_fmu(joint, tmp_path / "a.fmu", 3, "body")
     b = export_fmu(joint, tmp_path / "b.fmu", 3, "body")
     assert a.read_bytes() == b.read_bytes()
-    other = from_coefficients({"x": {"k": 0.9, "c": C, "m": M}})
+    other = Joint.from_coefficients({"x": {"k": 0.9, "c": C, "m": M}})
     c = export_fmu(other, tmp_path / "c.fmu", 3, "body")
     tokens = {read_model_description(str(p)).guid for p in (a, c)}
     assert len(tokens) == 2
@@ -335,7 +335,7 @@ def test_missing_compiler_message_and_source_only(joint, tmp_path, monkeypatch):
 
 def test_body_interface_without_mass_is_refused(tmp_path):
     with pytest.raises(DesignerError, match="needs a mass"):
-        export_fmu(from_coefficients({"x": {"k": K, "c": C}}), tmp_path / "j.fmu", interface="body")
+        export_fmu(Joint.from_coefficients({"x": {"k": K, "c": C}}), tmp_path / "j.fmu", interface="body")
 
 
 def test_sources_rebuild_into_a_working_binary(fmus, tmp_path):

@@ -10,10 +10,9 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from designer.export import sources
 from designer.export.modelica import modelica_text
 from designer.export.robot import mjcf_text, urdf_text
-from designer.joint import PRB_GAMMA, from_coefficients
+from designer.joint import PRB_GAMMA, Joint
 
 DESIGN = {"density": 60, "length": 24, "width": 4.5, "height": 9, "layer": 0.16, "raster": 0}
 
@@ -40,17 +39,23 @@ class FakeSurrogate:
 
     id = "fake-1"
     responses = ["c_x", "k_x"]
+    axes = ["x"]
 
-    def predict(self, X):
-        from types import SimpleNamespace
+    def predict(self, X, *, allow_extrapolation=False):
+        from designer import Prediction
 
-        one = lambda v: SimpleNamespace(value=np.array([v]), lo=np.array([v / 2]), hi=np.array([v * 2]))  # noqa: E731
+        def one(v):
+            return Prediction(np.array([v]), np.array([v / 2]), np.array([v * 2]))
+
         return {"k_x": one(0.8), "c_x": one(2e-3)}
 
 
 def test_joint_from_design_carries_pis_settings_mass_and_prb():
-    j = sources.from_design(DESIGN, ["x", "theta"], surrogate=FakeSurrogate())
-    assert j.axes["x"].k == 0.8 and j.axes["x"].k_pi95 == (0.4, 1.6)
+    j = Joint.from_design(DESIGN, axes=["x", "theta"], surrogate=FakeSurrogate())
+    assert j.axes["x"].k == 0.8 and (j.axes["x"].predicted["k"].low, j.axes["x"].predicted["k"].high) == (
+        0.4,
+        1.6,
+    )
     assert j.provenance["params"]["width"] == 4.5 and j.provenance["surrogate"] == "fake-1"
     assert j.axes["x"].m > 0
     arm = PRB_GAMMA * 24
@@ -67,21 +72,24 @@ def test_joint_from_suggestion(tmp_path):
             {
                 "params": DESIGN,
                 "predicted": {
-                    "k": {"value": 0.7, "pi95": [0.5, 0.9]},
-                    "c": {"value": 1e-3, "pi95": [0, 3e-3]},
+                    "k": {"value": 0.7, "low": 0.5, "high": 0.9},
+                    "c": {"value": 1e-3, "low": 0, "high": 3e-3},
                 },
                 "desirability": 0.9,
             },
             {
                 "params": DESIGN,
-                "predicted": {"k": {"value": 0.6, "pi95": None}, "c": {"value": 1e-3, "pi95": None}},
+                "predicted": {
+                    "k": {"value": 0.6, "low": 0.3, "high": 1.2},
+                    "c": {"value": 1e-3, "low": 0, "high": 3e-3},
+                },
                 "desirability": 0.5,
             },
         ],
     }
     p = tmp_path / "s.json"
     p.write_text(json.dumps(s))
-    j = sources.from_suggestion(p, 2)
+    j = Joint.from_suggestion(p, candidate=2)
     assert j.axes["x"].k == 0.6 and j.provenance["desirability"] == 0.5 and j.axes["x"].m > 0
     r = run("export", "fmu", "--from", str(p), "--candidate", "3", "-o", str(tmp_path / "j.fmu"))
     assert r.returncode == 2 and "candidate 3 does not exist" in r.stderr and "Traceback" not in r.stderr
@@ -145,7 +153,7 @@ def test_cli_without_compiler_says_how_and_source_only_works(tmp_path, cache_env
 
 
 def test_modelica_package_uses_msl_with_si_values():
-    j = from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}, "theta": {"k": 50.0, "c": 0.1}})
+    j = Joint.from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}, "theta": {"k": 50.0, "c": 0.1}})
     text = modelica_text(j)
     assert "Modelica.Mechanics.Translational.Components.SpringDamper springDamper_x(c = k_x, d = c_x)" in text
     assert "TranslationalSpringConstant k_x = 800.0" in text and "Mass m_x = 0.01" in text
@@ -158,7 +166,9 @@ def test_modelica_package_uses_msl_with_si_values():
 def test_mjcf_loads_in_mujoco_with_the_joint_numbers():
     import mujoco
 
-    j = from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}, "theta": {"k": 50.0, "c": 0.1, "m": 1e-5}})
+    j = Joint.from_coefficients(
+        {"x": {"k": 0.8, "c": 2e-3, "m": 0.01}, "theta": {"k": 50.0, "c": 0.1, "m": 1e-5}}
+    )
     model = mujoco.MjModel.from_xml_string(mjcf_text(j))
     assert list(model.jnt_stiffness) == [800.0, 0.05]
     assert list(model.dof_damping) == [2.0, 1e-4] and list(model.dof_armature) == [0.01, 1e-5]
@@ -166,7 +176,7 @@ def test_mjcf_loads_in_mujoco_with_the_joint_numbers():
 
 
 def test_urdf_declares_damping_and_says_it_has_no_stiffness():
-    j = from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}})
+    j = Joint.from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}})
     text = urdf_text(j)
     root = ET.fromstring(text)
     joint = root.find("joint")
@@ -205,7 +215,7 @@ def test_cli_exports_a_design_through_the_shipped_surrogate(tmp_path, cache_env)
     r = run(*args, "--json", env=cache_env)
     assert r.returncode == 0, r.stderr
     axes = json.loads(r.stdout)["joint"]["axes"]
-    pred = Surrogate.load_default().predict(pd.DataFrame([DESIGN]))
+    pred = Surrogate.load().predict(pd.DataFrame([DESIGN]))
     k, c = float(pred["k_x"].value[0]), float(pred["c_x"].value[0])
     assert axes["x"]["rig"]["k"] == pytest.approx(k) and axes["x"]["rig"]["c"] == pytest.approx(c)
     assert axes["theta"]["rig"]["k"] == pytest.approx(k * (PRB_GAMMA * 24) ** 2)

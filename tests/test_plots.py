@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -33,8 +34,36 @@ def test_main_effects_match_the_table(table):
     assert set(med.factor) == set(space.FACTOR_NAMES)
 
 
+def assert_inside(fig) -> None:
+    """Everything drawn (texts, legends, ticks) lies inside the figure's canvas: nothing cut at an edge."""
+    fig.canvas.draw()
+    drawn = fig.get_tightbbox(fig.canvas.get_renderer())
+    canvas = fig.bbox_inches
+    assert drawn.x0 >= -0.01 and drawn.y0 >= -0.01, (drawn, canvas)
+    assert drawn.x1 <= canvas.x1 + 0.01 and drawn.y1 <= canvas.y1 + 0.01, (drawn, canvas)
+
+
+def tick_labels(ax) -> list[str]:
+    """The y tick labels as drawn; each must read back as its tick's value (no rounding away)."""
+    ax.figure.canvas.draw()
+    lo, hi = ax.get_ylim()
+    shown = [
+        (t.get_text(), t.get_position()[1]) for t in ax.get_yticklabels() if lo <= t.get_position()[1] <= hi
+    ]
+    for text, value in shown:
+        assert float(text.replace("\u2212", "-")) == pytest.approx(value, rel=1e-9, abs=1e-12), (text, value)
+    return [text for text, _ in shown]
+
+
 def test_effects_png(table, tmp_path):
-    path = effects.plot_effects(table, ["c_x", "k_x"], tmp_path / "effects.png")
+    fig = effects.plot_effects(table, responses=["c_x", "k_x"])
+    assert_inside(fig)
+    # c in N.s/mm: tick labels distinct and readable (0.001, 0.002 ...), never all "0.0"
+    labels = tick_labels(fig.axes[0])
+    assert len(set(labels)) == len(labels) >= 3 and "0.0" not in labels, labels
+    tick_labels(fig.axes[len(space.FACTORS)])  # k_x: 0.25 reads 0.25, not 0.2
+    assert all(t.get_fontsize() >= 9 for t in fig.axes[0].get_yticklabels())
+    path = common.save_figure(fig, tmp_path / "effects.png")
     rgb = assert_picture(path, min_size=(1200, 500))
     # medians are drawn in pure red
     red = (rgb[..., 0] > 0.9) & (rgb[..., 1] < 0.15) & (rgb[..., 2] < 0.15)
@@ -50,9 +79,20 @@ def test_correlations_are_pearson(table):
     assert np.allclose(np.diag(corr), 1.0)
 
 
+def test_plots_draw_into_a_given_empty_figure(table):
+    from matplotlib.figure import Figure
+
+    mine = Figure(figsize=(5, 4))
+    assert heatmap.plot_heatmap(table, responses=["k_x"], fig=mine) is mine and mine.axes
+    with pytest.raises(DesignerError, match="fig= already holds axes"):
+        effects.plot_effects(table, responses=["k_x"], fig=mine)
+
+
 def test_heatmap_png_and_svg(table, tmp_path):
-    assert_picture(heatmap.plot_heatmap(table, ["c_x", "k_x"], tmp_path / "hm.png"))
-    svg = heatmap.plot_heatmap(table, ["c_x", "k_x"], tmp_path / "hm.svg")
+    fig = heatmap.plot_heatmap(table, responses=["c_x", "k_x"])
+    assert_inside(fig)
+    assert_picture(common.save_figure(fig, tmp_path / "hm.png"))
+    svg = common.save_figure(fig, tmp_path / "hm.svg")
     assert svg.read_text().lstrip().startswith("<?xml")
 
 
@@ -64,7 +104,7 @@ def test_bad_names_are_designer_errors(table, tmp_path):
     with pytest.raises(DesignerError, match="unknown axis"):
         common.responses_for(table, None, "w")
     with pytest.raises(DesignerError, match="does not exist"):
-        effects.plot_effects(table, ["k_x"], tmp_path / "missing" / "e.png")
+        common.save_figure(effects.plot_effects(table, responses=["k_x"]), tmp_path / "missing" / "e.png")
 
 
 def designer(*args: str, cwd) -> subprocess.CompletedProcess:
@@ -99,10 +139,41 @@ def test_timeseries_png_with_reference(tmp_path):
 
     t = np.linspace(0, 2, 400)
     frame = pd.DataFrame({"t": t, "joint.x.s": np.exp(-t) * np.sin(9 * t), "joint.x.f": np.cos(9 * t)})
-    assert_picture(
-        plot_timeseries(frame, tmp_path / "ts.png", reference=frame.iloc[::4]), min_size=(800, 300)
-    )
+    fig = plot_timeseries(frame, reference=frame.iloc[::4])
+    assert_inside(fig)
+    assert_picture(common.save_figure(fig, tmp_path / "ts.png"), min_size=(800, 300))
     with pytest.raises(DesignerError, match="no column q"):
-        plot_timeseries(frame, tmp_path / "ts.png", ["q"])
+        plot_timeseries(frame, columns=["q"])
     with pytest.raises(DesignerError, match="no 'time' column"):
-        plot_timeseries(frame, tmp_path / "ts.png", time="time")
+        plot_timeseries(frame, time="time")
+
+
+def test_importing_and_plotting_leave_the_process_alone(tmp_path):
+    """No backend switch, no pyplot, no environment edits: on import, on plotting, on rendering 3D.
+
+    (Matplotlib's own boxplot reads every rcParam, which resolves the default backend as pyplot
+    would for anyone; so the check plots the heat map.)
+    """
+    code = (
+        "import os, sys, matplotlib\n"
+        "backend = dict.__getitem__(matplotlib.rcParams, 'backend'); env = dict(os.environ)\n"
+        "import designer.plots.common, designer.plots.effects, designer.plots.heatmap, designer.plots.loo\n"
+        "import designer.plots.space, designer.plots.timeseries, designer.plots.checks\n"
+        "import designer.plots.profile\n"
+        "assert dict.__getitem__(matplotlib.rcParams, 'backend') is backend, 'backend set on import'\n"
+        "from designer.data import load_table\n"
+        "fig = designer.plots.heatmap.plot_heatmap(load_table(), responses=['k_x'])\n"
+        "designer.plots.common.save_figure(fig, sys.argv[1])\n"
+        "assert dict.__getitem__(matplotlib.rcParams, 'backend') is backend, 'backend switched'\n"
+        "assert 'matplotlib.pyplot' not in sys.modules, 'pyplot imported'\n"
+        "from designer.surrogate import Surrogate\n"
+        "view = designer.plots.space.surface_view(Surrogate.load(), 'k_x', resolution=5)\n"
+        "designer.plots.space.render(view, window=(200, 150)).close()\n"
+        "assert dict(os.environ) == env, 'environment edited'\n"
+        "print('clean')\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k not in ("MPLBACKEND", "VTK_DEFAULT_OPENGL_WINDOW")}
+    run = subprocess.run(
+        [sys.executable, "-I", "-c", code, str(tmp_path / "e.png")], capture_output=True, text=True, env=env
+    )
+    assert run.returncode == 0 and "clean" in run.stdout, run.stderr

@@ -2,27 +2,47 @@
 
 from __future__ import annotations
 
+import json
 import re
 
 import numpy as np
 import pytest
-from imagecheck import assert_picture, chromium, dump_dom
+from imagecheck import assert_picture, chromium, dump_dom, load_rgb
 
 from designer.errors import DesignerError
-from designer.plots import loo, space
+from designer.plots import common, html3d, loo, space
 from designer.surrogate import Surrogate
 
 
 @pytest.fixture(scope="module")
 def sur():
-    return Surrogate.load_default()
+    return Surrogate.load()
+
+
+def assert_margins_clear(rgb: np.ndarray, px: int = 4) -> None:
+    """Nothing drawn in the outer `px` pixels: legends, titles and labels stay inside the picture."""
+    for name, strip in (
+        ("left", rgb[:, :px]),
+        ("right", rgb[:, -px:]),
+        ("top", rgb[:px]),
+        ("bottom", rgb[-px:]),
+    ):
+        assert (strip > 0.9).all(), f"something is drawn at the {name} edge"
+
+
+def axis_labels(plotter, axis: int) -> list[str]:
+    labels = plotter.renderer.cube_axes_actor.GetAxisLabels(axis)
+    return [labels.GetValue(i) for i in range(labels.GetNumberOfValues())]
 
 
 def test_surface_png_and_html(sur, tmp_path):
-    view = space.plot_surface(
-        sur, "k_x", "width", "height", tmp_path / "s.png", target=0.8, html=tmp_path / "s.html"
-    )
-    assert_picture(tmp_path / "s.png", size=space.WINDOW)
+    view = space.surface_view(sur, "k_x", x="width", y="height", target=0.8)
+    plotter = space.render(view)
+    assert all(axis_labels(plotter, 2))
+    space.save_screenshot(plotter, tmp_path / "s.png")
+    plotter.close()
+    assert_margins_clear(assert_picture(tmp_path / "s.png", size=space.WINDOW))
+    html3d.write_scene(view.scene, tmp_path / "s.html")
     assert view.held == {"density": 60.0, "length": 24.0, "layer": 0.16, "raster": 0.0}
     lo, hi = view.value_range
     assert lo < 0.8 < hi and 0 < view.target_in_pi <= 1
@@ -35,10 +55,32 @@ def test_surface_png_and_html(sur, tmp_path):
     dom = dump_dom(exe, tmp_path / "s.html")
     drawn = re.search(r'data-drawn="(\d+)"', dom)
     assert drawn and int(drawn.group(1)) > 1000, "the scene's script did not draw"
+    # the axis titles and ticks are drawn over the scene (after it), inside the canvas
+    labels = json.loads(re.search(r'data-labels="([^"]*)"', dom).group(1).replace("&quot;", '"'))
+    titles = [t for t, *_ in labels]
+    assert {"width (mm)", "height (mm)", "k_x (N/mm)"} <= set(titles)
+    assert all(10 <= x <= 890 and 10 <= y <= 670 for _, x, y in labels), labels
 
 
-def test_surface_follows_the_surrogate(sur, tmp_path):
-    view = space.plot_surface(sur, "k_x", "width", "height", tmp_path / "s.png", fixed={"raster": 45})
+def test_small_values_get_readable_ticks(sur, tmp_path):
+    """c in N.s/mm: distinct z ticks with their digits (0.00172), never a column of "0.0"."""
+    view = space.surface_view(sur, "c_x", resolution=9)
+    plotter = space.render(view, window=(600, 450))
+    z = axis_labels(plotter, 2)
+    cube = plotter.renderer.cube_axes_actor
+    sizes = [cube.GetLabelTextProperty(i).GetFontSize() for i in range(3)]
+    sizes += [cube.GetTitleTextProperty(i).GetFontSize() for i in range(3)]
+    plotter.close()
+    assert min(sizes) >= 14, sizes  # readable ticks and titles (they were 10)
+    assert len(set(z)) == len(z) >= 3 and all(float(t) > 0 for t in z[1:]), z
+    fig = loo.plot_loo(sur, responses=["c_x"])
+    fig.canvas.draw()
+    ticks = [t.get_text() for t in fig.axes[0].get_yticklabels() if t.get_text()]
+    assert len(set(ticks)) == len(ticks) >= 3, ticks
+
+
+def test_surface_follows_the_surrogate(sur):
+    view = space.surface_view(sur, "k_x", x="width", y="height", fixed={"raster": 45})
     assert view.held["raster"] == 45.0 and view.target is None
     import pandas as pd
 
@@ -55,26 +97,31 @@ def test_surface_follows_the_surrogate(sur, tmp_path):
     value = sur.model("k_x").predict(corners).value
     assert view.value_range[0] == pytest.approx(min(value), rel=1e-6)
     assert view.value_range[1] == pytest.approx(max(value), rel=1e-6)
+    assert json.loads(json.dumps(view.to_dict()))["response"] == "k_x"
 
 
 def test_volume_png(sur, tmp_path):
-    view = space.plot_volume(sur, "k_x", ["width", "height", "density"], tmp_path / "v.png", target=0.8)
-    assert_picture(tmp_path / "v.png", size=space.WINDOW)
+    view = space.volume_view(sur, "k_x", factors=["width", "height", "density"], target=0.8)
+    plotter = space.render(view)
+    space.save_screenshot(plotter, tmp_path / "v.png")
+    plotter.close()
+    assert_margins_clear(assert_picture(tmp_path / "v.png", size=space.WINDOW))
     assert set(view.held) == {"length", "layer", "raster"}
 
 
 def test_space_rejects_bad_requests(sur, tmp_path):
     with pytest.raises(DesignerError, match="categorical"):
-        space.plot_surface(sur, "k_x", "layer", "height", tmp_path / "s.png")
+        space.surface_view(sur, "k_x", x="layer", y="height")
     with pytest.raises(DesignerError, match="also held fixed"):
-        space.plot_surface(sur, "k_x", "width", "height", tmp_path / "s.png", fixed={"width": 3})
+        space.surface_view(sur, "k_x", fixed={"width": 3})
     with pytest.raises(DesignerError, match="outside the tested range"):
-        space.plot_surface(sur, "k_x", "width", "height", tmp_path / "s.png", fixed={"density": 200})
+        space.surface_view(sur, "k_x", fixed={"density": 200})
     with pytest.raises(DesignerError, match="no response"):
-        space.plot_surface(sur, "k_z", "width", "height", tmp_path / "s.png")
+        space.surface_view(sur, "k_z")
+    view = space.surface_view(sur, "k_x", resolution=5)
     with pytest.raises(DesignerError, match=".html"):
-        space.plot_surface(sur, "k_x", "width", "height", tmp_path / "s.png", html=tmp_path / "s.txt")
-    assert not (tmp_path / "s.png").exists()
+        html3d.write_scene(view.scene, tmp_path / "s.txt")
+    assert not list(tmp_path.iterdir())
 
 
 def test_loo_table_and_png(sur, tmp_path):
@@ -82,4 +129,6 @@ def test_loo_table_and_png(sur, tmp_path):
     assert len(d) == len(sur.table)
     assert d.covered.mean() == pytest.approx(sur.model("k_x").loo["coverage95"])
     assert np.all(d.lo <= d.predicted) and np.all(d.predicted <= d.hi)
-    assert_picture(loo.plot_loo(sur, sur.responses, tmp_path / "loo.png"), min_size=(800, 400))
+    rgb = load_rgb(common.save_figure(loo.plot_loo(sur), tmp_path / "loo.png"))
+    assert_picture(tmp_path / "loo.png", min_size=(800, 400))
+    assert rgb.shape[1] > rgb.shape[0]

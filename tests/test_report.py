@@ -9,8 +9,10 @@ from pathlib import Path
 import pytest
 from imagecheck import assert_picture, chromium, dump_dom
 
-from designer import report
+from designer import checks, report
 from designer.data import load_table
+from designer.data_checks import check_dataset
+from designer.stats_checks import check_main_effects
 
 
 def test_validate_writes_a_passing_report(tmp_path):
@@ -19,11 +21,11 @@ def test_validate_writes_a_passing_report(tmp_path):
     assert run.returncode == 0, run.stdout + run.stderr
     out = tmp_path / "rep"
     md = (out / "report.md").read_text()
-    names = [c(report.Context(load_table(), tmp_path)).name for c in report.CHECKS[:1]]
+    names = [check_dataset(checks.Context(load_table(), tmp_path)).name]
     assert names[0] in md and "FAIL" not in md
     for png in sorted((out / "figures").glob("*.png")):
         assert_picture(png)
-    assert len(list((out / "figures").glob("*.png"))) >= len(report.CHECKS)
+    assert len(list((out / "figures").glob("*.png"))) >= len(checks.CHECKS)
     for name in ("table4", "fmu_step_response", "identification", "cosim_convergence", "cosim_arm"):
         assert (out / "figures" / f"{name}.png").is_file()
     for title in ("Table 4", "validate_fmu", "libcosimpy", "Identification closed loop", "convergence"):
@@ -32,9 +34,9 @@ def test_validate_writes_a_passing_report(tmp_path):
     if exe is None:
         pytest.skip("no headless Chromium on this machine")
     dom = dump_dom(exe, out / "report.html")
-    assert f'data-checks="{len(report.CHECKS)}"' in dom
-    assert f'data-passed="{len(report.CHECKS)}"' in dom
-    assert dom.count('class="check"') == len(report.CHECKS)
+    assert f'data-checks="{len(checks.CHECKS)}"' in dom
+    assert f'data-passed="{len(checks.CHECKS)}"' in dom
+    assert dom.count('class="check"') == len(checks.CHECKS)
 
 
 def test_a_failing_check_fails_the_report(tmp_path):
@@ -42,13 +44,13 @@ def test_a_failing_check_fails_the_report(tmp_path):
     # triple the stiffness of the widest runs: k_x now rises with width, against the study
     wide = table.width == 7
     table.loc[wide, "k_x"] *= 3
-    ctx = report.Context(table, tmp_path)
-    result = report.check_main_effects(ctx)
+    ctx = checks.Context(table, tmp_path)
+    result = check_main_effects(ctx)
     assert not result.passed
     rows = result.table.set_index(["response", "factor"])
     assert not rows.loc[("k_x", "width"), "agrees"]
     assert rows.loc[("k_x", "height"), "agrees"]
-    results = report.run_checks(ctx, (report.check_dataset, report.check_main_effects))
+    results = checks.run_checks(ctx, (check_dataset, check_main_effects))
     page, md = report.write_report(results, tmp_path, 1.0)
     assert "1 of 2 checks pass" in md.read_text() and "FAIL" in page.read_text()
 
@@ -61,3 +63,31 @@ def test_bad_table_fails_in_one_line(tmp_path):
         [str(exe), "validate", "--table", str(bad), "-o", "rep"], capture_output=True, text=True, cwd=tmp_path
     )
     assert run.returncode == 2 and run.stderr.startswith("error:") and "Traceback" not in run.stderr
+
+
+def test_a_crashing_check_is_a_failed_check_not_an_aborted_report(tmp_path):
+    def check_that_crashes(ctx):
+        raise ZeroDivisionError("a fault inside a library")
+
+    ctx = checks.Context(load_table(), tmp_path)
+    results = checks.run_checks(ctx, (check_that_crashes, check_dataset))
+    assert [r.passed for r in results] == [False, True]
+    assert results[0].summary == "could not run: ZeroDivisionError: a fault inside a library"
+
+
+def test_an_interrupted_report_leaves_the_old_one_whole(tmp_path, monkeypatch):
+    out = tmp_path / "rep"
+    out.mkdir()
+    (out / "report.html").write_text("old report")
+
+    def interrupt(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(report, "run_checks", lambda ctx, progress=None: [])
+    monkeypatch.setattr(report, "write_report", interrupt)
+    with pytest.raises(KeyboardInterrupt):
+        report.validate(out)
+    assert [p.name for p in tmp_path.iterdir()] == ["rep"]
+    assert [p.name for p in out.iterdir()] == ["report.html"] and (
+        out / "report.html"
+    ).read_text() == "old report"

@@ -8,13 +8,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from designer.chirp import Chirp
 from designer.data import load_table
 from designer.errors import DesignerError
 from designer.mass import specimen_mass
 from designer.rig.clean import clean
 from designer.rig.identify import identify, results_table
 from designer.rig.logs import read_log, sidecar_path, validate_frame, write_log
-from designer.rig.simulate import Chirp, simulate
+from designer.rig.simulate import simulate
 
 FACTORS = {"density": 60, "length": 24, "width": 4.5, "height": 9, "layer": 0.16, "raster": 0}
 CLI = [sys.executable, "-I", "-c", "from designer_cli.main import main; main()"]
@@ -53,9 +54,9 @@ def test_strong_inertial_excitation_recovers_m_within_5_percent():
 
 
 def test_chirp_derivatives_are_exact():
-    chirp = Chirp(duration=50.0)
+    chirp = Chirp(sweep=50.0)
     t = np.linspace(0, 50, 200001)
-    q, dq, ddq = chirp(t)
+    q, dq, ddq = chirp.motion(t)
     assert np.abs(np.gradient(q, t) - dq)[10:-10].max() < 1e-4
     assert np.abs(np.gradient(dq, t) - ddq)[10:-10].max() < 1e-3
     # the instantaneous frequency sweeps 0.2 -> 1.85 Hz

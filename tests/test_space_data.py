@@ -18,14 +18,14 @@ def test_bundled_table_is_the_study_table():
 
 
 def test_validate_names_factor_value_and_range():
-    ok = space.validate(dict(density=60, length=24, width=4.5, height=9, layer=0.16, raster=0))
+    ok = space.check_design(dict(density=60, length=24, width=4.5, height=9, layer=0.16, raster=0))
     assert ok["layer"] == 0.16
     with pytest.raises(DesignerError, match=r"width = 9 mm is outside the tested range 2 to 7 mm"):
-        space.validate(dict(density=60, length=24, width=9, height=9, layer=0.16, raster=0))
+        space.check_design(dict(density=60, length=24, width=9, height=9, layer=0.16, raster=0))
     with pytest.raises(DesignerError, match="layer = 0.15 mm is not a tested level"):
         space.check_value("layer", 0.15)
     with pytest.raises(DesignerError, match="missing factor"):
-        space.validate(dict(density=60))
+        space.check_design(dict(density=60))
     with pytest.raises(DesignerError, match="unknown factor 'colour'"):
         space.check_value("colour", 1)
     with pytest.raises(DesignerError, match="not a finite number"):

@@ -11,19 +11,19 @@ from designer.surrogate import Surrogate
 
 @pytest.fixture(scope="module")
 def sur():
-    return Surrogate.load_default()
+    return Surrogate.load()
 
 
 def test_flagship_target(sur):
     r = suggest(sur, k=0.8, c=2e-3)
     top = r.candidates[0]
-    assert abs(top.predicted["k"]["value"] / 0.8 - 1) <= 0.02
-    lo, hi = top.predicted["k"]["pi95"]
+    assert abs(top.predicted["k"].value / 0.8 - 1) <= 0.02
+    lo, hi = top.predicted["k"].low, top.predicted["k"].high
     assert lo < 0.8 < hi
     assert r.reachable
     assert any("c_x is not predictable" in s for s in r.statements)
     assert r.predictability["k"]["q2"] >= 0.4
-    space.validate(top.params)  # printable and in range
+    space.check_design(top.params)  # printable and in range
     # distinct candidates, ranked by desirability
     assert len(r.candidates) == 5
     d = [c.desirability for c in r.candidates]
@@ -36,9 +36,9 @@ def test_round_trip_on_random_designs(sur):
     for _ in range(20):
         design = {f.name: rng.uniform(f.low, f.high) for f in space.CONTINUOUS}
         design |= {f.name: rng.choice(f.levels) for f in space.CATEGORICAL}
-        k = float(sur.predict(design, ["k_x"])["k_x"].value[0])
+        k = float(sur.predict(design, responses=["k_x"])["k_x"].value[0])
         top = suggest(sur, k=k, top=1).candidates[0]
-        assert abs(top.predicted["k"]["value"] / k - 1) <= 0.01, (design, k, top)
+        assert abs(top.predicted["k"].value / k - 1) <= 0.01, (design, k, top)
 
 
 def test_unreachable_target_says_so_with_nearest_designs(sur):
@@ -46,7 +46,7 @@ def test_unreachable_target_says_so_with_nearest_designs(sur):
     assert not r.reachable
     text = " ".join(r.statements)
     assert "outside the measured range" in text and "out of reach" in text
-    best = r.candidates[0].predicted["k"]["value"]
+    best = r.candidates[0].predicted["k"].value
     assert 1.0 < best < 5.0
     # the nearest design is the stiffest the tested ranges allow: the reachable maximum
     assert f"to {best:.3g} N/mm" in text
@@ -56,7 +56,7 @@ def test_extrapolation_only_when_asked(sur):
     inside = suggest(sur, k=2.5, top=1).candidates[0]
     assert not inside.extrapolated
     outside = suggest(sur, k=2.5, top=1, allow_extrapolation=True).candidates[0]
-    assert outside.predicted["k"]["value"] > inside.predicted["k"]["value"]
+    assert outside.predicted["k"].value > inside.predicted["k"].value
     assert outside.extrapolated and any("extrapolation" in n for n in outside.notes)
 
 

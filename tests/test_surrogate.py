@@ -16,7 +16,7 @@ def refit():
 
 
 def test_shipped_surrogate_equals_a_refit_of_the_bundled_table(refit):
-    shipped = Surrogate.load_default()
+    shipped = Surrogate.load()
     assert shipped.table_hash == data.table_hash(data.load_table())
     assert shipped.responses == refit.responses
     for r in refit.responses:
@@ -55,11 +55,11 @@ def test_leave_one_out_is_an_honest_refit():
 def test_prediction_intervals_and_casadi_function_agree(refit):
     design = dict(density=60, length=24, width=4.5, height=9, layer=0.16, raster=0)
     for r in refit.responses:
-        p = refit.predict(design, [r])[r]
-        assert p.lo[0] < p.value[0] < p.hi[0]
+        p = refit.predict(design, responses=[r])[r]
+        assert p.low[0] < p.value[0] < p.high[0]
         f = refit.models[r].casadi_function()
         out = f([design[n] for n in space.FACTOR_NAMES])
-        assert [float(v) for v in out] == pytest.approx([p.value[0], p.lo[0], p.hi[0]], rel=1e-12)
+        assert [float(v) for v in out] == pytest.approx([p.value[0], p.low[0], p.high[0]], rel=1e-12)
 
 
 def test_vectorised_prediction_matches_single(refit):

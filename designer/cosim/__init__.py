@@ -1,18 +1,33 @@
-"""Co-simulation of joint FMUs with a MuJoCo robot or the virtual rig: master, robot adapter, scenarios."""
+"""Co-simulation of joint FMUs with a MuJoCo robot or the virtual rig.
 
-from .master import Master, Result
+sc = designer.cosim.load("examples/two_link_arm.toml")    # or designer.cosim.Scenario(...)
+result = designer.cosim.run(sc)                           # in memory, nothing written
+frame = result.to_frame()                                 # t [s], then system.variable in SI
+designer.cosim.write_outputs(result, "results/")          # time series, metrics.json, plot.png
+"""
+
+from .master import Master, Trace
+from .references import Chirp, Sine, Step, Trajectory
 from .robot import Robot, SpringDamper, load_spec, planar_arm_xml
-from .run import simulate
-from .scenario import Scenario, load
+from .run import Result, plot_result, run, write_outputs
+from .scenario import JointSource, Scenario, load
 
 __all__ = [
+    "Chirp",
+    "JointSource",
     "Master",
     "Result",
     "Robot",
-    "SpringDamper",
     "Scenario",
+    "Sine",
+    "SpringDamper",
+    "Step",
+    "Trace",
+    "Trajectory",
     "load",
     "load_spec",
     "planar_arm_xml",
-    "simulate",
+    "plot_result",
+    "run",
+    "write_outputs",
 ]

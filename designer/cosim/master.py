@@ -31,7 +31,7 @@ class System(Protocol):
 
 
 @dataclass(frozen=True)
-class Result:
+class Trace:
     """Time series of every output, columns named `system.variable`, rows at t = 0, h, ..., N h."""
 
     time: np.ndarray
@@ -145,7 +145,7 @@ class Master:
         duration: float,
         step: float,
         progress: Callable[[float], None] | None = None,
-    ) -> Result:
+    ) -> Trace:
         """Run from 0 to `duration` with macro step `step`; outputs are recorded after each exchange."""
         if not (np.isfinite(step) and step > 0):
             raise DesignerError(f"step {step:g} s is not positive", "give a positive step in seconds")
@@ -169,4 +169,4 @@ class Master:
                 progress(i / n)
         if progress is not None:
             progress(1.0)
-        return Result(time=np.arange(n + 1) * step, columns=self.columns, values=values)
+        return Trace(time=np.arange(n + 1) * step, columns=self.columns, values=values)

@@ -8,9 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..chirp import Chirp
 from ..errors import DesignerError
-from ..rig.simulate import DURATION, F0, F1, HUB_AMPLITUDE
-from ..rig.simulate import Chirp as RigChirp
 
 
 @dataclass(frozen=True)
@@ -40,20 +39,6 @@ class Sine:
             self.offset + self.amplitude * math.sin(w * t + self.phase),
             self.amplitude * w * math.cos(w * t + self.phase),
         )
-
-
-@dataclass(frozen=True)
-class Chirp:
-    """The rig's hub motion: amplitude sin(2 pi (f0 t + (f1 - f0) t^2 / (2 sweep))), the study's sweep."""
-
-    amplitude: float = HUB_AMPLITUDE
-    f0: float = F0
-    f1: float = F1
-    sweep: float = DURATION
-
-    def __call__(self, t: float) -> tuple[float, float]:
-        q, dq, _ = RigChirp(self.f0, self.f1, self.sweep)(t)
-        return self.amplitude * float(q), self.amplitude * float(dq)
 
 
 @dataclass(frozen=True)

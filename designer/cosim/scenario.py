@@ -1,13 +1,17 @@
-"""Scenario files (TOML): parsed and checked completely before anything runs.
+"""Scenarios: what to co-simulate, built in code (checked when built) or read from a TOML file.
 
-A scenario is either a robot (`[robot]` and `[joints.NAME]`) or the virtual rig (`[rig]`); both
-take `[simulation]`, `[outputs]` and `[validation]`. The README documents every key.
+A scenario is either a robot (`joints`: flexible joints of a MuJoCo model, each driven by a motor
+reference) or the virtual rig (`rig_joint` driven by the hub chirp). `Scenario(...)` checks every
+value when it is built, so a run never starts on a bad scenario; `load(path)` also checks the file's
+keys and types and names the file and key of the first problem. The README documents every key.
 """
 
 from __future__ import annotations
 
 import math
+import os
 import sys
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -19,192 +23,325 @@ else:
 
 from .. import units
 from ..errors import DesignerError
-from ..joint import Joint, from_coefficients
+from ..joint import Joint, from_one_source
+from ..keys import check_keys
 from .master import ALGORITHMS
 from .references import Chirp, Reference, Sine, Step, Trajectory
 from .robot import ARM_LENGTHS, ARM_MASSES, INTEGRATORS
 
 FMI_VERSIONS = (2, 3)
+OUTPUTS = ("csv", "parquet", "plot")
+#: the FMU parameters a scenario may override, per axis ("theta.k")
+PARAMETER_FIELDS = ("m", "c", "k", "offset", "enabled")
+#: a run's results may take at most this share of the memory available when it starts
+MEMORY_SHARE = 0.5
 
 
 @dataclass(frozen=True)
 class JointSource:
-    """Where a joint FMU comes from: a file, or a joint (coefficients, design, suggestion) to export."""
+    """Where a joint FMU comes from: an FMU file, or a `Joint` exported on the fly.
 
-    axis: str
+    `parameters` overrides FMU parameters in SI, keyed "axis.field" (e.g. {"theta.k": 0.3}).
+
+    Raises:
+        DesignerError: not exactly one of `fmu` and `joint`, an unknown axis, an FMU file that is
+            missing or lacks the axis, a joint without the axis, a bad `fmi_version` or parameter.
+    """
+
+    axis: str = "theta"
     fmu: Path | None = None
     joint: Joint | None = None
     fmi_version: int = 2
-    parameters: dict[str, float] = field(default_factory=dict)
+    parameters: Mapping[str, float] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        units.check_axis(self.axis)
+        if (self.fmu is None) == (self.joint is None):
+            raise DesignerError("a JointSource needs exactly one of fmu= or joint=", "give one of them")
+        if self.fmi_version not in FMI_VERSIONS:
+            raise DesignerError(f"fmi_version = {self.fmi_version!r} is not supported", "use 2 or 3")
+        for key, value in self.parameters.items():
+            axis, _, name = str(key).partition(".")
+            if axis != self.axis or name not in PARAMETER_FIELDS:
+                raise DesignerError(
+                    f"parameter '{key}' is not a parameter of axis {self.axis}",
+                    f"use {', '.join(f'{self.axis}.{f}' for f in PARAMETER_FIELDS)}",
+                )
+            _finite(value, f"parameter '{key}'")
+        if self.fmu is not None:
+            from .fmu import check_fmu
+
+            object.__setattr__(self, "fmu", Path(self.fmu))
+            check_fmu(self.fmu, [self.axis])
+        else:
+            self.joint.axis(self.axis)
 
 
 @dataclass(frozen=True)
 class Scenario:
-    """A checked scenario: kind "robot" or "rig", times in s, paths absolute."""
+    """A checked scenario; times in s, lengths in m, masses in kg, paths absolute.
 
-    path: Path
-    kind: str
+    Robot: `joints` maps hinge or slide joints of the model (None: the built-in planar arm with
+    `lengths` and `masses`, hinges j1..jN) to their `JointSource`; `motors` gives each joint's motor
+    reference (default: held at 0). Rig: `rig_joint` (needs a mass) is driven by `hub` (default:
+    the study's chirp, 1 rad, 0.2 to 1.85 Hz over 2200 s); `factors` go into the rig log's sidecar.
+    `validation_steps` default to the step halved three times; `validation_duration` to `duration`.
+    `path` is the file the scenario was read from, if any.
+
+    Raises:
+        DesignerError: the first value that is out of range or inconsistent, naming its field.
+    """
+
     duration: float
     step: float
-    algorithm: str = "gauss-seidel"
-    integrator: str = "euler"
-    #: robot: the model file (None: the built-in planar arm) and the arm's links
+    joints: Mapping[str, JointSource] = field(default_factory=dict)
+    motors: Mapping[str, Reference] = field(default_factory=dict)
     model: Path | None = None
     lengths: tuple[float, ...] = ARM_LENGTHS
     masses: tuple[float, ...] = ARM_MASSES
-    #: robot: per robot joint, its FMU source and its motor reference
-    joints: dict[str, JointSource] = field(default_factory=dict)
-    motors: dict[str, Reference] = field(default_factory=dict)
-    #: rig: the joint, its hub motion and the specimen's factors for the log's sidecar
     rig_joint: JointSource | None = None
     hub: Chirp | None = None
-    factors: dict[str, float] | None = None
-    outputs: dict[str, bool] = field(default_factory=lambda: {"csv": True, "parquet": True, "plot": True})
-    #: macro steps of the validation, s, and the span it covers
+    factors: Mapping[str, float] | None = None
+    algorithm: str = "gauss-seidel"
+    integrator: str = "euler"
+    outputs: Mapping[str, bool] = field(default_factory=dict)
     validation_steps: tuple[float, ...] = ()
-    validation_duration: float = 0.0
+    validation_duration: float | None = None
+    path: Path | None = None
+
+    @property
+    def kind(self) -> str:
+        """ "robot" or "rig"."""
+        return "rig" if self.rig_joint is not None else "robot"
+
+    def __post_init__(self) -> None:
+        step, duration = _positive(self.step, "step"), _positive(self.duration, "duration")
+        if duration < step:
+            raise DesignerError(f"duration = {duration:g} s is shorter than step = {step:g} s", "lengthen it")
+        _one_of(self.algorithm, ALGORITHMS, "algorithm")
+        _one_of(self.integrator, INTEGRATORS, "integrator")
+        if bool(self.joints) == (self.rig_joint is not None):
+            raise DesignerError(
+                "a scenario needs joints (a robot) or rig_joint (the virtual rig), not both or neither",
+                "give joints={'j1': JointSource(...)} or rig_joint=JointSource(...)",
+            )
+        if self.kind == "robot":
+            self._check_robot()
+        else:
+            self._check_rig()
+        unknown = set(self.outputs) - set(OUTPUTS)
+        if unknown or not all(isinstance(v, bool) for v in self.outputs.values()):
+            raise DesignerError(
+                f"outputs = {dict(self.outputs)} is not a set of switches", "use csv, parquet, plot"
+            )
+        object.__setattr__(self, "outputs", {k: bool(self.outputs.get(k, True)) for k in OUTPUTS})
+        self._check_validation()
+        check_memory(self)
+
+    def _check_robot(self) -> None:
+        from .robot import check_joints, load_spec
+
+        if self.model is not None:
+            object.__setattr__(self, "model", Path(self.model))
+        else:
+            lengths = tuple(_positive(v, "lengths") for v in self.lengths)
+            masses = tuple(_positive(v, "masses") for v in self.masses)
+            if not lengths or len(lengths) != len(masses):
+                raise DesignerError(
+                    f"lengths ({len(lengths)}) and masses ({len(masses)}) differ in number",
+                    "give one length and one mass per link",
+                )
+            object.__setattr__(self, "lengths", lengths)
+            object.__setattr__(self, "masses", masses)
+        check_joints(load_spec(self.model, self.lengths, self.masses), list(self.joints))
+        for name, src in self.joints.items():
+            if not isinstance(src, JointSource):
+                raise DesignerError(f"joints['{name}'] is a {type(src).__name__}", "give a JointSource")
+        extra = set(self.motors) - set(self.joints)
+        if extra:
+            raise DesignerError(
+                f"motors name joint(s) without a flexible joint: {', '.join(sorted(extra))}",
+                f"flexible joints: {', '.join(self.joints)}",
+            )
+        for name, ref in self.motors.items():
+            if not isinstance(ref, (Step, Sine, Chirp, Trajectory)):
+                raise DesignerError(
+                    f"motors['{name}'] is a {type(ref).__name__}", "give a Step, Sine, Chirp or Trajectory"
+                )
+        object.__setattr__(self, "motors", {j: self.motors.get(j, Step(0.0)) for j in self.joints})
+
+    def _check_rig(self) -> None:
+        src = self.rig_joint
+        if not isinstance(src, JointSource):
+            raise DesignerError(f"rig_joint is a {type(src).__name__}", "give a JointSource")
+        if src.joint is not None and src.joint.axis(src.axis).m is None:
+            raise DesignerError(
+                f"the rig joint has no mass on axis {src.axis}",
+                "give its m, or build it from a design so the mass follows from geometry",
+            )
+        if self.hub is None:
+            object.__setattr__(self, "hub", Chirp())
+        if self.factors is not None:
+            from .. import space
+
+            object.__setattr__(self, "factors", space.check_design(self.factors))
+
+    def _check_validation(self) -> None:
+        steps = self.validation_steps or tuple(self.step / 2**i for i in range(4))
+        steps = tuple(_positive(s, "validation_steps") for s in steps)
+        if len(steps) < 2:
+            raise DesignerError(
+                f"validation_steps = {list(steps)} lists fewer than two steps", "e.g. [1e-3, 5e-4]"
+            )
+        span = (
+            self.duration
+            if self.validation_duration is None
+            else _positive(self.validation_duration, "validation_duration")
+        )
+        object.__setattr__(self, "validation_steps", steps)
+        object.__setattr__(self, "validation_duration", min(span, self.duration))
+
+    def signals(self) -> int:
+        """How many signals a run records per step (the width of its result)."""
+        return 6 if self.kind == "rig" else 5 * len(self.joints)
 
 
-def _where(path: Path, key: str) -> str:
-    return f"{path.name}: {key}"
+def check_memory(sc: Scenario) -> None:
+    """Refuse a run whose results would not fit in memory, before anything is allocated.
+
+    Raises:
+        DesignerError: with the estimate and what is available.
+    """
+    rows = sc.duration / sc.step + 1
+    need = 8.0 * rows * (sc.signals() + 1)
+    avail = _available_memory()
+    if need > MEMORY_SHARE * avail:
+        raise DesignerError(
+            f"duration = {sc.duration:g} s at step = {sc.step:g} s is {rows:.3g} steps, about "
+            f"{_size(need)} of results; {_size(avail)} of memory is available",
+            "shorten the duration or lengthen the step",
+        )
 
 
-def _table(doc: dict, key: str, path: Path, required: bool = False) -> dict:
-    value = doc.get(key, {} if not required else None)
-    if value is None:
-        raise DesignerError(f"{path.name} has no [{key}] table", "see the scenario format in the README")
-    if not isinstance(value, dict):
-        raise DesignerError(f"{_where(path, key)} must be a table", "see the scenario format in the README")
-    return value
+def _available_memory() -> float:
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return float(line.split()[1]) * 1024.0
+    except OSError:
+        pass
+    return float(os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
 
 
-def _number(table: dict, key: str, path: Path, default: float | None = None, positive: bool = True) -> float:
-    value = table.get(key, default)
-    if value is None:
-        raise DesignerError(f"{_where(path, key)} is missing", "give it a number")
+def _size(n: float) -> str:
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
+        if n < 1024 or unit == "PiB":
+            return f"{n:.3g} {unit}"
+        n /= 1024
+    return f"{n:.3g} PiB"
+
+
+def _finite(value: Any, what: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise DesignerError(f"{_where(path, key)} = {value!r} is not a number", "give a finite number")
-    if positive and value <= 0:
-        raise DesignerError(f"{_where(path, key)} = {value:g} must be positive", "give a positive number")
+        raise DesignerError(f"{what} = {value!r} is not a finite number", "give a finite number")
     return float(value)
 
 
-def _choice(table: dict, key: str, options: tuple, path: Path, default):
-    value = table.get(key, default)
+def _positive(value: Any, what: str) -> float:
+    v = _finite(value, what)
+    if v <= 0:
+        raise DesignerError(f"{what} = {v:g} must be positive", "give a positive number")
+    return v
+
+
+def _one_of(value: Any, options: tuple, what: str) -> None:
     if value not in options:
         raise DesignerError(
-            f"{_where(path, key)} = {value!r} is not allowed", f"use one of: {', '.join(map(str, options))}"
+            f"{what} = {value!r} is not allowed", f"use one of: {', '.join(map(str, options))}"
         )
-    return value
 
 
-def _file(value: Any, key: str, path: Path) -> Path:
-    if not isinstance(value, str):
-        raise DesignerError(f"{_where(path, key)} must be a path", "give a file path as a string")
-    p = Path(value)
-    return p if p.is_absolute() else (path.parent / p).resolve()
+# ---------------------------------------------------------------- reading a TOML file
 
-
-def _reference(spec: Any, key: str, path: Path) -> Reference:
-    if not isinstance(spec, dict) or "type" not in spec:
-        raise DesignerError(
-            f"{_where(path, key)} must be a table with a type",
-            'e.g. {type = "sine", amplitude = 0.5, frequency = 1}',
-        )
-    kind = spec["type"]
-    if kind == "step":
-        return Step(
-            _number(spec, "amplitude", path, positive=False),
-            _number(spec, "at", path, 0.0, positive=False),
-            _number(spec, "initial", path, 0.0, positive=False),
-        )
-    if kind == "sine":
-        return Sine(
-            _number(spec, "amplitude", path, positive=False),
-            _number(spec, "frequency", path),
-            _number(spec, "offset", path, 0.0, positive=False),
-            _number(spec, "phase", path, 0.0, positive=False),
-        )
-    if kind == "chirp":
-        return _chirp(spec, path)
-    if kind == "csv":
-        return Trajectory.from_csv(_file(spec.get("file"), f"{key}.file", path), spec.get("column", "q"))
-    raise DesignerError(
-        f"{_where(path, key)}: unknown reference type {kind!r}", "use step, sine, chirp or csv"
-    )
-
-
-def _chirp(spec: dict, path: Path) -> Chirp:
-    base = Chirp()
-    return Chirp(
-        _number(spec, "amplitude", path, base.amplitude),
-        _number(spec, "f0", path, base.f0),
-        _number(spec, "f1", path, base.f1),
-        _number(spec, "sweep", path, base.sweep),
-    )
-
-
+#: keys of each table of a scenario file
+KEYS = {
+    "": ("simulation", "robot", "joints", "rig", "outputs", "validation"),
+    "simulation": ("duration", "step", "algorithm", "integrator"),
+    "robot": ("model", "lengths", "masses"),
+    "joint": (
+        "fmu",
+        "coefficients",
+        "design",
+        "suggestion",
+        "candidate",
+        "axis",
+        "fmi_version",
+        "parameters",
+        "reference",
+    ),
+    "rig": ("joint", "amplitude", "f0", "f1", "sweep", "factors"),
+    "validation": ("steps", "duration"),
+    "step": ("type", "amplitude", "at", "initial"),
+    "sine": ("type", "amplitude", "frequency", "offset", "phase"),
+    "chirp": ("type", "amplitude", "f0", "f1", "sweep"),
+    "csv": ("type", "file", "column"),
+}
 SOURCES = ("fmu", "coefficients", "design", "suggestion")
 
 
-def _joint_source(spec: Any, key: str, path: Path, default_axis: str, name: str) -> JointSource:
-    if not isinstance(spec, dict):
-        raise DesignerError(f"{_where(path, key)} must be a table", "see the scenario format in the README")
-    axis = units.check_axis(spec.get("axis", default_axis))
-    version = _choice(spec, "fmi_version", FMI_VERSIONS, path, 2)
-    params = spec.get("parameters", {})
-    if not isinstance(params, dict):
-        raise DesignerError(f"{_where(path, key)}.parameters must be a table", 'e.g. {"theta.k" = 0.3}')
-    has = [k for k in SOURCES if k in spec]
-    if len(has) != 1:
-        raise DesignerError(
-            f"{_where(path, key)} needs exactly one of {', '.join(SOURCES)}",
-            f"it has: {', '.join(has) or 'none'}",
-        )
-    if "candidate" in spec and "suggestion" not in spec:
-        raise DesignerError(f"{_where(path, key)}.candidate needs a suggestion", 'add suggestion = "s.json"')
-    if "fmu" in spec:
-        fmu = _file(spec["fmu"], f"{key}.fmu", path)
-        from .fmu import check_fmu
+class _Doc:
+    """A scenario file's tables with the file's name for messages."""
 
-        check_fmu(fmu, [axis])
-        return JointSource(axis=axis, fmu=fmu, fmi_version=version, parameters=params)
-    joint = _joint(spec, key, path, axis, name)
-    return JointSource(axis=axis, joint=joint, fmi_version=version, parameters=params)
+    def __init__(self, path: Path) -> None:
+        self.path = path
 
+    def where(self, key: str) -> str:
+        return f"{self.path.name}: {key}"
 
-def _joint(spec: dict, key: str, path: Path, axis: str, name: str) -> Joint:
-    """The joint of a coefficients, design (through the default surrogate) or suggestion source."""
-    from ..export import sources
+    def table(self, doc: Mapping, key: str, keys: str | None = None, required: bool = False) -> dict:
+        value = doc.get(key.rpartition(".")[2])
+        if value is None:
+            if required:
+                raise DesignerError(
+                    f"{self.path.name} has no [{key}] table", "see the scenario format in the README"
+                )
+            return {}
+        if not isinstance(value, dict):
+            raise DesignerError(f"{self.where(key)} must be a table", "see the scenario format in the README")
+        if keys is not None:
+            check_keys(value, KEYS[keys], where=f"[{key}] of {self.path.name}")
+        return value
 
-    if "suggestion" in spec:
-        candidate = spec.get("candidate", 1)
-        if isinstance(candidate, bool) or not isinstance(candidate, int):
+    def number(self, table: Mapping, key: str, where: str, default: float | None = None) -> float | None:
+        value = table.get(key, default)
+        if value is None:
+            return None
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
             raise DesignerError(
-                f"{_where(path, key)}.candidate = {candidate!r} is not a whole number", "1 = best"
+                f"{self.where(where + key)} = {value!r} is not a number", "give a finite number"
             )
-        return sources.from_suggestion(
-            _file(spec["suggestion"], f"{key}.suggestion", path), candidate, [axis], name
-        )
-    if "design" in spec:
-        design = spec["design"]
-        if not isinstance(design, dict):
-            raise DesignerError(
-                f"{_where(path, key)}.design must be a table of the six print settings",
-                "e.g. {density = 60, length = 24, width = 4.5, height = 9, layer = 0.16, raster = 45}",
-            )
-        return sources.from_design(design, [axis], name)
-    coef = spec["coefficients"]
-    if not isinstance(coef, dict) or not {"k", "c"} <= set(coef):
-        raise DesignerError(
-            f"{_where(path, key)}.coefficients needs k and c (rig units)", "e.g. {k = 300, c = 0.8, m = 2e-6}"
-        )
-    coef = {q: _number(coef, q, path, positive=q != "c") for q in coef}
-    return from_coefficients({axis: coef}, name=name)
+        return float(value)
+
+    def required(self, table: Mapping, key: str, where: str) -> float:
+        if key not in table:
+            raise DesignerError(f"{self.where(where + key)} is missing", "give it a number")
+        return self.number(table, key, where)
+
+    def file(self, value: Any, key: str) -> Path:
+        if not isinstance(value, str):
+            raise DesignerError(f"{self.where(key)} must be a path", "give a file path as a string")
+        p = Path(value)
+        return p if p.is_absolute() else (self.path.parent / p).resolve()
 
 
 def load(path: str | Path) -> Scenario:
-    """Read and check a scenario file; every problem raises a DesignerError before anything runs."""
+    """Read and check a scenario file; every problem raises a DesignerError before anything runs.
+
+    Raises:
+        DesignerError: a missing or malformed file, an unknown key (with the closest valid one), a
+            value of the wrong type or out of range, naming the file and the key.
+    """
     path = Path(path).resolve()
     if not path.is_file():
         raise DesignerError(f"scenario {path} does not exist", "give the path of a .toml scenario file")
@@ -212,74 +349,128 @@ def load(path: str | Path) -> Scenario:
         doc = tomllib.loads(path.read_text())
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise DesignerError(f"{path.name} is not valid TOML: {exc}", "fix the syntax") from None
-    sim = _table(doc, "simulation", path, required=True)
-    step = _number(sim, "step", path)
-    duration = _number(sim, "duration", path)
-    if duration < step:
-        raise DesignerError(f"duration {duration:g} s is shorter than the step {step:g} s", "lengthen it")
-    out = {k: True for k in ("csv", "parquet", "plot")}
-    for k, v in _table(doc, "outputs", path).items():
-        if k not in out or not isinstance(v, bool):
-            raise DesignerError(
-                f"{_where(path, 'outputs.' + k)} is not an output switch",
-                "use csv, parquet, plot = true|false",
-            )
-        out[k] = v
-    val = _table(doc, "validation", path)
-    steps = val.get("steps", [step / 2**i for i in range(4)])
-    if not isinstance(steps, list) or len(steps) < 2:
-        raise DesignerError(
-            f"{_where(path, 'validation.steps')} must list at least two steps", "e.g. [1e-3, 5e-4]"
-        )
-    steps = tuple(_number({"step": s}, "step", path) for s in steps)
+    d = _Doc(path)
+    check_keys(doc, KEYS[""], where=path.name)
+    sim = d.table(doc, "simulation", "simulation", required=True)
+    outputs = d.table(doc, "outputs")
+    check_keys(outputs, OUTPUTS, where=f"[outputs] of {path.name}")
+    val = d.table(doc, "validation", "validation")
+    steps = val.get("steps", [])
+    if not isinstance(steps, list):
+        raise DesignerError(f"{d.where('validation.steps')} must be a list of steps", "e.g. [1e-3, 5e-4]")
     common = dict(
         path=path,
-        duration=duration,
-        step=step,
-        algorithm=_choice(sim, "algorithm", ALGORITHMS, path, "gauss-seidel"),
-        integrator=_choice(sim, "integrator", INTEGRATORS, path, "euler"),
-        outputs=out,
-        validation_steps=steps,
-        validation_duration=min(_number(val, "duration", path, duration), duration),
+        duration=d.required(sim, "duration", "simulation."),
+        step=d.required(sim, "step", "simulation."),
+        algorithm=sim.get("algorithm", "gauss-seidel"),
+        integrator=sim.get("integrator", "euler"),
+        outputs=outputs,
+        validation_steps=tuple(d.number({"steps": s}, "steps", "validation.") for s in steps),
+        validation_duration=d.number(val, "duration", "validation."),
     )
     if ("rig" in doc) == ("robot" in doc):
         raise DesignerError(f"{path.name} needs exactly one of [robot] or [rig]", "see the README")
-    if "rig" in doc:
-        rig = _table(doc, "rig", path)
-        factors = rig.get("factors")
-        if factors is not None:
-            from .. import space
-
-            factors = space.validate(factors)
-        return Scenario(
-            kind="rig",
-            rig_joint=_joint_source(rig.get("joint"), "rig.joint", path, "theta", "joint_rig"),
-            hub=_chirp(rig, path),
-            factors=factors,
-            **common,
-        )
-    return _robot(doc, path, common)
+    try:
+        return _rig(doc, d, common) if "rig" in doc else _robot(doc, d, common)
+    except DesignerError as exc:
+        if exc.problem.startswith(path.name):
+            raise
+        raise DesignerError(f"{path.name}: {exc.problem}", exc.fix) from None
 
 
-def _robot(doc: dict, path: Path, common: dict) -> Scenario:
-    from .robot import check_joints, load_spec
-
-    robot = _table(doc, "robot", path)
-    model = robot.get("model", "arm")
-    model_path = None if model == "arm" else _file(model, "robot.model", path)
-    lengths = tuple(robot.get("lengths", ARM_LENGTHS))
-    masses = tuple(robot.get("masses", ARM_MASSES))
-    spec = load_spec(model_path, lengths, masses)
-    joints_doc = _table(doc, "joints", path, required=True)
-    if not joints_doc:
-        raise DesignerError(f"{path.name} maps no joint", "add a [joints.NAME] table per flexible joint")
-    check_joints(spec, list(joints_doc))
-    joints, motors = {}, {}
-    for name, spec_j in joints_doc.items():
-        joints[name] = _joint_source(spec_j, f"joints.{name}", path, "theta", f"joint_{name}")
-        motors[name] = _reference(
-            spec_j.get("reference", {"type": "step", "amplitude": 0.0}), f"joints.{name}.reference", path
-        )
+def _rig(doc: Mapping, d: _Doc, common: dict) -> Scenario:
+    rig = d.table(doc, "rig", "rig")
+    base = Chirp()
+    hub = Chirp(*(d.number(rig, k, "rig.", getattr(base, k)) for k in ("amplitude", "f0", "f1", "sweep")))
     return Scenario(
-        kind="robot", model=model_path, lengths=lengths, masses=masses, joints=joints, motors=motors, **common
+        rig_joint=_joint_source(rig.get("joint"), "rig.joint", d, "joint_rig"),
+        hub=hub,
+        factors=rig.get("factors"),
+        **common,
     )
+
+
+def _robot(doc: Mapping, d: _Doc, common: dict) -> Scenario:
+    robot = d.table(doc, "robot", "robot")
+    model = robot.get("model", "arm")
+    joints_doc = d.table(doc, "joints", required=True)
+    if not joints_doc:
+        raise DesignerError(f"{d.path.name} maps no joint", "add a [joints.NAME] table per flexible joint")
+    joints, motors = {}, {}
+    for name, spec in joints_doc.items():
+        key = f"joints.{name}"
+        joints[name] = _joint_source(spec, key, d, f"joint_{name}")
+        motors[name] = _reference(
+            spec.get("reference", {"type": "step", "amplitude": 0.0}), f"{key}.reference", d
+        )
+    lengths = robot.get("lengths", list(ARM_LENGTHS))
+    masses = robot.get("masses", list(ARM_MASSES))
+    for key, value in (("lengths", lengths), ("masses", masses)):
+        if not isinstance(value, list):
+            raise DesignerError(f"{d.where('robot.' + key)} must be a list of numbers", "e.g. [0.08, 0.06]")
+    return Scenario(
+        model=None if model == "arm" else d.file(model, "robot.model"),
+        lengths=tuple(d.number({"lengths": x}, "lengths", "robot.") for x in lengths),
+        masses=tuple(d.number({"masses": x}, "masses", "robot.") for x in masses),
+        joints=joints,
+        motors=motors,
+        **common,
+    )
+
+
+def _reference(spec: Any, key: str, d: _Doc) -> Reference:
+    if not isinstance(spec, dict) or spec.get("type") not in ("step", "sine", "chirp", "csv"):
+        raise DesignerError(
+            f"{d.where(key)} must be a table with a type of step, sine, chirp or csv",
+            'e.g. {type = "sine", amplitude = 0.5, frequency = 1}',
+        )
+    kind = spec["type"]
+    check_keys(spec, KEYS[kind], where=f"{key} ({kind}) of {d.path.name}")
+    if kind == "csv":
+        return Trajectory.from_csv(d.file(spec.get("file"), f"{key}.file"), spec.get("column", "q"))
+    cls = {"step": Step, "sine": Sine, "chirp": Chirp}[kind]
+    values = {k: d.number(spec, k, key + ".") for k in KEYS[kind][1:] if k in spec}
+    if kind in ("step", "sine") and "amplitude" not in values:
+        raise DesignerError(
+            f"{d.where(key + '.amplitude')} is missing", "give the amplitude in rad (m for a slide)"
+        )
+    if kind == "sine" and not values.get("frequency", 0) > 0:
+        raise DesignerError(f"{d.where(key + '.frequency')} must be positive", "give the frequency in Hz")
+    return cls(**values)
+
+
+def _joint_source(spec: Any, key: str, d: _Doc, name: str) -> JointSource:
+    if not isinstance(spec, dict):
+        raise DesignerError(f"{d.where(key)} must be a table", "see the scenario format in the README")
+    check_keys(spec, KEYS["joint"], where=f"[{key}] of {d.path.name}")
+    axis = spec.get("axis", "theta")
+    has = [k for k in SOURCES if k in spec]
+    if len(has) != 1:
+        raise DesignerError(
+            f"{d.where(key)} needs exactly one of {', '.join(SOURCES)}", f"it has: {', '.join(has) or 'none'}"
+        )
+    candidate = spec.get("candidate", 1)
+    if "candidate" in spec and "suggestion" not in spec:
+        raise DesignerError(f"{d.where(key)}.candidate needs a suggestion", 'add suggestion = "s.json"')
+    if isinstance(candidate, bool) or not isinstance(candidate, int):
+        raise DesignerError(f"{d.where(key)}.candidate = {candidate!r} is not a whole number", "1 = best")
+    params = spec.get("parameters", {})
+    if not isinstance(params, dict):
+        raise DesignerError(f"{d.where(key)}.parameters must be a table", 'e.g. {"theta.k" = 0.3}')
+    common = dict(axis=axis, fmi_version=spec.get("fmi_version", 2), parameters=params)
+    if "fmu" in spec:
+        return JointSource(fmu=d.file(spec["fmu"], f"{key}.fmu"), **common)
+    for table in ("coefficients", "design"):
+        if table in spec and not isinstance(spec[table], dict):
+            raise DesignerError(
+                f"{d.where(key)}.{table} must be a table", "see the scenario format in the README"
+            )
+    joint = from_one_source(
+        coefficients={axis: spec["coefficients"]} if "coefficients" in spec else None,
+        design=spec.get("design"),
+        suggestion=d.file(spec["suggestion"], f"{key}.suggestion") if "suggestion" in spec else None,
+        candidate=candidate,
+        axes=None if "coefficients" in spec else [axis],
+        name=name,
+    )
+    return JointSource(joint=joint, **common)

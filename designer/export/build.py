@@ -63,7 +63,7 @@ def platform_folder(fmi_version: int) -> str:
     if system is None:
         raise DesignerError(
             f"building FMU binaries on {sys.platform} is not supported",
-            "export with --source-only and build the binary with the platform's FMI tooling",
+            "export with source_only=True and build the binary with the platform's FMI tooling",
         )
     if fmi_version == 2:
         return system + ("64" if machine in ("x86_64", "aarch64") else "32")
@@ -83,7 +83,7 @@ def find_compiler() -> list[str]:
             raise DesignerError(
                 f"the C compiler '{cmd[0]}' named by $CC was not found",
                 "install a C compiler (for example apt-get install gcc), point CC at it, "
-                "or export with --source-only and build from the FMU's sources/",
+                "or export with source_only=True and build from the FMU's sources/",
             )
         return cmd
     for name in ("cc", "gcc", "clang"):
@@ -91,7 +91,7 @@ def find_compiler() -> list[str]:
             return [name]
     raise DesignerError(
         "no C compiler found (tried $CC, cc, gcc, clang)",
-        "install one (for example apt-get install gcc), or export with --source-only and build the "
+        "install one (for example apt-get install gcc), or export with source_only=True and build the "
         "binary from the FMU's sources/ (fmpy: python -m fmpy compile joint.fmu)",
     )
 
@@ -139,11 +139,11 @@ def build_binary(fmi_version: int) -> Path:
         except OSError as exc:
             raise DesignerError(
                 f"could not run the C compiler '{compiler[0]}': {exc}",
-                "check $CC, or export with --source-only",
+                "check $CC, or export with source_only=True",
             ) from None
         if done.returncode != 0:
             raise DesignerError(
                 f"compiling the FMU binary failed:\n{done.stderr.strip()}",
-                "check the compiler with 'cc --version', or export with --source-only",
+                "check the compiler with 'cc --version', or export with source_only=True",
             )
     return target

@@ -19,7 +19,7 @@ from xml.sax.saxutils import quoteattr
 
 from .. import __version__, units
 from ..errors import DesignerError
-from ..files import atomic_path
+from ..files import atomic_path, check_suffix
 from ..joint import AxisCoefficients, Joint
 from . import build
 
@@ -75,10 +75,12 @@ class Variable:
     depends_on: tuple[str, ...] | None = None  # for Outputs and derivatives
 
 
-def _pi_text(pi: tuple[float, float] | None, quantity: str, axis: str) -> str:
-    if pi is None:
+def _pi_text(ac: AxisCoefficients, quantity: str) -> str:
+    """The 95 % PI of a predicted coefficient in SI, for the variable's description."""
+    pred, axis = ac.predicted.get(quantity), ac.axis
+    if pred is None:
         return ""
-    lo, hi = (units.to_si(quantity, axis, v) for v in pi)
+    lo, hi = (units.to_si(quantity, axis, v) for v in (pred.low, pred.high))
     return f", 95 % PI {lo:.4g} to {hi:.4g} {units.si_unit(quantity, axis)}"
 
 
@@ -114,7 +116,7 @@ def _variables(joint: Joint, interface: str) -> list[Variable]:
                 "Real",
                 "parameter",
                 "tunable",
-                f"damping on {a}; {ac.origin}" + _pi_text(ac.c_pi95, "c", a),
+                f"damping on {a}; {ac.origin}" + _pi_text(ac, "c"),
                 si["c"],
                 units.si_unit("c", a),
             )
@@ -125,7 +127,7 @@ def _variables(joint: Joint, interface: str) -> list[Variable]:
                 "Real",
                 "parameter",
                 "tunable",
-                f"stiffness on {a}; {ac.origin}" + _pi_text(ac.k_pi95, "k", a),
+                f"stiffness on {a}; {ac.origin}" + _pi_text(ac, "k"),
                 si["k"],
                 units.si_unit("k", a),
             )
@@ -411,16 +413,16 @@ def _start_values(joint: Joint, interface: str, variables: list[Variable]) -> st
 
 def _check(joint: Joint, fmi_version: int, interface: str) -> None:
     if fmi_version not in FMI_VERSIONS:
-        raise DesignerError(f"FMI version {fmi_version} is not supported", "use --fmi 2 or --fmi 3")
+        raise DesignerError(f"fmi_version={fmi_version!r} is not supported", "use fmi_version=2 or 3")
     if interface not in INTERFACES:
-        raise DesignerError(f"unknown interface '{interface}'", "use --interface force or --interface body")
+        raise DesignerError(f"interface={interface!r} is not an interface", "use interface='force' or 'body'")
     if interface == "body":
         missing = [a for a, ac in joint.axes.items() if ac.m is None]
         if missing:
             raise DesignerError(
                 f"the body interface needs a mass, and axis {', '.join(missing)} has none",
-                "give --m in kg (kg.m^2 for a rotational axis), or export from a design so the mass "
-                "follows from its geometry",
+                "give each axis an m in kg (kg.m^2 for a rotational axis), or build the joint with "
+                "Joint.from_design so its mass follows from its geometry",
             )
 
 
@@ -468,7 +470,7 @@ def export_fmu(
     progress: Callable[[float], None] | None = None,
 ) -> Path:
     """Write `joint` as an FMU at `path` (atomically); the same joint always gives the same bytes."""
-    path = Path(path)
+    path = check_suffix(path, (".fmu",), what="an FMU")
     entries = archive_entries(joint, fmi_version, interface, source_only)
     if progress:
         progress(0.5)

@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 
 from .. import units
-from ..files import atomic_write
+from ..files import atomic_write, check_suffix
 from ..joint import Joint
 
 _MSL = {
@@ -74,7 +74,7 @@ def modelica_text(joint: Joint) -> str:
 
 def export_modelica(joint: Joint, path: str | Path) -> Path:
     """Write the package as a single .mo file (atomically) and return its path."""
-    path = Path(path)
+    path = check_suffix(path, (".mo",), what="a Modelica")
     with atomic_write(path) as fh:
         fh.write(modelica_text(joint))
     return path

@@ -7,7 +7,7 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 from .. import units
-from ..files import atomic_write
+from ..files import atomic_write, check_suffix
 from ..joint import Joint
 
 #: the joint axis of each channel; the rotational ones follow roll (phi, x), pitch (theta, y), yaw (psi, z)
@@ -90,7 +90,17 @@ def urdf_text(joint: Joint) -> str:
 def export_robot(joint: Joint, path: str | Path, fmt: str) -> Path:
     """Write the MJCF ('mjcf') or URDF ('urdf') snippet atomically and return its path."""
     text = mjcf_text(joint) if fmt == "mjcf" else urdf_text(joint)
-    path = Path(path)
+    path = check_suffix(path, (".xml", ".mjcf") if fmt == "mjcf" else (".urdf",), what=f"an {fmt.upper()}")
     with atomic_write(path) as fh:
         fh.write(text)
     return path
+
+
+def export_mjcf(joint: Joint, path: str | Path) -> Path:
+    """Write the joint as an MJCF model at `path` (atomically); returns the path."""
+    return export_robot(joint, path, "mjcf")
+
+
+def export_urdf(joint: Joint, path: str | Path) -> Path:
+    """Write the joint as a URDF chain at `path` (atomically); returns the path."""
+    return export_robot(joint, path, "urdf")

@@ -2,20 +2,18 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pandas as pd
+from matplotlib.figure import Figure
 
-from .common import save_figure
+from .common import new_figure
 
 
-def plot_table4(compare: pd.DataFrame, path: str | Path) -> Path:
+def plot_table4(compare: pd.DataFrame, *, fig: Figure | None = None) -> Figure:
     """F of each source, the paper's Table 4 beside ours (`stats.compare_table4`), log scale."""
-    import matplotlib.pyplot as plt
-
     x = np.arange(len(compare))
-    fig, ax = plt.subplots(figsize=(8, 4))
+    fig = new_figure(figsize=(8, 4), fig=fig)
+    ax = fig.subplots()
     ax.bar(x - 0.2, compare["F_paper"], 0.4, label="paper's Table 4", color="0.6")
     ax.bar(x + 0.2, compare["F"], 0.4, label="ours (bundled Table 3)", color="tab:blue")
     ax.axhline(1.0, color="k", lw=0.6, ls=":")
@@ -26,16 +24,14 @@ def plot_table4(compare: pd.DataFrame, path: str | Path) -> Path:
         ax.annotate("" if ok else "differs", (i, max(compare["F"].iloc[i], compare["F_paper"].iloc[i])))
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3, axis="y")
-    fig.tight_layout()
-    return save_figure(fig, path)
+    return fig
 
 
-def plot_identification(rows: pd.DataFrame, tolerance_pct: float, path: str | Path) -> Path:
-    """Relative error of identified k and c per coefficient set, with the tolerance band."""
-    import matplotlib.pyplot as plt
-
+def plot_identification(rows: pd.DataFrame, *, tolerance_pct: float, fig: Figure | None = None) -> Figure:
+    """Relative error of identified k and c per coefficient set, with the tolerance band (%)."""
     x = np.arange(len(rows))
-    fig, ax = plt.subplots(figsize=(8, 3.8))
+    fig = new_figure(figsize=(8, 3.8), fig=fig)
+    ax = fig.subplots()
     ax.axhspan(-tolerance_pct, tolerance_pct, color="tab:green", alpha=0.12, label=f"+/- {tolerance_pct:g} %")
     ax.plot(x - 0.1, rows["k error %"], "o", label="k")
     ax.plot(x + 0.1, rows["c error %"], "s", label="c")
@@ -45,15 +41,13 @@ def plot_identification(rows: pd.DataFrame, tolerance_pct: float, path: str | Pa
     ax.set_title("Virtual rig -> identification, closed loop")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
-    fig.tight_layout()
-    return save_figure(fig, path)
+    return fig
 
 
-def plot_convergence(steps: pd.DataFrame, path: str | Path, unit: str) -> Path:
-    """Error against macro step, log-log, every column of `steps` but "step" as one line."""
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6, 4.2))
+def plot_convergence(steps: pd.DataFrame, *, unit: str, fig: Figure | None = None) -> Figure:
+    """Error (in `unit`) against macro step (s), log-log, every column of `steps` but "step" a line."""
+    fig = new_figure(figsize=(6, 4.2), fig=fig)
+    ax = fig.subplots()
     h = steps["step"].to_numpy()
     for col in steps.columns.drop("step"):
         ax.loglog(h, np.maximum(steps[col].to_numpy(), 1e-18), "o-", label=col)
@@ -63,5 +57,4 @@ def plot_convergence(steps: pd.DataFrame, path: str | Path, unit: str) -> Path:
     ax.set_ylabel(f"max error ({unit})")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3, which="both")
-    fig.tight_layout()
-    return save_figure(fig, path)
+    return fig

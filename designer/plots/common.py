@@ -1,22 +1,23 @@
-"""What every figure shares: the headless matplotlib backend, response names with units, atomic saving."""
+"""What every figure shares: response names with units, a figure of its own, atomic saving.
+
+No process-global state: figures are `matplotlib.figure.Figure` objects with their own Agg canvas
+(no pyplot, no backend switch), so importing or plotting changes nothing for the caller's own
+matplotlib use; saving is a separate call.
+"""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
-from typing import TYPE_CHECKING
 
-import matplotlib
+import pandas as pd
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.ticker import Formatter
 
-matplotlib.use("Agg")  # no display anywhere: CI, servers, the report
-
-import pandas as pd  # noqa: E402
-
-from .. import units  # noqa: E402
-from ..errors import DesignerError  # noqa: E402
-from ..files import atomic_path  # noqa: E402
-
-if TYPE_CHECKING:
-    from matplotlib.figure import Figure
+from .. import units
+from ..errors import DesignerError
+from ..files import atomic_path
 
 #: the image formats figures may be saved in
 FORMATS = (".png", ".svg", ".pdf")
@@ -53,14 +54,60 @@ def check_image_path(path: str | Path) -> Path:
     return p
 
 
-def save_figure(fig: Figure, path: str | Path, dpi: int = 120) -> Path:
-    """Save a matplotlib figure atomically and close it; returns the path."""
-    import matplotlib.pyplot as plt
+def decimals_for(ticks: tuple[float, ...]) -> int:
+    """The fewest decimals that print every tick exactly: (0.5, 1) -> 1, (0.25, 0.5) -> 2, (0.0005,) -> 4."""
+    step = min((abs(b - a) for a, b in zip(ticks, ticks[1:], strict=False)), default=0.0) or max(
+        (abs(t) for t in ticks), default=1.0
+    )
+    d = max(0, -math.floor(math.log10(step) + 1e-9)) if step else 0
+    while d < 12 and any(abs(round(t, d) - t) > 1e-6 * step for t in ticks):
+        d += 1
+    return d
 
+
+class _StepFormatter(Formatter):
+    """Tick labels with the decimals the ticks need: c in N.s/mm reads 0.0015 (not 0.0), k 0.25 (not 0.2)."""
+
+    ticks: tuple[float, ...] = ()
+
+    def set_locs(self, locs) -> None:
+        self.ticks = tuple(float(v) for v in locs)
+
+    def __call__(self, x: float, pos: int | None = None) -> str:
+        ticks = self.ticks or (float(x),)
+        step = abs(ticks[1] - ticks[0]) if len(ticks) > 1 else abs(x)
+        return "0" if step and abs(x) < 1e-9 * step else f"{x:.{decimals_for(ticks)}f}"
+
+
+def value_formatter() -> Formatter:
+    """A tick formatter for response axes whose values may be small (see `decimals_for`)."""
+    return _StepFormatter()
+
+
+def new_figure(*, figsize: tuple[float, float], fig: Figure | None = None) -> Figure:
+    """The caller's empty figure `fig`, or a new one of `figsize` inches with its own Agg canvas, in
+    constrained layout (legends and labels stay inside).
+
+    Raises:
+        DesignerError: `fig` already holds axes.
+    """
+    if fig is not None:
+        if fig.axes:
+            raise DesignerError("fig= already holds axes", "pass an empty Figure, or none for a new one")
+        fig.set_layout_engine("constrained")
+        return fig
+    fig = Figure(figsize=figsize, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def save_figure(fig: Figure, path: str | Path, *, dpi: int = 120) -> Path:
+    """Write a figure atomically as PNG, SVG or PDF (by suffix); returns the path.
+
+    Raises:
+        DesignerError: the suffix is not an image format, or the folder is missing.
+    """
     p = check_image_path(path)
-    try:
-        with atomic_path(p) as tmp:
-            fig.savefig(tmp, dpi=dpi, format=p.suffix[1:].lower(), bbox_inches="tight")
-    finally:
-        plt.close(fig)
+    with atomic_path(p) as tmp:
+        fig.savefig(tmp, dpi=dpi, format=p.suffix[1:].lower())
     return p

@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pandas as pd
+from matplotlib.figure import Figure
 
 from .. import space
-from .common import response_label, save_figure
+from .common import new_figure, response_label, value_formatter
 
 
 def main_effects(table: pd.DataFrame, responses: list[str]) -> pd.DataFrame:
@@ -29,14 +28,11 @@ def main_effects(table: pd.DataFrame, responses: list[str]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def plot_effects(table: pd.DataFrame, responses: list[str], path: str | Path) -> Path:
-    """One row of boxplots per response, one panel per factor; red lines are the medians."""
-    import matplotlib.pyplot as plt
-
+def plot_effects(table: pd.DataFrame, *, responses: list[str], fig: Figure | None = None) -> Figure:
+    """One row of boxplots per response (rig units), one panel per factor; red lines are the medians."""
     ncol = len(space.FACTORS)
-    fig, axes = plt.subplots(
-        len(responses), ncol, figsize=(2.4 * ncol, 2.8 * len(responses)), squeeze=False, sharey="row"
-    )
+    fig = new_figure(figsize=(2.5 * ncol, 2.9 * len(responses) + 0.4), fig=fig)
+    axes = fig.subplots(len(responses), ncol, squeeze=False, sharey="row")
     rng = np.random.default_rng(0)  # fixed jitter: the same table gives the same picture
     for i, resp in enumerate(responses):
         for j, f in enumerate(space.FACTORS):
@@ -54,9 +50,10 @@ def plot_effects(table: pd.DataFrame, responses: list[str], path: str | Path) ->
             ax.plot(range(len(groups)), [np.median(g) for _, g in groups], "r--", lw=0.8)
             ax.set_xticks(range(len(groups)), [f"{level:g}" for level, _ in groups])
             ax.set_xlabel(f"{f.name} ({f.unit})")
+            ax.tick_params(labelsize=9)
             if j == 0:
                 ax.set_ylabel(response_label(resp))
+                ax.yaxis.set_major_formatter(value_formatter())
             ax.grid(axis="y", alpha=0.3)
     fig.suptitle(f"Main effects on {', '.join(responses)} ({len(table)} runs; red: medians)")
-    fig.tight_layout()
-    return save_figure(fig, path)
+    return fig

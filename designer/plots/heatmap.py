@@ -2,22 +2,20 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pandas as pd
+from matplotlib.figure import Figure
 
 from ..stats import correlation
-from .common import save_figure
+from .common import new_figure
 
 
-def plot_heatmap(table: pd.DataFrame, responses: list[str], path: str | Path) -> Path:
-    """Annotated heat map of the correlations, -1 (blue) to 1 (red)."""
-    import matplotlib.pyplot as plt
-
+def plot_heatmap(table: pd.DataFrame, *, responses: list[str], fig: Figure | None = None) -> Figure:
+    """Annotated heat map of the Pearson correlations of factors and responses, -1 (blue) to 1 (red)."""
     corr = correlation(table, responses)
     n = len(corr)
-    fig, ax = plt.subplots(figsize=(0.75 * n + 2.5, 0.75 * n + 1.5))
+    fig = new_figure(figsize=(0.75 * n + 2.5, 0.75 * n + 1.5), fig=fig)
+    ax = fig.subplots()
     im = ax.imshow(corr.to_numpy(), cmap="coolwarm", vmin=-1, vmax=1)
     ax.set_xticks(range(n), corr.columns, rotation=45, ha="right")
     ax.set_yticks(range(n), corr.index)
@@ -28,5 +26,4 @@ def plot_heatmap(table: pd.DataFrame, responses: list[str], path: str | Path) ->
             )
     fig.colorbar(im, ax=ax, label="Pearson correlation")
     ax.set_title(f"Factor and response correlations ({len(table)} runs)")
-    fig.tight_layout()
-    return save_figure(fig, path)
+    return fig

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import DesignerError
 from ..files import atomic_write
 
 #: above this many triangles a layer is decimated before embedding (keeps the page fast)
@@ -75,7 +76,15 @@ def _payload(layer: Layer) -> dict[str, Any]:
 
 
 def write_scene(scene: Scene, path: str | Path) -> Path:
-    """Write the scene as one HTML file that opens in any browser."""
+    """Write the scene as one HTML file that opens in any browser (no server, no network).
+
+    Raises:
+        DesignerError: the path does not end in .html or .htm, or its folder is missing.
+    """
+    if Path(path).suffix.lower() not in (".html", ".htm"):
+        raise DesignerError(
+            f"cannot write an HTML scene to '{Path(path).name}'", "end the file name in .html"
+        )
     data = {
         "title": scene.title,
         "labels": list(scene.axis_labels),

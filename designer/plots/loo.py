@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pandas as pd
+from matplotlib.figure import Figure
 
-from .common import response_label, save_figure
+from .common import new_figure, response_label, value_formatter
 
 
 def loo_table(surrogate, response: str) -> pd.DataFrame:
@@ -18,18 +17,18 @@ def loo_table(surrogate, response: str) -> pd.DataFrame:
     return pd.DataFrame(
         {
             "observed": observed,
-            "predicted": np.asarray(pred["value"], float),
-            "lo": np.asarray(pred["lo"], float),
-            "hi": np.asarray(pred["hi"], float),
+            "predicted": np.asarray(pred.value, float),
+            "lo": np.asarray(pred.low, float),
+            "hi": np.asarray(pred.high, float),
         }
     ).assign(covered=lambda d: (d.observed >= d.lo) & (d.observed <= d.hi))
 
 
-def plot_loo(surrogate, responses: list[str], path: str | Path) -> Path:
-    """One panel per response: LOO predictions with PI bars against the measurements, 1:1 line."""
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(1, len(responses), figsize=(5.2 * len(responses), 4.8), squeeze=False)
+def plot_loo(surrogate, *, responses: list[str] | None = None, fig: Figure | None = None) -> Figure:
+    """One panel per response (default: all): LOO predictions with PI bars against the measurements."""
+    responses = surrogate.responses if responses is None else responses
+    fig = new_figure(figsize=(5.2 * len(responses), 4.8), fig=fig)
+    axes = fig.subplots(1, len(responses), squeeze=False)
     for ax, resp in zip(axes[0], responses, strict=True):
         model = surrogate.model(resp)
         d = loo_table(surrogate, resp)
@@ -60,7 +59,9 @@ def plot_loo(surrogate, responses: list[str], path: str | Path) -> Path:
             f"95 % PI coverage {loo['coverage95']:.0%} of {len(d)} runs",
             fontsize=10,
         )
+        ax.xaxis.set_major_formatter(value_formatter())
+        ax.yaxis.set_major_formatter(value_formatter())
+        ax.tick_params(labelsize=9)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="upper left")
-    fig.tight_layout()
-    return save_figure(fig, path)
+    return fig

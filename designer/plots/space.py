@@ -1,16 +1,18 @@
 """The design space in 3D (pyvista, off-screen): the surrogate over two or three factors, others held.
 
-`plot_surface` draws the predicted response over two continuous factors with the 95 % prediction
-interval as translucent surfaces, the measured runs as points and the target as a contour line.
-`plot_volume` draws the response over three continuous factors as isosurfaces, the target's in red.
-Both draw in the unit cube (each axis scaled to its tested range) and can also write the scene as an
-interactive HTML page (`designer.plots.html3d`).
+`surface_view` computes the predicted response over two continuous factors with the 95 % prediction
+interval as translucent surfaces, the measured runs as points and the target as a contour line;
+`volume_view` the response over three continuous factors as isosurfaces, the target's in red. Both
+return a `SpaceView`: the numbers and the scene, in the unit cube (each axis scaled to its tested
+range). `render` draws a view in its own off-screen pyvista plotter and returns it;
+`save_screenshot` writes the picture and `html3d.write_scene` the interactive page.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -22,7 +24,7 @@ from .. import space
 from ..errors import DesignerError
 from ..files import atomic_path
 from .common import check_image_path, response_label
-from .html3d import Layer, Scene, write_scene
+from .html3d import Layer, Scene
 
 #: the picture's size in pixels (width, height)
 WINDOW = (1200, 900)
@@ -33,7 +35,7 @@ TARGET_COLOR = (0.9, 0.05, 0.05)
 
 @dataclass
 class SpaceView:
-    """What a design-space figure shows, as numbers: the held factors and the response's range."""
+    """What a design-space figure shows: the held factors, the response's range, and the scene."""
 
     response: str
     unit: str
@@ -43,12 +45,12 @@ class SpaceView:
     target: float | None
     #: share of the drawn grid where the target lies inside the 95 % PI
     target_in_pi: float | None
-    files: list[Path] = field(default_factory=list)
+    #: what `render` and `html3d.write_scene` draw
+    scene: Scene = field(repr=False, compare=False)
 
     def to_dict(self) -> dict[str, Any]:
-        d = dict(self.__dict__)
-        d["files"] = [str(p) for p in self.files]
-        return d
+        """The numbers, JSON-able (the scene left out)."""
+        return {k: v for k, v in self.__dict__.items() if k != "scene"}
 
 
 def held_values(table: pd.DataFrame, free: list[str], fixed: Mapping[str, float] | None) -> dict[str, float]:
@@ -56,7 +58,7 @@ def held_values(table: pd.DataFrame, free: list[str], fixed: Mapping[str, float]
     fixed = dict(fixed or {})
     for name in fixed:
         if name in free:
-            raise DesignerError(f"{name} is drawn on an axis and also held fixed", f"drop --fix {name}=...")
+            raise DesignerError(f"{name} is drawn on an axis and also held fixed", f"drop {name} from fixed=")
     held = {}
     for f in space.FACTORS:
         if f.name in free:
@@ -75,7 +77,7 @@ def _free_factors(names: list[str]) -> list[space.Factor]:
         if f.categorical:
             raise DesignerError(
                 f"{f.name} is categorical ({f.describe_range()})",
-                "draw continuous factors (density, length, width, height) and hold it with --fix",
+                "draw continuous factors (density, length, width, height) and hold it in fixed=",
             )
     if len(set(names)) != len(names):
         raise DesignerError(f"a factor is repeated in {', '.join(names)}", "draw distinct factors")
@@ -96,45 +98,47 @@ def _runs_near(table: pd.DataFrame, held: Mapping[str, float]) -> np.ndarray:
 
 
 def _rgb(values: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """Colours of the values on the colour map over [lo, hi] (mid-map when the range is empty)."""
     from matplotlib import colormaps
 
-    return colormaps[CMAP](np.clip((values - lo) / (hi - lo), 0, 1))[:, :3]
+    v = np.asarray(values, float)
+    u = np.full(v.shape, 0.5) if hi - lo <= 1e-12 * max(abs(hi), 1e-300) else (v - lo) / (hi - lo)
+    return colormaps[CMAP](np.clip(u, 0, 1))[:, :3]
 
 
-def _plotter():
-    """An off-screen pyvista plotter that renders without a display (EGL when there is no X server)."""
-    if not os.environ.get("DISPLAY"):
-        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-    import pyvista as pv
+@contextlib.contextmanager
+def _headless() -> Iterator[None]:
+    """While a render window is made: ask VTK for EGL when there is no X display, then restore."""
+    if os.environ.get("DISPLAY") or "VTK_DEFAULT_OPENGL_WINDOW" in os.environ:
+        yield
+        return
+    os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = "vtkEGLRenderWindow"
+    try:
+        yield
+    finally:
+        os.environ.pop("VTK_DEFAULT_OPENGL_WINDOW", None)
 
-    pv.OFF_SCREEN = True
-    plotter = pv.Plotter(off_screen=True, window_size=list(WINDOW))
-    plotter.set_background("white")
-    return pv, plotter
 
-
-def _finish(plotter, scene: Scene, path: Path, title: str) -> None:
-    """Axes with the factors' real ranges, the title, camera, and the screenshot written atomically."""
-    ranges = [v for r in scene.axis_ranges for v in r]
+def _axes(plotter, scene: Scene) -> None:
+    """Bounds with the factors' real ranges; ticks with 3 significant digits (c reads 0.00226, not 0.0)."""
     plotter.show_bounds(
         bounds=[0, 1, 0, 1, 0, 1],
-        axes_ranges=ranges,
+        axes_ranges=[v for r in scene.axis_ranges for v in r],
         xtitle=scene.axis_labels[0],
         ytitle=scene.axis_labels[1],
         ztitle=scene.axis_labels[2],
         color="black",
-        font_size=10,
+        font_size=15,
+        fmt="%.3g",
+        n_xlabels=3,
+        n_ylabels=3,
+        n_zlabels=5,
         location="outer",
     )
-    plotter.add_text(title, font_size=10, color="black")
-    plotter.camera_position = [(2.6, -1.9, 1.9), (0.5, 0.5, 0.45), (0, 0, 1)]
-    with atomic_path(path) as tmp:
-        plotter.screenshot(str(tmp))
-    plotter.close()
 
 
 def _colorbar(plotter, response: str, lo: float, hi: float) -> None:
-    """The colour scale of the response (an invisible mesh carrying its range)."""
+    """The colour scale of the response (an invisible mesh carrying its range), right of the scene."""
     import pyvista as pv
 
     bar = pv.PolyData(np.zeros((2, 3)))
@@ -143,70 +147,129 @@ def _colorbar(plotter, response: str, lo: float, hi: float) -> None:
         bar,
         scalars=response,
         cmap=CMAP,
+        clim=[lo, hi],
         opacity=0.0,
         show_scalar_bar=True,
-        scalar_bar_args={"title": response_label(response), "color": "black", "vertical": True},
+        scalar_bar_args={
+            "title": response_label(response),
+            "color": "black",
+            "vertical": True,
+            "fmt": "%.3g",
+            "n_labels": 5,
+            "title_font_size": 16,
+            "label_font_size": 14,
+            "position_x": 0.86,
+            "position_y": 0.08,
+            "width": 0.05,
+            "height": 0.5,
+        },
     )
 
 
-def _write(
-    plotter_layers: list[Layer],
-    scene: Scene,
-    path: Path,
-    html: Path | None,
-    title: str,
-    scale: tuple[str, float, float],
-) -> None:
-    """Render the layers to the PNG and, when asked, the same scene to HTML."""
-    pv, plotter = _plotter()
-    for layer in plotter_layers:
-        kwargs: dict[str, Any] = {"opacity": layer.opacity}
-        if layer.rgb is not None:
-            kwargs |= {"scalars": (layer.rgb * 255).astype(np.uint8), "rgb": True}
-        else:
-            kwargs["color"] = layer.color
-        if layer.mesh.n_cells and layer.mesh.verts.size == layer.mesh.n_cells * 2:
-            kwargs |= {"point_size": layer.size * 4, "render_points_as_spheres": True}
-        elif layer.mesh.lines.size:
-            kwargs["line_width"] = layer.size * 2
-        plotter.add_mesh(layer.mesh, **kwargs)
-    _colorbar(plotter, *scale)
-    plotter.add_legend(
-        labels=[(layer.name, layer.color) for layer in plotter_layers],
-        bcolor="white",
-        size=(0.32, 0.03 * len(plotter_layers)),
-        loc="upper right",
-        face="rectangle",
-    )
-    _finish(plotter, scene, path, title)
-    if html is not None:
-        write_scene(scene, html)
+def _add_layer(plotter, layer: Layer) -> None:
+    kwargs: dict[str, Any] = {"opacity": layer.opacity}
+    if layer.rgb is not None:
+        kwargs |= {"scalars": (layer.rgb * 255).astype(np.uint8), "rgb": True}
+    else:
+        kwargs["color"] = layer.color
+    if layer.mesh.n_cells and layer.mesh.verts.size == layer.mesh.n_cells * 2:
+        kwargs |= {"point_size": layer.size * 4, "render_points_as_spheres": True}
+    elif layer.mesh.lines.size:
+        kwargs["line_width"] = layer.size * 2
+    plotter.add_mesh(layer.mesh, **kwargs)
 
 
-def _check_html(html: str | Path | None) -> Path | None:
-    if html is None:
-        return None
-    p = Path(html)
-    if p.suffix.lower() not in (".html", ".htm"):
-        raise DesignerError(f"cannot write an HTML scene to '{p.name}'", "end the file name in .html")
+def render(view: SpaceView, *, window: tuple[int, int] = WINDOW):
+    """Draw the view in a new off-screen pyvista plotter of `window` pixels and return the plotter.
+
+    The legend (layer names in their colours, fixed font size) sits in the top right under the
+    title, the colour scale below it on the right, both inside the picture. Close the plotter
+    (`plotter.close()`) when done with it.
+    """
+    with _headless():
+        import pyvista as pv
+
+        plotter = pv.Plotter(off_screen=True, window_size=list(window))
+    plotter.set_background("white")
+    layers = view.scene.layers
+    for layer in layers:
+        _add_layer(plotter, layer)
+    lo, hi = view.value_range
+    if hi - lo <= 1e-9 * abs(hi):  # a constant response: the scale spans the plotted PI instead
+        lo, hi = view.scene.axis_ranges[2]
+    _colorbar(plotter, view.response, lo, hi)
+    left = min(0.68 * window[0], window[0] - 24 - 13 * max(len(layer.name) for layer in layers))
+    for i, layer in enumerate(layers):  # the legend: each name in its layer's colour, fixed size
+        pos = (int(left), int(window[1] - 64 - 24 * i))
+        plotter.add_text(layer.name, position=pos, font_size=12, color=layer.color)
+    _axes(plotter, view.scene)
+    title = view.scene.title
+    plotter.add_text(title, font_size=11 if len(title) <= 90 else 9, color="black", position="upper_edge")
+    plotter.camera_position = [(2.75, -2.0, 1.95), (0.62, 0.42, 0.5), (0, 0, 1)]
+    return plotter
+
+
+def save_screenshot(plotter, path: str | Path) -> Path:
+    """Write the plotter's picture atomically (.png); returns the path.
+
+    Raises:
+        DesignerError: the suffix is not an image format, or the folder is missing.
+    """
+    p = check_image_path(path)
+    with atomic_path(p) as tmp:
+        plotter.screenshot(str(tmp))
     return p
 
 
-def plot_surface(
-    surrogate,
-    response: str,
-    x: str,
-    y: str,
-    path: str | Path,
-    fixed: Mapping[str, float] | None = None,
-    target: float | None = None,
-    html: str | Path | None = None,
-    resolution: int = 41,
-) -> SpaceView:
-    """The response over factors x and y (others held), its 95 % PI, the measured runs and the target."""
+def _run_layers(points: np.ndarray, near: np.ndarray) -> list[Layer]:
+    """The measured runs (unit-cube points): those at the held values in black, the others grey."""
     import pyvista as pv
 
-    path, html = check_image_path(path), _check_html(html)
+    layers = []
+    if near.any():
+        layers.append(
+            Layer(
+                f"runs at the held values ({int(near.sum())})",
+                pv.PolyData(points[near]),
+                color=(0, 0, 0),
+                size=4,
+            )
+        )
+    if (~near).any():
+        layers.append(
+            Layer(
+                f"other runs ({int((~near).sum())})",
+                pv.PolyData(points[~near]),
+                color=(0.55, 0.55, 0.55),
+                size=2.5,
+            )
+        )
+    return layers
+
+
+def surface_view(
+    surrogate,
+    response: str,
+    *,
+    x: str = "width",
+    y: str = "height",
+    fixed: Mapping[str, float] | None = None,
+    target: float | None = None,
+    resolution: int = 41,
+) -> SpaceView:
+    """The response over factors x and y (others held), its 95 % PI, the measured runs and the target.
+
+    Args:
+        surrogate: the fitted surrogate; response: e.g. "k_x".
+        x, y: continuous factors on the two axes; fixed: values of held factors (others at the level
+            nearest the runs' median); target: in rig units; resolution: grid points per axis.
+
+    Raises:
+        DesignerError: a categorical or repeated factor on an axis, a held factor out of range, a
+            response the surrogate does not have.
+    """
+    import pyvista as pv
+
     model = surrogate.model(response)
     fx, fy = _free_factors([x, y])
     table = surrogate.table
@@ -216,8 +279,8 @@ def plot_surface(
     X[x], X[y] = gx.ravel(), gy.ravel()
     pred = model.predict(X)
     observed = table[response].to_numpy(float)
-    zlo = float(min(pred.lo.min(), observed.min(), target if target is not None else np.inf))
-    zhi = float(max(pred.hi.max(), observed.max(), target if target is not None else -np.inf))
+    zlo = float(min(pred.low.min(), observed.min(), target if target is not None else np.inf))
+    zhi = float(max(pred.high.max(), observed.max(), target if target is not None else -np.inf))
     zlo, zhi = zlo - 0.02 * (zhi - zlo), zhi + 0.02 * (zhi - zlo)
 
     def grid(z: np.ndarray) -> pv.PolyData:
@@ -235,31 +298,13 @@ def plot_surface(
             rgb=_rgb(pred.value, vlo, vhi),
             color=tuple(_rgb(np.array([0.5]), 0, 1)[0]),
         ),
-        Layer("95 % PI lower", grid(pred.lo), color=PI_COLOR, opacity=0.25),
-        Layer("95 % PI upper", grid(pred.hi), color=PI_COLOR, opacity=0.25),
+        Layer("95 % PI lower", grid(pred.low), color=PI_COLOR, opacity=0.25),
+        Layer("95 % PI upper", grid(pred.high), color=PI_COLOR, opacity=0.25),
     ]
-    near = _runs_near(table, held)
     runs = np.c_[
         _unit(table[x], fx.low, fx.high), _unit(table[y], fy.low, fy.high), _unit(observed, zlo, zhi)
     ]
-    if near.any():
-        layers.append(
-            Layer(
-                f"runs at the held values ({int(near.sum())})",
-                pv.PolyData(runs[near]),
-                color=(0, 0, 0),
-                size=4,
-            )
-        )
-    if (~near).any():
-        layers.append(
-            Layer(
-                f"other runs ({int((~near).sum())})",
-                pv.PolyData(runs[~near]),
-                color=(0.55, 0.55, 0.55),
-                size=2.5,
-            )
-        )
+    layers += _run_layers(runs, _runs_near(table, held))
     share = None
     if target is not None:
         mid.point_data["value"] = pred.value
@@ -269,7 +314,7 @@ def plot_surface(
             floor = line.copy()
             floor.points[:, 2] = 0.0
             layers.append(Layer("target, projected", floor, color=TARGET_COLOR, size=1.5, opacity=0.6))
-        share = float(np.mean((pred.lo <= target) & (target <= pred.hi)))
+        share = float(np.mean((pred.low <= target) & (target <= pred.high)))
     held_txt = ", ".join(f"{k} {v:g} {space.factor(k).unit}" for k, v in held.items())
     title = f"{response_label(response)} over {x} and {y}; held: {held_txt}"
     scene = Scene(
@@ -278,30 +323,31 @@ def plot_surface(
         ((fx.low, fx.high), (fy.low, fy.high), (zlo, zhi)),
         layers,
     )
-
-    _write(layers, scene, path, html, title, (response, vlo, vhi))
-    return SpaceView(
-        response, model.unit, [x, y], held, (vlo, vhi), target, share, [path] + ([html] if html else [])
-    )
+    return SpaceView(response, model.unit, [x, y], held, (vlo, vhi), target, share, scene)
 
 
-def plot_volume(
+def volume_view(
     surrogate,
     response: str,
+    *,
     factors: list[str],
-    path: str | Path,
     fixed: Mapping[str, float] | None = None,
     target: float | None = None,
-    html: str | Path | None = None,
     resolution: int = 25,
     levels: int = 4,
 ) -> SpaceView:
-    """The response over three factors as isosurfaces (translucent), the target's in red, runs as points."""
+    """The response over three factors as isosurfaces (translucent), the target's in red, runs as points.
+
+    Raises:
+        DesignerError: not three distinct continuous factors, a held factor out of range, a response
+            the surrogate does not have.
+    """
     import pyvista as pv
 
-    path, html = check_image_path(path), _check_html(html)
     if len(factors) != 3:
-        raise DesignerError(f"a volume needs three factors, got {len(factors)}", "give --x, --y and --z")
+        raise DesignerError(
+            f"a volume needs three factors, got {len(factors)}", "give three factors in factors="
+        )
     model = surrogate.model(response)
     fs = _free_factors(factors)
     table = surrogate.table
@@ -326,7 +372,7 @@ def plot_volume(
         iso = vol.contour([target], scalars="value")
         if iso.n_points:
             layers.append(Layer(f"target {target:g} {model.unit}", iso, color=TARGET_COLOR, opacity=0.85))
-        share = float(np.mean((pred.lo <= target) & (target <= pred.hi)))
+        share = float(np.mean((pred.low <= target) & (target <= pred.high)))
     pts = np.c_[[_unit(table[f.name], f.low, f.high) for f in fs]].T
     observed = table[response].to_numpy(float)
     layers.append(
@@ -343,15 +389,4 @@ def plot_volume(
     scene = Scene(
         title, tuple(f"{f.name} ({f.unit})" for f in fs), tuple((f.low, f.high) for f in fs), layers
     )
-
-    _write(layers, scene, path, html, title, (response, vlo, vhi))
-    return SpaceView(
-        response,
-        model.unit,
-        list(factors),
-        held,
-        (vlo, vhi),
-        target,
-        share,
-        [path] + ([html] if html else []),
-    )
+    return SpaceView(response, model.unit, list(factors), held, (vlo, vhi), target, share, scene)

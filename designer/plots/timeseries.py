@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from pathlib import Path
 
 import pandas as pd
+from matplotlib.figure import Figure
 
 from ..errors import DesignerError
-from .common import save_figure
+from .common import new_figure
 
 #: most panels drawn in one figure
 MAX_PANELS = 8
@@ -16,16 +16,15 @@ MAX_PANELS = 8
 
 def plot_timeseries(
     frame: pd.DataFrame,
-    path: str | Path,
+    *,
     columns: list[str] | None = None,
     time: str = "t",
     reference: pd.DataFrame | None = None,
     panels: Mapping[str, list[str]] | None = None,
-) -> Path:
+    fig: Figure | None = None,
+) -> Figure:
     """Columns of `frame` against `time` (s), one panel each (or grouped: `panels` maps a label to its
     columns); the same column of `reference` dashed, where it has one."""
-    import matplotlib.pyplot as plt
-
     if time not in frame.columns:
         raise DesignerError(
             f"the time series has no '{time}' column", f"it has {', '.join(map(str, frame.columns))}"
@@ -40,9 +39,10 @@ def plot_timeseries(
         )
     if len(panels) > MAX_PANELS:
         raise DesignerError(
-            f"{len(panels)} signals is too many for one figure", f"pick at most {MAX_PANELS} with --columns"
+            f"{len(panels)} signals is too many for one figure", f"pick at most {MAX_PANELS} with columns="
         )
-    fig, axes = plt.subplots(len(panels), 1, sharex=True, figsize=(9, 1.9 * len(panels) + 0.8), squeeze=False)
+    fig = new_figure(figsize=(9, 1.9 * len(panels) + 0.8), fig=fig)
+    axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)
     for ax, (label, cols) in zip(axes[:, 0], panels.items(), strict=True):
         for col in cols:
             ax.plot(frame[time], frame[col], lw=0.9, label=col if len(cols) > 1 else "co-simulation")
@@ -53,5 +53,4 @@ def plot_timeseries(
         ax.set_ylabel(label, fontsize=8)
         ax.grid(alpha=0.3)
     axes[-1, 0].set_xlabel(f"{time} (s)")
-    fig.tight_layout()
-    return save_figure(fig, path)
+    return fig

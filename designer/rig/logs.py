@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 
 from .. import space, units
+from ..data import is_parquet
 from ..errors import DesignerError
 from ..files import atomic_path, atomic_write
 
@@ -53,7 +54,6 @@ STUCK_SAMPLES = 5
 GAP_FACTOR = 1.5
 #: the largest relative spread of sampling intervals (outside gaps) a log may have
 JITTER_LIMIT = 0.05
-_PARQUET = (".parquet", ".pq")
 _SUFFIX_RE = re.compile(r"^(?P<name>[A-Za-z]+)(?:\s*\[(?P<b>[^\]]+)\]|_(?P<u>.+))?$")
 
 
@@ -143,7 +143,7 @@ def _check_factors(factors: dict | None, source: str) -> dict[str, float] | None
     if factors is None:
         return None
     try:
-        return space.validate(factors, allow_extrapolation=True)
+        return space.check_design(factors, allow_extrapolation=True)
     except DesignerError as exc:
         raise DesignerError(f"{source}: {exc.problem}", exc.fix) from None
 
@@ -277,7 +277,7 @@ def _read_frame(p: Path) -> pd.DataFrame:
     import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
 
-    table = pq.read_table(p) if p.suffix.lower() in _PARQUET else pacsv.read_csv(p)
+    table = pq.read_table(p) if is_parquet(p) else pacsv.read_csv(p)
     if len(set(table.column_names)) < table.num_columns:
         return table.to_pandas()
     columns = (col.to_numpy(zero_copy_only=False) for col in table.columns)
@@ -304,7 +304,7 @@ def write_log(df: pd.DataFrame, path: str | Path, factors: dict | None = None) -
     """Validate and write a log atomically (Parquet for .parquet/.pq, else CSV) and its factor sidecar."""
     p = Path(path)
     log = validate_frame(df, source=p.name, factors=factors)
-    if p.suffix.lower() in _PARQUET:
+    if is_parquet(p):
         with atomic_path(p) as tmp:
             log.data.to_parquet(tmp, index=False)
     else:

@@ -9,40 +9,20 @@ dropout segments (the sensor reading NaN or stuck at zero), as on the real rig.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
 from .. import units
+from ..chirp import F0, F1, HUB_AMPLITUDE, SWEEP, Chirp
 from ..errors import DesignerError
 from .logs import LOAD, STUCK_SAMPLES
 
-#: the study's excitation (section 3.2)
-HUB_AMPLITUDE = 1.0
-F0 = 0.2
-F1 = 1.85
-DURATION = 2200.0
+#: the study's excitation (section 3.2), its sweep the default duration
+DURATION = SWEEP
 RATE = 1000.0
 #: length of one simulated dropout segment, s
 DROPOUT_SECONDS = 0.05
-
-
-@dataclass(frozen=True)
-class Chirp:
-    """q(t) = sin(2 pi (f0 t + (f1 - f0) t^2 / (2 T))) and its exact derivatives."""
-
-    f0: float = F0
-    f1: float = F1
-    duration: float = DURATION
-
-    def __call__(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """q, q' and q'' at the times t."""
-        sweep = (self.f1 - self.f0) / self.duration
-        phase = 2 * np.pi * (self.f0 * t + sweep * t**2 / 2)
-        omega = 2 * np.pi * (self.f0 + sweep * t)
-        s, c = np.sin(phase), np.cos(phase)
-        return s, omega * c, 2 * np.pi * sweep * c - omega**2 * s
 
 
 def _check(name: str, value: float, positive: bool = True) -> float:
@@ -84,10 +64,10 @@ def simulate(
         raise DesignerError("no axis to simulate", "give m, c, k for at least one axis")
     n = int(round(duration * rate)) + 1
     if n < 3 * STUCK_SAMPLES:
-        raise DesignerError(f"{n} samples is too short a run", "raise --duration or --rate")
+        raise DesignerError(f"{n} samples is too short a run", "raise duration or rate")
     rng = np.random.default_rng(seed)
     t = np.arange(n) / rate
-    q, dq, ddq = Chirp(f0, f1, duration)(t)
+    q, dq, ddq = Chirp(1.0, f0, f1, duration).motion(t)
     cols: dict[str, np.ndarray] = {"t": t}
     for axis, coef in coefficients.items():
         units.check_axis(axis)

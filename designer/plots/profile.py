@@ -1,0 +1,311 @@
+"""An interactive prediction profiler: one self-contained HTML page (no server, no network).
+
+As JMP's Profiler and Minitab's Response Optimizer do it: a slider per continuous factor and level
+buttons for the categorical ones; per response a row of panels with the prediction and its 95 %
+prediction interval against each factor, the others held at the sliders; targets, desirability and
+the probability of landing within a tolerance of the target; a strip of `designer suggest`
+candidates that set the sliders when clicked.
+
+The page evaluates the surrogate itself, from the exported coefficients: each response's feature
+columns are exported as expression trees recorded by running the surrogate's own feature code
+(`designer.surrogate._columns`) on symbols, so the page and `Surrogate.predict` compute the same
+expressions with the same coefficients, covariance, t quantile and transform.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from .. import space, units
+from ..errors import DesignerError
+from ..files import atomic_write
+from ..surrogate import ResponseSurface, Surrogate, _columns
+
+#: the design the page opens at unless told otherwise (the study's centre, layer 0.16 mm, raster 0 deg)
+DEFAULT_DESIGN: dict[str, float] = {
+    "density": 60.0,
+    "length": 24.0,
+    "width": 4.5,
+    "height": 9.0,
+    "layer": 0.16,
+    "raster": 0.0,
+}
+#: relative tolerance within which a printed joint counts as meeting its target
+TOLERANCE = 0.10
+#: narrowest printable width or height: two walls and one infill line, mm
+PRINTABLE_MIN_MM = 2 * space.WALL_MM + space.NOZZLE_MM
+#: points per continuous factor where the y range of each response's panels is sampled
+_RANGE_POINTS = 5
+
+
+class _Expr:
+    """A symbolic value: arithmetic on it records an expression tree (nested JSON lists)."""
+
+    __array_ufunc__ = None  # numpy scalars defer to the reflected operators below
+
+    def __init__(self, node: list[Any]) -> None:
+        self.node = node
+
+    def _op(self, op: str, other: Any, swap: bool = False) -> _Expr:
+        a, b = self.node, _node(other)
+        return _Expr([op, b, a] if swap else [op, a, b])
+
+    def __add__(self, o: Any) -> _Expr:
+        return self._op("+", o)
+
+    def __radd__(self, o: Any) -> _Expr:
+        return self._op("+", o, swap=True)
+
+    def __sub__(self, o: Any) -> _Expr:
+        return self._op("-", o)
+
+    def __rsub__(self, o: Any) -> _Expr:
+        return self._op("-", o, swap=True)
+
+    def __mul__(self, o: Any) -> _Expr:
+        return self._op("*", o)
+
+    def __rmul__(self, o: Any) -> _Expr:
+        return self._op("*", o, swap=True)
+
+    def __truediv__(self, o: Any) -> _Expr:
+        return self._op("/", o)
+
+    def __rtruediv__(self, o: Any) -> _Expr:
+        return self._op("/", o, swap=True)
+
+
+def _node(v: Any) -> list[Any]:
+    return v.node if isinstance(v, _Expr) else ["c", float(v)]
+
+
+class _TraceOps:
+    """The surrogate's array operations on symbols: `log` and the categorical level indicator."""
+
+    @staticmethod
+    def log(a: Any) -> _Expr:
+        return _Expr(["log", _node(a)])
+
+    @staticmethod
+    def is_level(a: Any, level: float) -> _Expr:
+        return _Expr(["level", _node(a), float(level)])
+
+
+def feature_program(form: str) -> list[list[Any]]:
+    """The feature columns of a surrogate form (intercept excluded) as expression trees.
+
+    Nodes: ``["x", factor]``, ``["c", constant]``, ``[op, a, b]`` with op one of ``+ - * /``,
+    ``["log", a]`` and ``["level", a, level]`` (1 where a is the level as numpy.isclose says, else 0).
+    """
+    symbols = {n: _Expr(["x", n]) for n in space.FACTOR_NAMES}
+    return [_node(c) for c in _columns(form, symbols, _TraceOps)]
+
+
+def _accuracy(model: ResponseSurface) -> dict[str, Any]:
+    """The response's validation figures: nested leave-one-out when the surrogate has them."""
+    nested = getattr(model, "loo_nested", None)
+    if nested:
+        kind = "nested leave-one-out (form and penalty chosen inside each fold)"
+        return {"kind": kind, "nested": True} | {
+            k: float(nested[k]) for k in ("q2", "rmse", "mape", "coverage95")
+        }
+    kind = "leave-one-out of the selected form (this surrogate has no nested figures; optimistic)"
+    return {"kind": kind, "nested": False} | {
+        k: float(model.loo[k]) for k in ("q2", "rmse", "mape", "coverage95")
+    }
+
+
+def _value_range(model: ResponseSurface, observed: np.ndarray, target: float | None) -> list[float]:
+    """The y range shared by a response's panels: its PI over the tested box, the runs and the target."""
+    axes = [np.linspace(f.low, f.high, _RANGE_POINTS) for f in space.CONTINUOUS]
+    axes += [np.asarray(f.levels, float) for f in space.CATEGORICAL]
+    grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, len(space.FACTORS))
+    pred = model.predict(pd.DataFrame(grid, columns=list(space.FACTOR_NAMES)))
+    lo = min(float(np.min(pred.low)), float(np.min(observed)), target if target is not None else math.inf)
+    hi = max(float(np.max(pred.high)), float(np.max(observed)), target if target is not None else -math.inf)
+    pad = 0.04 * (hi - lo)
+    return [max(lo - pad, 0.0) if lo >= 0 else lo - pad, hi + pad]
+
+
+def _target(surrogate: Surrogate, quantity: str, axis: str, value: float) -> dict[str, float]:
+    """A target with its desirability bounds, as `designer suggest` sets them."""
+    from ..suggest import make_target
+
+    t = make_target(surrogate, quantity, axis, value)
+    return {"value": t.value, "low": t.low, "high": t.high, "importance": t.importance}
+
+
+def _response(surrogate: Surrogate, name: str, statement: str, target: float | None) -> dict[str, Any]:
+    model = surrogate.model(name)
+    observed = np.asarray(surrogate.training[name], float)
+    return {
+        "name": name,
+        "quantity": model.quantity,
+        "unit": model.unit,
+        "form": model.form,
+        "transform": model.transform,
+        "features": feature_program(model.form),
+        "coef": [float(v) for v in model.coef],
+        "vcov": np.asarray(model.vcov, float).tolist(),
+        "sigma": float(model.sigma),
+        "t95": float(model.t95),
+        "dof": float(model.dof),
+        "predictable": bool(model.predictable),
+        "statement": statement,
+        "accuracy": _accuracy(model),
+        "range": _value_range(model, observed, target),
+        "target": None if target is None else _target(surrogate, model.quantity, model.axis, target),
+    }
+
+
+def _suggestions(suggestion: Any) -> list[dict[str, Any]]:
+    """Candidates of a `Suggestion`, of its `to_dict()`, or of a JSON file holding that dict."""
+    if suggestion is None:
+        return []
+    if isinstance(suggestion, str | Path):
+        p = Path(suggestion)
+        try:
+            suggestion = json.loads(p.read_text(encoding="utf-8"))
+        except FileNotFoundError:
+            raise DesignerError(
+                f"no such suggestion file: {p}", "give a JSON file of Suggestion.to_dict()"
+            ) from None
+        except (OSError, ValueError) as exc:
+            raise DesignerError(
+                f"cannot read suggestion {p}: {exc}", "give a JSON file of Suggestion.to_dict()"
+            ) from None
+    if hasattr(suggestion, "to_dict"):
+        suggestion = suggestion.to_dict()
+    candidates = suggestion.get("candidates") if isinstance(suggestion, Mapping) else None
+    if not isinstance(candidates, list):
+        raise DesignerError(
+            "suggestion has no list of candidates", "pass a Suggestion, its to_dict() or such a JSON file"
+        )
+    out = []
+    for i, c in enumerate(candidates, start=1):
+        try:
+            params = {n: float(c["params"][n]) for n in space.FACTOR_NAMES}
+        except (KeyError, TypeError, ValueError):
+            raise DesignerError(
+                f"suggestion candidate {i} does not give all six factors",
+                "pass a Suggestion, its to_dict() or such a JSON file",
+            ) from None
+        try:
+            space.check_design(params)
+            inside = True
+        except DesignerError:
+            inside = False  # extrapolated: listed, but the sliders cannot reach it
+        # factors without effect on this design (suggest's "any", e.g. density at 2 mm width)
+        free = [n for n in c.get("any", []) if n in space.FACTOR_NAMES]
+        out.append({"rank": i, "params": params, "inside": inside, "any": free})
+    return out
+
+
+@dataclass
+class Profiler:
+    """What the profiler page shows and computes with, as plain JSON-able data."""
+
+    data: dict[str, Any]
+
+    def to_html(self) -> str:
+        """The self-contained page: the template with this data embedded."""
+        template = (resources.files("designer.plots") / "profile.html").read_text(encoding="utf-8")
+        payload = json.dumps(self.data, separators=(",", ":"), allow_nan=False).replace("</", "<\\/")
+        title = f"Prediction profiler, axis {self.data['axis']}"
+        return template.replace("__TITLE__", html.escape(title)).replace("__DATA__", payload)
+
+
+def build_profiler(
+    surrogate: Surrogate,
+    *,
+    axis: str = "x",
+    targets: Mapping[str, float] | None = None,
+    tolerance: float = TOLERANCE,
+    suggestion: Any = None,
+    design: Mapping[str, float] | None = None,
+) -> Profiler:
+    """Gather what the profiler page needs for k and c of one axis.
+
+    Args:
+        surrogate: the fitted surrogate whose coefficients the page evaluates.
+        axis: the axis of the responses (x y z theta phi psi).
+        targets: target values by quantity in rig units, e.g. {"k": 0.8} (N/mm).
+        tolerance: relative tolerance of "meeting the target" (0.1: within 10 %).
+        suggestion: a `Suggestion`, its `to_dict()` or the path of a JSON file of it (what the
+            suggest command writes with its JSON option).
+        design: factors the page opens at (the rest from `DEFAULT_DESIGN`), within the tested ranges.
+
+    Raises:
+        DesignerError: unknown axis, quantity or factor; a value outside the tested ranges; a
+            target that is not positive; a tolerance outside (0, 1); an unreadable suggestion.
+    """
+    units.check_axis(axis)
+    targets = dict(targets or {})
+    for q in targets:
+        if q not in ("k", "c"):
+            raise DesignerError(f"targets has unknown quantity '{q}'", "give targets={'k': 0.8}, for k or c")
+    if not (isinstance(tolerance, int | float) and 0 < tolerance < 1):
+        raise DesignerError(
+            f"tolerance={tolerance!r} is not a fraction between 0 and 1", "give e.g. tolerance=0.1"
+        )
+    start = space.check_design(DEFAULT_DESIGN | dict(design or {}))
+    from ..suggest import predictability
+
+    info = predictability(surrogate, axis)
+    responses = [
+        _response(surrogate, f"{q}_{axis}", info[q]["statement"], targets.get(q)) for q in ("k", "c")
+    ]
+    runs = {n: [float(v) for v in surrogate.training[n]] for n in space.FACTOR_NAMES}
+    runs |= {r["name"]: [float(v) for v in surrogate.training[r["name"]]] for r in responses}
+    factors = [
+        {
+            "name": f.name,
+            "unit": f.unit,
+            "label": f.label,
+            "low": float(f.low),
+            "high": float(f.high),
+            "levels": [float(v) for v in f.levels],
+            "categorical": f.categorical,
+            "step": float(f.resolution),
+            "printable_min": PRINTABLE_MIN_MM if f.name in ("width", "height") else None,
+        }
+        for f in space.FACTORS
+    ]
+    return Profiler(
+        {
+            "axis": axis,
+            "surrogate_id": surrogate.id,
+            "factors": factors,
+            "design": start,
+            "responses": responses,
+            "runs": runs,
+            "tolerance": float(tolerance),
+            "suggestions": _suggestions(suggestion),
+            "wall_mm": space.WALL_MM,
+            "nozzle_mm": space.NOZZLE_MM,
+        }
+    )
+
+
+def write_profiler(profiler: Profiler, path: str | Path) -> Path:
+    """Write the page atomically; the path must end in .html.
+
+    Raises:
+        DesignerError: the path does not end in .html or .htm, or its folder is missing.
+    """
+    p = Path(path)
+    if p.suffix.lower() not in (".html", ".htm"):
+        raise DesignerError(f"cannot write the profiler page to '{p.name}'", "end the file name in .html")
+    with atomic_write(p, "w", encoding="utf-8") as fh:
+        fh.write(profiler.to_html())
+    return p

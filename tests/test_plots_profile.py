@@ -1,0 +1,127 @@
+"""The profiler page's data (library) and `designer profile` (CLI); test_profile_browser drives the page."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from designer import space
+from designer.errors import DesignerError
+from designer.plots import profile
+from designer.surrogate import FORMS, Surrogate, design_matrix
+
+
+@pytest.fixture(scope="module")
+def sur():
+    return Surrogate.load()
+
+
+def _evaluate(node, x):
+    """A reading of the exported expression trees, to check them against the surrogate's features."""
+    op = node[0]
+    if op == "x":
+        return x[node[1]]
+    if op == "c":
+        return node[1]
+    if op == "log":
+        return math.log(_evaluate(node[1], x))
+    if op == "level":
+        return float(abs(_evaluate(node[1], x) - node[2]) <= 1e-8 + 1e-5 * abs(node[2]))
+    a, b = _evaluate(node[1], x), _evaluate(node[2], x)
+    return {"+": a + b, "-": a - b, "*": a * b, "/": a / b}[op]
+
+
+@pytest.mark.parametrize("form", FORMS)
+def test_feature_programs_are_the_surrogates_features(form):
+    rng = np.random.default_rng(3)
+    program = profile.feature_program(form)
+    for _ in range(20):
+        x = {f.name: float(rng.uniform(f.low, f.high)) for f in space.CONTINUOUS}
+        x |= {f.name: float(rng.choice(f.levels)) for f in space.CATEGORICAL}
+        want = design_matrix(form, x)[0]
+        got = [1.0] + [_evaluate(n, x) for n in program]
+        np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-13)
+
+
+def test_profiler_data(sur, tmp_path):
+    page = profile.build_profiler(sur, targets={"k": 0.8}, design={"width": 3.5})
+    d = page.data
+    assert d["design"] == profile.DEFAULT_DESIGN | {"width": 3.5}
+    k, c = d["responses"]
+    assert (k["name"], c["name"]) == ("k_x", "c_x")
+    assert k["coef"] == list(sur.model("k_x").coef) and k["transform"] == "log"
+    assert k["target"]["value"] == 0.8 and c["target"] is None
+    assert not c["predictable"] and "not predictable" in c["statement"]
+    assert "leave-one-out" in k["accuracy"]["kind"] and k["accuracy"]["q2"] == sur.model("k_x").loo["q2"]
+    # the panels' y range holds every run and the PI at the design
+    lo, hi = k["range"]
+    assert lo <= min(sur.training["k_x"]) and hi >= max(sur.training["k_x"])
+    html = profile.write_profiler(page, tmp_path / "p.html").read_text()
+    assert "Content-Security-Policy" in html and "default-src 'none'" in html
+    assert "http://" not in html and "https://" not in html
+    embedded = json.loads(html.split('type="application/json">')[1].split("</script>")[0])
+    assert embedded["responses"][0]["vcov"] == np.asarray(sur.model("k_x").vcov).tolist()
+
+
+def test_nested_figures_are_preferred(sur, monkeypatch):
+    model = sur.model("k_x")
+    monkeypatch.setattr(
+        model, "loo_nested", {"q2": 0.32, "rmse": 0.22, "mape": 19.0, "coverage95": 0.9}, raising=False
+    )
+    acc = profile.build_profiler(sur).data["responses"][0]["accuracy"]
+    assert acc["nested"] and acc["q2"] == 0.32 and acc["kind"].startswith("nested")
+
+
+def test_bad_requests_name_the_argument(sur, tmp_path):
+    with pytest.raises(DesignerError, match="targets has unknown quantity 'm'"):
+        profile.build_profiler(sur, targets={"m": 1.0})
+    with pytest.raises(DesignerError, match="tolerance=1.5"):
+        profile.build_profiler(sur, tolerance=1.5)
+    with pytest.raises(DesignerError, match="outside the tested range"):
+        profile.build_profiler(sur, design={"width": 9})
+    with pytest.raises(DesignerError, match="unknown axis"):
+        profile.build_profiler(sur, axis="w")
+    with pytest.raises(DesignerError, match="no list of candidates"):
+        profile.build_profiler(sur, suggestion={"rows": []})
+    with pytest.raises(DesignerError, match="candidate 1 does not give all six"):
+        profile.build_profiler(sur, suggestion={"candidates": [{"params": {"width": 3}}]})
+    with pytest.raises(DesignerError, match="no such suggestion file"):
+        profile.build_profiler(sur, suggestion=tmp_path / "none.json")
+    with pytest.raises(DesignerError, match=".html"):
+        profile.write_profiler(profile.build_profiler(sur), tmp_path / "p.png")
+    far = dict(profile.DEFAULT_DESIGN, width=9.0)
+    strip = profile.build_profiler(sur, suggestion={"candidates": [{"params": far}]}).data["suggestions"]
+    assert strip == [{"rank": 1, "params": far, "inside": False, "any": []}]
+    any_density = {"candidates": [{"params": profile.DEFAULT_DESIGN, "any": ["density"]}]}
+    assert profile.build_profiler(sur, suggestion=any_density).data["suggestions"][0]["any"] == ["density"]
+
+
+def designer(*args: str, cwd) -> subprocess.CompletedProcess:
+    exe = Path(sys.executable).with_name("designer")
+    return subprocess.run([str(exe), *args], capture_output=True, text=True, cwd=cwd)
+
+
+def test_cli_profile(sur, tmp_path):
+    run = designer(
+        "profile", "--design", "raster=45", "--target", "k=0.8", "--json", "-o", "p.html", cwd=tmp_path
+    )
+    assert run.returncode == 0, run.stderr
+    out = json.loads(run.stdout)
+    assert out["design"]["raster"] == 45.0 and (tmp_path / "p.html").is_file()
+    want = sur.predict(out["design"], responses=["k_x"])["k_x"]
+    assert out["predicted"]["k_x"]["value"] == pytest.approx(float(want.value[0]), rel=1e-12)
+    for bad, message in (
+        (["--design", "width=3", "--design", "width=4"], "twice"),
+        (["--target", "k"], "is not NAME=VALUE"),
+    ):
+        run = designer("profile", *bad, cwd=tmp_path)
+        assert run.returncode == 2 and message in run.stderr and "Traceback" not in run.stderr, (
+            bad,
+            run.stderr,
+        )
