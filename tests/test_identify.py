@@ -128,6 +128,8 @@ def _impossible():
         "above Nyquist": (make_log({"x": X}, duration=30, rate=500, seed=1, f0=300, f1=400), "10 x"),
         "0.2 s": (make_log({"x": X}, duration=0.2, rate=500, seed=1), "cycles"),
         "few cycles": (make_log({"x": X}, duration=30, rate=500, seed=1, f0=0.2, f1=0.3), "cycles"),
+        "negative k": (make_log({"x": dict(X, k=-0.8)}, duration=30, rate=500, seed=1), "impossible"),
+        "load unrelated": (base.assign(Fx=np.random.default_rng(0).standard_normal(len(base))), "R2"),
     }
 
 

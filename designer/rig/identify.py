@@ -351,7 +351,7 @@ def identify_log(
             is not a finite number.
     """
     log = _as_log(source)
-    chosen = log.axes if axes is None else [units.check_axis(a) for a in axes]
+    chosen = log.axes if axes is None else list(axes)
     absent = [a for a in chosen if a not in log.axes]
     if absent:
         raise DesignerError(f"axes={absent} not in the log", f"the log has {', '.join(log.axes)}")
