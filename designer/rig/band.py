@@ -28,7 +28,7 @@ TAPER = 0.04
 #: stop edge over pass edge of the low-pass
 STOP_RATIO = 1.5
 #: rate of the filtered grid over the stop edge
-GRID_RATIO = 4.0
+GRID_RATIO = 2.5
 #: rows within this many 1 / (transition width) of an end or of a filled sample are left out
 GUARD_TRANSITIONS = 2.5
 #: samples averaged at each end to take out the straight line that joins the ends before the FFT

@@ -37,19 +37,32 @@ class Solution:
         return 1.0 - self.rss / self.tss if self.tss > 0 else float("nan")
 
 
+def _box(a: np.ndarray, m: int) -> np.ndarray:
+    """Full convolution of each column of `a` with m ones (length rows + m - 1), by cumulative sums."""
+    n, p = a.shape
+    upper = np.empty((n + m - 1, p))
+    np.cumsum(a, axis=0, out=upper[:n])
+    upper[n:] = upper[n - 1]
+    out = upper.copy()
+    out[m:] -= upper[: n - 1]
+    return out
+
+
 def newey_west(scores: np.ndarray, lags: int, rows: int) -> np.ndarray:
     """Bartlett-weighted long-run covariance of the rows of `scores` (rows in time order, mean taken out).
 
+    sum over |l| <= lags of (1 - |l| / (lags + 1)) Gamma_l, computed as g' (T g) with T the
+    triangular smoother, itself two moving sums (linear in the rows for any truncation).
     Divided by 1 - b + b^2 / 3, b = (lags + 1) / rows: the mean of the Bartlett estimate when the
     truncation is a fixed fraction b of the sample (Kiefer and Vogelsang 2005), which otherwise
     biases the standard errors low because the scores of a least-squares fit sum to zero.
     """
     g = scores - scores.mean(axis=0)
-    out = g.T @ g
-    for lag in range(1, min(lags, g.shape[0] - 1) + 1):
-        gamma = g[lag:].T @ g[:-lag]
-        out += (1.0 - lag / (lags + 1.0)) * (gamma + gamma.T)
-    b = min((lags + 1.0) / max(rows, 1), 1.0)
+    m = lags + 1
+    smooth = _box(_box(g, m), m)[m - 1 : m - 1 + g.shape[0]] / m
+    out = g.T @ smooth
+    out = (out + out.T) / 2
+    b = min(m / max(rows, 1), 1.0)
     return out / (1.0 - b + b * b / 3.0)
 
 
