@@ -169,7 +169,7 @@ def _spectra(log: RigLog, axis: str) -> bandlib.Spectra:
     """Spectra of the axis: block means at about PRE_RATE, or the full rate when the band needs it."""
     r = log.data[axis].to_numpy()
     f = log.data[LOAD[axis]].to_numpy()
-    valid = 1.0 - float(missing(f).mean())
+    valid = 1.0 - log.missing_fraction.get(LOAD[axis], float(missing(f).mean()))
     if valid < MIN_VALID:
         raise AxisFailed(f"the load channel {LOAD[axis]} has only {100 * valid:.3g} % valid samples")
     if 1.0 - float(log.dropouts[axis].mean()) < MIN_VALID:

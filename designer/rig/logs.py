@@ -70,6 +70,8 @@ class RigLog:
     dropouts: dict[str, np.ndarray] = field(default_factory=dict)
     #: seconds by which the load channels lag the position channels (from the sidecar), if known
     load_delay_s: float | None = None
+    #: per axis column, the fraction of samples the sensor did not deliver (NaN or stuck at zero)
+    missing_fraction: dict[str, float] = field(default_factory=dict)
 
     @property
     def duration(self) -> float:
@@ -244,7 +246,7 @@ def validate_frame(
     gap_rows = np.zeros(len(t), dtype=bool)
     gap_rows[1:] |= gaps
     gap_rows[:-1] |= gaps
-    dropouts = {}
+    dropouts, fractions = {}, {}
     for a in axes:
         flagged = gap_rows.copy()
         for col in (a, LOAD[a]):
@@ -253,7 +255,9 @@ def validate_frame(
                 raise DesignerError(
                     f"{source}: column '{col}' is all NaN", f"drop axis {a} or fix the sensor"
                 )
-            flagged |= missing(v)
+            absent = missing(v)
+            fractions[col] = float(absent.mean())
+            flagged |= absent
         if flagged.all():
             raise DesignerError(
                 f"{source}: axis {a} ('{a}', '{LOAD[a]}') has no valid samples (all NaN or stuck at zero)",
@@ -269,6 +273,7 @@ def validate_frame(
         rate=1.0 / step,
         axes=axes,
         dropouts=dropouts,
+        missing_fraction=fractions,
     )
 
 

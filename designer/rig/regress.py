@@ -26,7 +26,6 @@ class Solution:
     rss: float
     tss: float
     rows: int
-    residual: np.ndarray
 
     @property
     def se(self) -> np.ndarray:
@@ -79,29 +78,27 @@ def solve(
     Raises:
         numpy.linalg.LinAlgError: the scaled system is singular (a column carries no signal).
     """
-    xk, yk = x[keep], y[keep]
-    n, p = xk.shape
-    scale = np.sqrt(np.mean(xk**2, axis=0))
+    w = keep.astype(np.float64)
+    xw = x * w[:, None]  # the kept rows, zeros elsewhere
+    n, p = int(keep.sum()), x.shape[1]
+    gram = xw.T @ x
+    scale = np.sqrt(np.diag(gram) / n)
     scale[scale == 0] = 1.0
-    xs = xk / scale
-    a = xs.T @ xs - n * noise_cov / np.outer(scale, scale)
-    a_inv = np.linalg.inv(a)
-    beta_s = a_inv @ (xs.T @ yk)
-    resid = yk - xs @ beta_s
-    cov_s = np.full((p, p), np.nan)
+    outer = np.outer(scale, scale)
+    a_inv = np.linalg.inv(gram / outer - n * noise_cov / outer)
+    beta = (a_inv @ ((xw.T @ y) / scale)) / scale
+    resid = (y - x @ beta) * w
+    cov = np.full((p, p), np.nan)
     if lags is not None:
-        scores = np.zeros((x.shape[0], p))
-        scores[keep] = xs * resid[:, None]
-        cov_s = a_inv @ (newey_west(scores, lags, n) * n / max(n - p, 1)) @ a_inv
-    full = np.zeros(x.shape[0])
-    full[keep] = resid
+        scores = xw * resid[:, None] / scale
+        cov = a_inv @ (newey_west(scores, lags, n) * n / max(n - p, 1)) @ a_inv / outer
+    mean_y = float(w @ y) / n
     return Solution(
-        beta=beta_s / scale,
-        cov=cov_s / np.outer(scale, scale),
+        beta=beta,
+        cov=cov,
         rss=float(resid @ resid),
-        tss=float(np.sum((yk - yk.mean()) ** 2)),
+        tss=float(w @ (y - mean_y) ** 2),
         rows=n,
-        residual=full,
     )
 
 
