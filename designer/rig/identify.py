@@ -79,6 +79,7 @@ class AxisFit:
     #: R2 and RMS residual over the load's range, both on the band-limited signals
     r2: float
     nrmse: float
+    #: rows of the filtered grid in the fit (the band-limited signals resampled at 2.5x the stop edge)
     samples: int
     m_identified: bool
     #: mass from geometry (kg, translational axes with known factors) when m is not identified
@@ -230,7 +231,7 @@ def fit_axis(log: RigLog, axis: str, *, load_delay_s: float = 0.0) -> AxisFit:
             f"frequency {top:.3g} Hz (or the excitation is aliased)"
         )
     m_log, c, k = (float(v) * scale for v in main.beta[:3])
-    m_se_log, c_se, k_se = (float(v) * scale for v in main.se[:3])
+    c_se, k_se = (float(v) * scale for v in main.se[1:3])
     if not np.isfinite([m_log, c, k, c_se, k_se, main.r2]).all():
         raise AxisFailed("the fit is not finite (values too large or degenerate)")
     if k <= 0 or c < 0 or main.r2 < MIN_R2:
@@ -275,7 +276,8 @@ def fit_axis(log: RigLog, axis: str, *, load_delay_s: float = 0.0) -> AxisFit:
         m_identified=identified,
         m_geometric=None if identified else _geometric(log, axis),
         inertia_ratio=inertia,
-        band=spec.band.to_dict() | {"filter_pass_hz": ch.pass_edge, "filter_stop_hz": 1.5 * ch.pass_edge},
+        band=spec.band.to_dict()
+        | {"filter_pass_hz": ch.pass_edge, "filter_stop_hz": bandlib.STOP_RATIO * ch.pass_edge},
         load_delay_s=load_delay_s,
         c_per_sample_skew=c_skew,
         c_skew_relative=abs(c_skew) / c if c > 0 else float("inf"),
