@@ -92,6 +92,8 @@ class Channels:
     inst_freq: np.ndarray
     #: the line taken out of the position before filtering, per row: r + r_line is the deflection
     r_line: np.ndarray
+    #: the load with one more skew (see `filtered`), or None
+    y_skew: np.ndarray | None = None
 
 
 def block_means(values: np.ndarray, bad: np.ndarray, factor: int) -> tuple[np.ndarray, np.ndarray]:
@@ -253,8 +255,11 @@ def _guard(filled: np.ndarray, n: int, nd: int, samples: int, reach: int) -> np.
     return near
 
 
-def filtered(spec: Spectra, pass_edge: float, delay_s: float = 0.0) -> Channels:
-    """r'', r', r and the load through the low-pass at `pass_edge` Hz, the load advanced by `delay_s`."""
+def filtered(spec: Spectra, pass_edge: float, delay_s: float = 0.0, skew_s: float | None = None) -> Channels:
+    """r'', r', r and the load through the low-pass at `pass_edge` Hz, the load advanced by `delay_s`.
+
+    With `skew_s`, `y_skew` is the load advanced by `delay_s + skew_s` as well.
+    """
     from scipy.fft import ifft, irfft, next_fast_len
 
     stop = STOP_RATIO * pass_edge
@@ -266,7 +271,10 @@ def filtered(spec: Spectra, pass_edge: float, delay_s: float = 0.0) -> Channels:
     gain = lowpass(freqs, pass_edge)
     pos = spec.position[:bins] * gain
     load = spec.load[:bins] * gain * np.exp(1j * w * delay_s)
-    cols = irfft(np.stack([-(w**2) * pos, 1j * w * pos, pos, load]), n=nd, axis=1) * (nd / spec.n)
+    rows = [-(w**2) * pos, 1j * w * pos, pos, load]
+    if skew_s is not None:
+        rows.append(load * np.exp(1j * w * skew_s))
+    cols = irfft(np.stack(rows), n=nd, axis=1) * (nd / spec.n)
     grid_rate = nd * spec.rate / spec.n
     a, b = spec.r_line
     # analytic signal z of the filtered motion and its derivative: f = Im(z' conj z) / (2 pi |z|^2)
@@ -288,6 +296,7 @@ def filtered(spec: Spectra, pass_edge: float, delay_s: float = 0.0) -> Channels:
     return Channels(
         x=cols[:3].T,
         y=cols[3],
+        y_skew=cols[4] if skew_s is not None else None,
         t=np.arange(nd) / grid_rate,
         keep=keep,
         noise_cov=noise_cov,

@@ -205,9 +205,12 @@ def _cycles(ch: bandlib.Channels) -> float:
     return float(np.count_nonzero(s[1:] != s[:-1]) / 2)
 
 
-def _fit(spec: bandlib.Spectra, pass_edge: float, delay: float, *, hac: bool = True):
-    """Filter at `pass_edge` and fit (HAC covariance if `hac`); fail a log with too few cycles or rows."""
-    ch = bandlib.filtered(spec, pass_edge, delay)
+def _fit(spec: bandlib.Spectra, pass_edge: float, delay: float, *, skew_s: float | None = None):
+    """Filter at `pass_edge` and fit; fail a log with too few cycles or usable rows.
+
+    With `skew_s`, the solution's `also_beta` is the fit with the load advanced by that much more.
+    """
+    ch = bandlib.filtered(spec, pass_edge, delay, skew_s)
     cycles = _cycles(ch)
     if cycles < MIN_CYCLES:
         raise AxisFailed(f"only {cycles:.3g} cycles of excitation (at least {MIN_CYCLES:g} needed)")
@@ -216,7 +219,7 @@ def _fit(spec: bandlib.Spectra, pass_edge: float, delay: float, *, hac: bool = T
             f"only {int(ch.keep.sum())} usable rows after leaving out the ends and dropouts; record longer"
         )
     x, noise = _design(ch)
-    return ch, solve(x, ch.y, ch.keep, noise, _lags(ch) if hac else None)
+    return ch, solve(x, ch.y, ch.keep, noise, _lags(ch), also=ch.y_skew)
 
 
 def fit_axis(log: RigLog, axis: str, *, load_delay_s: float = 0.0) -> AxisFit:
@@ -224,7 +227,7 @@ def fit_axis(log: RigLog, axis: str, *, load_delay_s: float = 0.0) -> AxisFit:
     spec = _spectra(log, axis)
     top = spec.band.high
     scale = spec.scale_f / spec.scale_r
-    ch, main = _fit(spec, PASS_EDGES[0] * top, load_delay_s)
+    ch, main = _fit(spec, PASS_EDGES[0] * top, load_delay_s, skew_s=1.0 / log.rate)
     if log.rate < MIN_RATE_OVER_BAND * top:
         raise AxisFailed(
             f"sampling rate {log.rate:.4g} Hz is under {MIN_RATE_OVER_BAND:g} x the highest excitation "
@@ -240,10 +243,7 @@ def fit_axis(log: RigLog, axis: str, *, load_delay_s: float = 0.0) -> AxisFit:
             f"c = {c:.4g} {units.rig_unit('c', axis)}, R2 = {main.r2:.3g} "
             f"(needs k > 0, c >= 0, R2 >= {MIN_R2:g})"
         )
-    c_skew = (
-        float(_fit(spec, PASS_EDGES[0] * top, load_delay_s + 1.0 / log.rate, hac=False)[1].beta[1]) * scale
-        - c
-    )
+    c_skew = float(main.also_beta[1]) * scale - c
     wide = [(ch, main)] + [_fit(spec, p * top, load_delay_s) for p in PASS_EDGES[1:]]
     m_rows = [
         {

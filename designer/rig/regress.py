@@ -26,6 +26,7 @@ class Solution:
     rss: float
     tss: float
     rows: int
+    also_beta: np.ndarray | None = None
 
     @property
     def se(self) -> np.ndarray:
@@ -66,14 +67,21 @@ def newey_west(scores: np.ndarray, lags: int, rows: int) -> np.ndarray:
 
 
 def solve(
-    x: np.ndarray, y: np.ndarray, keep: np.ndarray, noise_cov: np.ndarray, lags: int | None
+    x: np.ndarray,
+    y: np.ndarray,
+    keep: np.ndarray,
+    noise_cov: np.ndarray,
+    lags: int | None,
+    *,
+    also: np.ndarray | None = None,
 ) -> Solution:
     """Bias-compensated least squares of y on the columns of x over the rows `keep`.
 
     x: (rows, p) in time order; noise_cov: (p, p) covariance of the noise in one row of x (zeros
     for exact columns); lags: Newey-West truncation in rows (None: coefficients only, cov NaN).
     Rows outside `keep` count as gaps in time (their contributions are zero), so the lag
-    structure of the kept rows is kept.
+    structure of the kept rows is kept. `also`: another right-hand side, whose coefficients
+    come back as `also_beta` (same normal equations, no second factorisation).
 
     Raises:
         numpy.linalg.LinAlgError: the scaled system is singular (a column carries no signal).
@@ -85,13 +93,14 @@ def solve(
     scale = np.sqrt(np.diag(gram) / n)
     scale[scale == 0] = 1.0
     outer = np.outer(scale, scale)
-    a_inv = np.linalg.inv(gram / outer - n * noise_cov / outer)
-    beta = (a_inv @ ((xw.T @ y) / scale)) / scale
-    resid = (y - x @ beta) * w
+    a_inv = np.linalg.inv(gram / outer - n * noise_cov / outer) / outer
+    beta = a_inv @ (xw.T @ y)
+    resid = y - x @ beta
+    resid *= w
     cov = np.full((p, p), np.nan)
     if lags is not None:
-        scores = xw * resid[:, None] / scale
-        cov = a_inv @ (newey_west(scores, lags, n) * n / max(n - p, 1)) @ a_inv / outer
+        xw *= resid[:, None]
+        cov = a_inv @ (newey_west(xw, lags, n) * n / max(n - p, 1)) @ a_inv
     mean_y = float(w @ y) / n
     return Solution(
         beta=beta,
@@ -99,6 +108,7 @@ def solve(
         rss=float(resid @ resid),
         tss=float(w @ (y - mean_y) ** 2),
         rows=n,
+        also_beta=None if also is None else a_inv @ (x.T @ (also * w)),
     )
 
 
