@@ -100,12 +100,16 @@ def block_means(values: np.ndarray, bad: np.ndarray, factor: int) -> tuple[np.nd
     """Means over consecutive blocks of `factor` samples (a trailing partial block is dropped).
 
     Returns the means and which blocks hold a bad sample; those means are meaningless until filled.
+    (A matrix-vector product and the sparse bad rows: one pass over the samples each.)
     """
     blocks = values.size // factor
     if factor == 1:
         return values.astype(np.float64, copy=True), bad.copy()
-    means = values[: blocks * factor].reshape(blocks, factor).mean(axis=1)
-    return means, bad[: blocks * factor].reshape(blocks, factor).any(axis=1)
+    means = values[: blocks * factor].reshape(blocks, factor) @ np.full(factor, 1.0 / factor)
+    bad_blocks = np.zeros(blocks, dtype=bool)
+    rows = np.flatnonzero(bad[: blocks * factor])
+    bad_blocks[rows // factor] = True
+    return means, bad_blocks
 
 
 def fill(values: np.ndarray, bad: np.ndarray) -> None:

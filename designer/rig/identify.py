@@ -173,8 +173,9 @@ def _spectra(log: RigLog, axis: str) -> bandlib.Spectra:
     valid = 1.0 - log.missing_fraction.get(LOAD[axis], float(missing(f).mean()))
     if valid < MIN_VALID:
         raise AxisFailed(f"the load channel {LOAD[axis]} has only {100 * valid:.3g} % valid samples")
-    if 1.0 - float(log.dropouts[axis].mean()) < MIN_VALID:
-        raise AxisFailed(f"only {100 * (1 - log.dropouts[axis].mean()):.3g} % of the samples are valid")
+    usable = 1.0 - np.count_nonzero(log.dropouts[axis]) / log.dropouts[axis].size
+    if usable < MIN_VALID:
+        raise AxisFailed(f"only {100 * usable:.3g} % of the samples are valid")
     factor = max(1, int(log.rate // bandlib.PRE_RATE))
     spec = bandlib.spectra(r, f, log.dropouts[axis], log.rate, factor)
     if spec.band is not None and factor > 1 and spec.band.high * bandlib.PRE_MARGIN > spec.rate:
