@@ -35,6 +35,22 @@ GUARD_TRANSITIONS = 2.5
 END_SAMPLES = 5
 
 
+def fast_len(n: int) -> int:
+    """The smallest 5-smooth length (2^a 3^b 5^c) at least n: an FFT size numpy transforms fast."""
+    best = 1 << max(n - 1, 0).bit_length()
+    p5 = 1
+    while p5 < best:
+        p35 = p5
+        while p35 < best:
+            size = p35
+            while size < n:
+                size *= 2
+            best = min(best, size)
+            p35 *= 3
+        p5 *= 5
+    return best
+
+
 @dataclass(frozen=True)
 class Band:
     """The excitation band, Hz: where the position's power above the noise floor lies."""
@@ -190,15 +206,13 @@ def _band_and_noise(r: np.ndarray, rate: float) -> tuple[Band | None, float]:
     lowest and highest frequencies are, at full weight. The noise floor is the median power well
     above the band, and the noise variance that floor over the window's sum of squares.
     """
-    from scipy.fft import next_fast_len, rfft
-
     window = np.ones(r.size)
     edge = int(TAPER / 2 * r.size)
     if edge:
         window[:edge] = 0.5 * (1 - np.cos(np.pi * np.arange(edge) / edge))
         window[r.size - edge :] = window[:edge][::-1]
-    n = next_fast_len(r.size, real=True)
-    spectrum = rfft((r - r.mean()) * window, n=n)
+    n = fast_len(r.size)
+    spectrum = np.fft.rfft((r - r.mean()) * window, n=n)
     power = spectrum.real**2 + spectrum.imag**2
     rough = estimate_band(power, rate, n, 0.0)
     if rough is None:
@@ -209,8 +223,6 @@ def _band_and_noise(r: np.ndarray, rate: float) -> tuple[Band | None, float]:
 
 def spectra(r: np.ndarray, f: np.ndarray, bad: np.ndarray, rate: float, factor: int) -> Spectra:
     """Block means, fill, unit scaling, end-line removal and one FFT of position and load."""
-    from scipy.fft import next_fast_len, rfft
-
     rb, bad_r = block_means(r, bad, factor)
     fb, _ = block_means(f, bad, factor)
     fill(rb, bad_r), fill(fb, bad_r)
@@ -222,8 +234,8 @@ def spectra(r: np.ndarray, f: np.ndarray, bad: np.ndarray, rate: float, factor: 
     band, noise_var = _band_and_noise(rb, srate)
     r_line = _ends_line(rb)
     _ends_line(fb)
-    n = next_fast_len(rb.size, real=True)
-    pos, load = rfft(rb, n=n), rfft(fb, n=n)
+    n = fast_len(rb.size)
+    pos, load = np.fft.rfft(rb, n=n), np.fft.rfft(fb, n=n)
     return Spectra(
         rate=srate,
         n=n,
@@ -264,11 +276,9 @@ def filtered(spec: Spectra, pass_edge: float, delay_s: float = 0.0, skew_s: floa
 
     With `skew_s`, `y_skew` is the load advanced by `delay_s + skew_s` as well.
     """
-    from scipy.fft import ifft, irfft, next_fast_len
-
     stop = STOP_RATIO * pass_edge
     bins = min(int(np.ceil(stop * spec.n / spec.rate)) + 1, spec.position.size)
-    nd = min(next_fast_len(max(int(np.ceil(GRID_RATIO * stop * spec.n / spec.rate)), 2 * bins)), spec.n)
+    nd = min(fast_len(max(int(np.ceil(GRID_RATIO * stop * spec.n / spec.rate)), 2 * bins)), spec.n)
     nd += nd % 2
     freqs = spec.freqs[:bins]
     w = 2 * np.pi * freqs
@@ -278,14 +288,14 @@ def filtered(spec: Spectra, pass_edge: float, delay_s: float = 0.0, skew_s: floa
     rows = [-(w**2) * pos, 1j * w * pos, pos, load]
     if skew_s is not None:
         rows.append(load * np.exp(1j * w * skew_s))
-    cols = irfft(np.stack(rows), n=nd, axis=1) * (nd / spec.n)
+    cols = np.fft.irfft(np.stack(rows), n=nd, axis=1) * (nd / spec.n)
     grid_rate = nd * spec.rate / spec.n
     a, b = spec.r_line
     # analytic signal z of the filtered motion and its derivative: f = Im(z' conj z) / (2 pi |z|^2)
     one_sided = np.zeros((2, nd), dtype=complex)
     one_sided[:, :bins] = 2 * np.stack([pos, 1j * w * pos])
     one_sided[:, 0] /= 2
-    z, dz = ifft(one_sided, axis=1)
+    z, dz = np.fft.ifft(one_sided, axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
         inst = (dz * z.conj()).imag / (2 * np.pi * (z.real**2 + z.imag**2))
     reach = int(np.ceil(GUARD_TRANSITIONS / (stop - pass_edge) * grid_rate))

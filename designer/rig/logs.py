@@ -278,15 +278,15 @@ def validate_frame(
 
 
 def _read_frame(p: Path) -> pd.DataFrame:
-    """The file's columns read by pyarrow, as a frame sharing its arrays (no consolidating copy)."""
+    """The file's columns read by pyarrow, one block per column (no consolidating copy).
+
+    `self_destruct` frees each Arrow column as it is converted, so the peak holds one copy.
+    """
     import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
 
     table = pq.read_table(p) if is_parquet(p) else pacsv.read_csv(p)
-    if len(set(table.column_names)) < table.num_columns:
-        return table.to_pandas()
-    columns = (col.to_numpy(zero_copy_only=False) for col in table.columns)
-    return pd.DataFrame(dict(zip(table.column_names, columns, strict=True)), copy=False)
+    return table.to_pandas(split_blocks=True, self_destruct=True)
 
 
 def read_log(path: str | Path) -> RigLog:
