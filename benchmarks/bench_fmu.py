@@ -50,7 +50,7 @@ static void logger(fmi2ComponentEnvironment e, fmi2String n, fmi2Status s, fmi2S
 }
 int main(int argc, char **argv) {
     fmi2CallbackFunctions cb = {logger, calloc, free, NULL, NULL};
-    fmi2ValueReference f = 107, s = 105;
+    fmi2ValueReference f = @F@, s = @S@; /* value references from fmus/FlexJoint/config.h */
     fmi2Real load = 2.744, x;
     struct timespec t0, t1;
     long i, n = atol(argv[3]);
@@ -86,7 +86,8 @@ def main() -> None:
     from fmpy import extract, read_model_description, simulate_fmu
     from pythonfmu.builder import FmuBuilder
 
-    from designer.export.fmu import export_fmu
+    from designer.export import build
+    from designer.export.fmu import export_fmu, value_reference
     from designer.joint import Joint
 
     joint = Joint.from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}})
@@ -111,9 +112,10 @@ def main() -> None:
 
     d = extract(str(path))
     src = Path(d) / "sources"
-    (work / "loop.c").write_text(LOOP)
+    refs = {"@F@": value_reference("x", "f"), "@S@": value_reference("x", "s")}
+    (work / "loop.c").write_text(LOOP.replace("@F@", str(refs["@F@"])).replace("@S@", str(refs["@S@"])))
     exe = work / "loop"
-    files = [str(src / n) for n in ("instance.c", "fmi2Functions.c", "model.c")]
+    files = [str(src / Path(n).name) for n in build.c_sources(2)]
     subprocess.run(
         ["cc", "-std=gnu99", "-O2", f"-I{src}", str(work / "loop.c"), *files, "-o", str(exe), "-lm"],
         check=True,

@@ -65,6 +65,15 @@ FLAGS: tuple[tuple[str, str], ...] = (
     (r"\btop=", "--top "),
     (r"\bk= and/or c=", "--k and/or --c"),
     (r"\btargets=\{'k': 0\.8\}", "--target k=0.8"),
+    # export mjcf/urdf/sdf/modelica/ssp
+    (r"\binto=", "--into "),
+    (r"\bjoint_name=", "--joint "),
+    (r"\baxis=(?='\w+'(, or| is | does ))", "--use-axis "),
+    (r"\bform=(?='\w*' is not a form)", "--form "),
+    (r"\bmsl=", "--msl "),
+    (r"\brest=(?=\S+ is for exports into)", "--rest "),
+    (r"\bmotor_inertia=", "--motor-inertia "),
+    (r"\bmotor_bandwidth=", "--motor-bandwidth "),
 )
 
 

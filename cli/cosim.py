@@ -17,6 +17,13 @@ def cosim(
         bool, typer.Option("--validate", help="compare with the reference at four steps")
     ] = False,
     json_out: Annotated[bool, typer.Option("--json", help="print metrics (and validation) as JSON")] = False,
+    engine: Annotated[
+        str,
+        typer.Option(
+            "--engine",
+            help="auto: the compiled kernel when a C compiler is there, else python; kernel; python",
+        ),
+    ] = "auto",
 ) -> None:
     """Co-simulate joint FMUs with a MuJoCo robot or the virtual rig; write time series, metrics, plot.
 
@@ -28,7 +35,7 @@ def cosim(
     sc = load(scenario)
     check_output_folder(out)
     with progress(f"co-simulating {scenario.name}", enabled=not json_out) as bar:
-        result = run(sc, validate=validate, progress=bar)
+        result = run(sc, validate=validate, progress=bar, engine=engine)
     files = write_outputs(result, out)
     summary = result.summary() | {"files": [str(f) for f in files]}
     if json_out:
@@ -66,6 +73,10 @@ def _print(summary: dict) -> None:
         console.print(f"  max error at the scenario's step: {val['max_error']:.3g} (rad or m)")
         for row in val["steps"]:
             console.print(f"  step {row['step']:.4g} s: max error {row['max_error']:.3g} (rad or m)")
+    for note in summary.get("notes", []):
+        console.print(f"note: {note}")
+    ran = {"kernel": "the compiled kernel", "python": "the Python master"}[summary["engine"]]
+    console.print(f"loop run by {ran}")
     for f in summary["files"]:
         console.print(f"wrote {f}")
 

@@ -26,25 +26,47 @@ def _load(path: Path | None):
 
 
 def _parse_fix(items: list[str]) -> dict[str, float]:
-    fixed = {}
+    from designer import space
+
+    fixed: dict[str, float] = {}
     for item in items:
         name, sep, value = item.partition("=")
+        name = name.strip()
         if not sep:
             raise DesignerError(
                 f"--fix '{item}' is not NAME=VALUE", "write it as, for example, --fix width=4.5"
             )
+        f = space.factor(name)
+        if name in fixed:
+            raise DesignerError(
+                f"--fix {name} is given twice ({fixed[name]:g} and {value})", f"give one --fix {name}=VALUE"
+            )
         try:
-            fixed[name.strip()] = float(value)
+            fixed[name] = float(value)
         except ValueError:
             raise DesignerError(
-                f"--fix '{item}': '{value}' is not a number", "write --fix width=4.5"
+                f"--fix '{item}': '{value}' is not a number", f"give {name} as {f.describe_range()}"
             ) from None
     return fixed
 
 
+def _parse_goal(text: str | None, flag: str) -> float | str | None:
+    """A goal flag's value: a number in rig units, or min or max."""
+    if text is None:
+        return None
+    if text.strip().lower() in ("min", "max"):
+        return text.strip().lower()
+    try:
+        return float(text)
+    except ValueError:
+        raise DesignerError(
+            f"{flag} '{text}' is not a number, min or max", f"write e.g. {flag} 0.8 or {flag} max"
+        ) from None
+
+
 def _pi(p: dict) -> str:
-    """A prediction's to_dict() as 'value [low, high]'."""
-    return f"{p['value']:.4g} [{p['low']:.3g}, {p['high']:.3g}]"
+    """A prediction's to_dict() as 'value [low, high]': three significant digits, bounds two."""
+    return f"{p['value']:.3g} [{p['low']:.2g}, {p['high']:.2g}]"
 
 
 def fit(
@@ -56,6 +78,7 @@ def fit(
 ) -> None:
     """Fit the response surfaces (form and ridge penalty chosen by leave-one-out) and save them.
 
+    Accuracy is reported by nested leave-one-out: the whole selection repeated without each run.
     Without --data, fits the bundled 44-run study table; without --out, writes nothing and reports.
 
     Example: designer fit --data my_runs.csv -o my_surrogate.json
@@ -63,6 +86,8 @@ def fit(
     from designer.data import load_table
     from designer.surrogate import Surrogate
 
+    if out is not None:
+        _check_output(out)
     table = load_table(data)
     sur = Surrogate().fit(table)
     if out is not None:
@@ -72,39 +97,80 @@ def fit(
         "table_hash": sur.table_hash,
         "n_runs": len(table),
         "out": str(out) if out else None,
-        "responses": {
-            r: {
-                "form": m.form,
-                "unit": m.unit,
-                "alpha": m.alpha,
-                "loo": m.loo,
-                "predictable": m.predictable,
-                "candidates": m.candidates,
-            }
-            for r, m in sur.models.items()
-        },
+        "responses": {r: _fit_report(sur, m) for r, m in sur.models.items()},
     }
     if as_json:
         print_json(report)
         return
+    _print_fit(report, len(table))
+    console.print(f"surrogate id {sur.id}" + (f", written to {out}" if out else " (not saved: give -o FILE)"))
+
+
+def _check_output(out: Path) -> None:
+    """Refuse an output the fit could not be written to, before the fit's seconds are spent."""
+    import os
+
+    if out.is_dir():
+        raise DesignerError(f"-o {out} is a folder", "give a file path ending in .json")
+    if out.suffix.lower() != ".json":
+        raise DesignerError(f"-o {out} does not end in .json", "the surrogate is JSON: give e.g. -o my.json")
+    parent = out.resolve().parent
+    if not parent.is_dir():
+        raise DesignerError(f"cannot write {out}: folder {parent} does not exist", "create it first")
+    if not os.access(parent, os.W_OK):
+        raise DesignerError(f"cannot write {out}: folder {parent} is not writable", "choose another path")
+
+
+def _fit_report(sur, m) -> dict:
+    """One response's part of `fit --json`: nested figures first, the chosen form's own LOO labelled."""
+    runs = sur.training["run"]
+    return {
+        "form": m.form,
+        "unit": m.unit,
+        "alpha": m.alpha,
+        "predictable": m.predictable,
+        "loo_nested": m.loo_nested,
+        "loo": m.loo,
+        "loo_label": "the selected form's own leave-one-out (optimistic: the form was chosen on these "
+        "errors); loo_nested repeats the whole selection without each run",
+        "influence": [d | {"run": int(runs[d["row"]])} for d in m.influence],
+        "lack_of_fit": m.lack_of_fit,
+        "candidates": m.candidates,
+    }
+
+
+def _print_fit(report: dict, n_runs: int) -> None:
     from rich.table import Table
 
-    tab = Table(title=f"Leave-one-out accuracy on {len(table)} runs (form chosen per response)")
+    tab = Table(title=f"Nested leave-one-out accuracy on {n_runs} runs (form chosen again without each run)")
     for col in ("response", "form", "Q2", "RMSE", "MAPE", "PI95 coverage", "verdict"):
         tab.add_column(col)
-    for r, m in sur.models.items():
-        verdict = "partly predictable" if m.predictable else "unpredictable (mean)"
+    for r, m in report["responses"].items():
+        nested = m["loo_nested"]
         tab.add_row(
             r,
-            m.form,
-            f"{m.loo['q2']:.3f}",
-            f"{m.loo['rmse']:.3g} {m.unit}",
-            f"{m.loo['mape']:.1f} %",
-            f"{100 * m.loo['coverage95']:.0f} %",
-            verdict,
+            m["form"],
+            f"{nested['q2']:.2f}",
+            f"{nested['rmse']:.2g} {m['unit']}",
+            f"{nested['mape']:.0f} %",
+            f"{100 * nested['coverage95']:.0f} %",
+            "partly predictable" if m["predictable"] else "unpredictable (mean)",
         )
     console.print(tab)
-    console.print(f"surrogate id {sur.id}" + (f", written to {out}" if out else " (not saved: give -o FILE)"))
+    for r, m in report["responses"].items():
+        for d in m["influence"]:
+            console.print(
+                f"- {r}: run {d['run']} ({100 * d['press_share']:.0f} % of the LOO squared error): "
+                f"without it the procedure {'keeps' if d['form'] == m['form'] else 'picks'} the "
+                f"{d['form']} form (its LOO Q2 {d['q2']:.2f}, {d['delta_q2']:+.2f})"
+            )
+        lof = m["lack_of_fit"]
+        if lof and lof["p_value"] is not None:
+            console.print(
+                f"- {r}: lack of fit against {lof['df_pure_error']:g} dof of pure error from "
+                f"{lof['replicated_designs']} replicated design(s): "
+                f"F = {lof['f']:.3g}, p = {lof['p_value']:.2g}"
+            )
 
 
 def predict(
@@ -126,7 +192,7 @@ def predict(
     Example: designer predict --density 60 --length 24 --width 4.5 --height 9 --layer 0.16 --raster 0
     """
     from designer import space, units
-    from designer.suggest import predictability
+    from designer.suggestions import predictability
 
     params = space.check_design(
         dict(density=density, length=length, width=width, height=height, layer=layer, raster=raster),
@@ -146,14 +212,30 @@ def predict(
         for q in ("k", "c")
     }
     notes = space.printability_notes(params)
+    extrapolated = space.extrapolated(params)
+    for name in extrapolated:
+        f = space.BY_NAME[name]
+        notes.append(
+            f"{name} = {params[name]:g} {f.unit} is outside the tested range {f.describe_range()}: "
+            "the prediction is an extrapolation"
+        )
     if as_json:
         print_json(
-            {"axis": axis, "params": params, "predicted": predicted, "notes": notes, "surrogate_id": sur.id}
+            {
+                "axis": axis,
+                "params": params,
+                "predicted": predicted,
+                "extrapolated": extrapolated,
+                "notes": notes,
+                "surrogate_id": sur.id,
+            }
         )
         return
     for q in ("k", "c"):
         p = predicted[q]
-        console.print(f"{q}_{axis} = {_pi(p)} {p['unit']}  (value [95 % PI]; LOO Q2 = {p['loo_q2']:.2f})")
+        console.print(
+            f"{q}_{axis} = {_pi(p)} {p['unit']}  (value [95 % PI]; nested LOO Q2 = {p['loo_q2']:.2f})"
+        )
         if not p["predictable"]:
             console.print(f"  [yellow]{info[q]['statement']}[/yellow]")
     for note in notes:
@@ -162,61 +244,99 @@ def predict(
 
 def suggest(
     k: Annotated[
-        float | None, typer.Option("--k", help="Target stiffness (N/mm; N.mm/rad on rotational axes).")
+        str | None,
+        typer.Option("--k", help="Stiffness goal: a target (N/mm; N.mm/rad on rotational axes), min or max."),
     ] = None,
     c: Annotated[
-        float | None, typer.Option("--c", help="Target damping (N.s/mm; N.mm.s/rad on rotational axes).")
+        str | None,
+        typer.Option(
+            "--c", help="Damping goal: a target (N.s/mm; N.mm.s/rad on rotational axes), min or max."
+        ),
     ] = None,
     axis: AxisOpt = "x",
     fix: Annotated[
-        list[str] | None, typer.Option("--fix", help="Hold a factor, e.g. --fix width=4.5 (repeatable).")
+        list[str] | None, typer.Option("--fix", help="Hold a factor, e.g. --fix width=4.5 (once per factor).")
     ] = None,
     top: Annotated[int, typer.Option("--top", help="How many distinct candidates.")] = 5,
-    importance_k: Annotated[float, typer.Option("--importance-k", help="Importance of the k target.")] = 1.0,
-    importance_c: Annotated[float, typer.Option("--importance-c", help="Importance of the c target.")] = 1.0,
+    tolerance: Annotated[
+        float, typer.Option("--tolerance", help="Band around a target that counts as met, % (+-).")
+    ] = 10.0,
+    importance_k: Annotated[float, typer.Option("--importance-k", help="Importance of the k goal.")] = 1.0,
+    importance_c: Annotated[float, typer.Option("--importance-c", help="Importance of the c goal.")] = 1.0,
+    weight_k: Annotated[float, typer.Option("--weight-k", help="Desirability shape exponent of k.")] = 1.0,
+    weight_c: Annotated[float, typer.Option("--weight-c", help="Desirability shape exponent of c.")] = 1.0,
     k_low: Annotated[
-        float | None, typer.Option(help="Lower desirability bound of k (default: data minimum).")
+        float | None, typer.Option(help="Lower desirability bound of k (default: measured min).")
     ] = None,
     k_high: Annotated[
-        float | None, typer.Option(help="Upper desirability bound of k (default: data maximum).")
+        float | None, typer.Option(help="Upper desirability bound of k (default: measured max).")
     ] = None,
     c_low: Annotated[
-        float | None, typer.Option(help="Lower desirability bound of c (default: data minimum).")
+        float | None, typer.Option(help="Lower desirability bound of c (default: measured min).")
     ] = None,
     c_high: Annotated[
-        float | None, typer.Option(help="Upper desirability bound of c (default: data maximum).")
+        float | None, typer.Option(help="Upper desirability bound of c (default: measured max).")
     ] = None,
     allow_extrapolation: Annotated[
-        bool, typer.Option(help="Search half a range beyond the tested ranges (flagged as extrapolated).")
+        bool,
+        typer.Option(help="Search half a range beyond the tested ranges, within printable limits (flagged)."),
     ] = False,
     surrogate: SurrogateOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
-    """Suggest printable settings whose predicted k and c hit the targets, ranked by desirability.
+    """Suggest printable settings for goals on k and c, ranked by the chance of meeting them.
 
-    Either target may be omitted. Each candidate comes with predicted values, 95 % prediction
-    intervals and its composite desirability; targets the data cannot reach or predict are said so.
+    Each goal is a target value, min or max. Candidates are ranked by the probability that a
+    printed joint lands within --tolerance of the targets, then by composite desirability D (over
+    the predictable responses). Exit 1 when no design's prediction reaches a target within the
+    tolerance (the output is still printed), 2 on bad input.
 
     Example: designer suggest --k 0.8 --c 2e-3 --fix raster=0 --top 3
     """
-    from designer.suggest import suggest as run_suggest
+    from designer.suggestions import suggest as run_suggest
 
+    _positive(importance_k=importance_k, importance_c=importance_c, weight_k=weight_k, weight_c=weight_c)
     result = run_suggest(
         _load(surrogate),
-        k=k,
-        c=c,
+        k=_parse_goal(k, "--k"),
+        c=_parse_goal(c, "--c"),
         axis=axis,
         fixed=_parse_fix(fix or []),
         top=top,
         importance={"k": importance_k, "c": importance_c},
         bounds={"k": (k_low, k_high), "c": (c_low, c_high)},
+        weight={"k": weight_k, "c": weight_c},
+        tolerance=_tolerance(tolerance),
         allow_extrapolation=allow_extrapolation,
     )
     data = result.to_dict()
     if as_json:
         print_json(data)
-        return
-    _print_suggestion(data)
+    else:
+        _print_suggestion(data)
+    if not data["reachable"]:
+        raise typer.Exit(1)
+
+
+def _positive(**values: float) -> None:
+    """Refuse a non-positive importance or weight, naming its flag."""
+    for name, v in values.items():
+        if not v > 0:
+            flag = "--" + name.replace("_", "-")
+            raise DesignerError(f"{flag} {v:g} must be positive", f"give e.g. {flag} 1")
+
+
+def _tolerance(percent: float) -> float:
+    if not 0 < percent < 100:
+        raise DesignerError(f"--tolerance {percent:g} is not between 0 and 100 %", "give e.g. --tolerance 10")
+    return percent / 100
+
+
+def _cell(cand: dict, name: str) -> str:
+    """A factor's value in the table: 'any' where it has no effect, '*' where extrapolated."""
+    if name in cand["any"]:
+        return "any"
+    return f"{cand['params'][name]:g}" + ("*" if name in cand["extrapolated"] else "")
 
 
 def _print_suggestion(data: dict) -> None:
@@ -224,9 +344,12 @@ def _print_suggestion(data: dict) -> None:
     from rich.table import Table
 
     u = data["units"]
-    goals = ", ".join(f"{q} = {v:g} {u[q]}" for q, v in data["targets"].items() if v is not None)
-    # an unpredictable response has the same prediction everywhere: stated below, not repeated per row
-    shown = [q for q in ("k", "c") if data["predictability"][q]["predictable"]] or ["k", "c"]
+    goals = ", ".join(
+        f"{q} = {v:g} {u[q]}" if isinstance(v, float) else f"{q} {v}"
+        for q, v in data["targets"].items()
+        if v is not None
+    )
+    band = f"+-{100 * data['tolerance']:.0f} %"
     tab = Table(
         title=f"Designs for {goals} on axis {data['axis']}",
         box=box.SIMPLE_HEAD,
@@ -235,24 +358,25 @@ def _print_suggestion(data: dict) -> None:
     )
     for col in ("#", "infill\n%", "l\nmm", "b\nmm", "h\nmm", "layer\nmm", "raster\ndeg"):
         tab.add_column(col, justify="right", no_wrap=True)
-    for q in shown:
+    for q in ("k", "c"):
         tab.add_column(f"{q} {u[q]}\n[95 % PI]", justify="right", no_wrap=True)
+    tab.add_column(f"P\n{band}", justify="right", no_wrap=True)
     tab.add_column("D", justify="right", no_wrap=True)
     for i, cand in enumerate(data["candidates"], 1):
-        p, pr = cand["params"], cand["predicted"]
+        names = ("density", "length", "width", "height", "layer", "raster")
         tab.add_row(
             str(i),
-            f"{p['density']:g}",
-            f"{p['length']:g}",
-            f"{p['width']:g}",
-            f"{p['height']:g}",
-            f"{p['layer']:g}",
-            f"{p['raster']:g}",
-            *[_pi(pr[q]) for q in shown],
-            f"{cand['desirability']:.3f}",
+            *[_cell(cand, n) for n in names],
+            *[_pi(cand["predicted"][q]) for q in ("k", "c")],
+            "-" if cand["p_within"] is None else f"{cand['p_within']:.2f}",
+            "-" if cand["desirability"] is None else f"{cand['desirability']:.2f}",
         )
     console.print(tab)
-    console.print("l, b, h: length, width, height; D: composite desirability (1 = every target met)")
+    console.print(
+        f"l, b, h: length, width, height; P: probability that a printed joint meets the predictable targets "
+        f"within {band}; D: composite desirability of the predictable responses (1 = every goal met); "
+        "any: no effect at this geometry (predicted as solid); *: outside the tested range (extrapolated)"
+    )
     style = "green" if data["reachable"] else "bold red"
     for s in data["statements"]:
         console.print(f"[{style}]-[/{style}] {s}")
@@ -264,7 +388,7 @@ def _print_suggestion(data: dict) -> None:
             console.print(f"- candidate {i}: {note}")
     console.print(
         "Printability: infill rounded to 1 %, geometry to 0.01 mm, layer and raster at the study's levels; "
-        "walls 0.8 mm, nozzle 0.4 mm."
+        "walls 0.8 mm, nozzle 0.4 mm, so width and height at least 2.0 mm."
     )
 
 

@@ -1,9 +1,14 @@
-"""`designer export fmu|modelica|mjcf|urdf`: a joint for simulators from numbers, a design or a suggestion."""
+"""`designer export fmu|modelica|mjcf|urdf|sdf|ssp`: a joint for simulators.
+
+The joint comes from numbers, a design or a suggestion.
+"""
 
 from __future__ import annotations
 
+import inspect
+from collections.abc import Callable
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
@@ -12,7 +17,7 @@ from designer.errors import DesignerError
 from .common import console, print_json, progress
 
 export_app = typer.Typer(
-    help="Export a joint: FMU (FMI 2/3), Modelica package, MJCF or URDF snippet.", no_args_is_help=True
+    help="Export a joint: FMU (FMI 2/3), Modelica, MJCF, URDF, SDF or SSP.", no_args_is_help=True
 )
 
 Floats = Annotated[list[float] | None, typer.Option(show_default=False)]  # noqa: UP007 (typer needs Optional)
@@ -76,7 +81,86 @@ def _print_joint(joint, what: str, path: Path) -> None:
         )
 
 
+Platforms = Annotated[
+    str | None,  # noqa: UP007
+    typer.Option(
+        help="binaries for: all, host, or a comma list of x86_64-linux, aarch64-linux, "
+        "x86_64-windows, x86_64-darwin, aarch64-darwin (default: all when ziglang is installed)"
+    ),
+]
+
 JOINT_HELP = "rig units: --k N/mm (N.mm/rad), --c N.s/mm (N.mm.s/rad), --m kg (kg.m^2)"
+
+
+def _snippet(
+    fmt: str, suffix: str, title: str, write: Callable[..., object], example: str, extra: tuple = ()
+) -> None:
+    """Add `export FMT`: the joint options, `extra` options (inspect.Parameters) passed to `write`.
+
+    `write(joint, output, (suggestion path, candidate) or None, **extra)` writes and returns the
+    path or a result with `advice`.
+    """
+
+    def command(
+        output: Annotated[Path, typer.Option("-o", "--output", help="the file to write")] = Path(
+            f"joint{suffix}"
+        ),
+        axis: Annotated[
+            list[str] | None, typer.Option(help="x y z theta phi psi; repeat for several")
+        ] = None,  # noqa: UP007
+        k: Floats = None,
+        c: Floats = None,
+        m: Floats = None,
+        density: Number = None,
+        length: Number = None,
+        width: Number = None,
+        height: Number = None,
+        layer: Number = None,
+        raster: Number = None,
+        from_: Annotated[
+            Path | None, typer.Option("--from", help="output of designer suggest --json")
+        ] = None,  # noqa: UP007
+        candidate: Annotated[int, typer.Option(help="candidate in --from, 1 = best")] = 1,
+        name: Annotated[str, typer.Option(help="joint (model) name")] = "FlexJoint",
+        allow_extrapolation: Annotated[bool, typer.Option(help="accept a design outside the ranges")] = False,
+        json_out: Annotated[bool, typer.Option("--json", help="print the result as JSON")] = False,
+        **options,
+    ) -> None:
+        joint = _joint(
+            axis,
+            k,
+            c,
+            m,
+            density,
+            length,
+            width,
+            height,
+            layer,
+            raster,
+            from_,
+            candidate,
+            name,
+            allow_extrapolation,
+        )
+        result = write(joint, output, (from_, candidate) if from_ else None, **options)
+        advice = getattr(result, "advice", {})
+        if json_out:
+            written = result.to_dict() if hasattr(result, "to_dict") else {"path": str(result)}
+            print_json({"format": fmt, "joint": joint.to_dict()} | written)
+            return
+        _print_joint(joint, title, output)
+        for n, a in advice.items():
+            console.print(f"  {n}: {a.text()}")
+
+    command.__doc__ = (
+        f"Write the joint as {title}, SI units, provenance in a comment.\n\n"
+        f"The joint comes from --k/--c [--m] ({JOINT_HELP}), the six print settings, or --from.\n\n"
+        f"Example: {example}"
+    )
+    signature = inspect.signature(command, eval_str=True)  # typer reads a __signature__ as it is
+    params = [p for p in signature.parameters.values() if p.kind is not p.VAR_KEYWORD]
+    command.__signature__ = signature.replace(parameters=[*params, *extra])
+    export_app.command(fmt)(command)
 
 
 def register(app: typer.Typer) -> None:
@@ -90,6 +174,7 @@ def register(app: typer.Typer) -> None:
         fmi: Annotated[int, typer.Option("--fmi", help="FMI version, 2 or 3")] = 2,
         interface: Annotated[str, typer.Option(help="force (element) or body")] = "force",
         source_only: Annotated[bool, typer.Option("--source-only", help="no binary: sources/ only")] = False,
+        platforms: Platforms = None,
         axis: Annotated[
             list[str] | None, typer.Option(help="x y z theta phi psi; repeat for several")
         ] = None,  # noqa: UP007
@@ -119,6 +204,7 @@ def register(app: typer.Typer) -> None:
 
         Example: designer export fmu --k 0.8 --c 2e-3 --m 0.01 --interface body --fmi 3 -o joint.fmu
         """
+        from designer.export import build
         from designer.export.fmu import export_fmu
 
         joint = _joint(
@@ -137,8 +223,9 @@ def register(app: typer.Typer) -> None:
             name,
             allow_extrapolation,
         )
+        platforms = platforms or ("all" if build.zig_available() else "host")
         with progress("exporting FMU (compiling on first use)") as tick:
-            path = export_fmu(joint, output, fmi, interface, source_only, progress=tick)
+            path = export_fmu(joint, output, fmi, interface, source_only, progress=tick, platforms=platforms)
         if json_out:
             print_json(
                 {
@@ -146,80 +233,157 @@ def register(app: typer.Typer) -> None:
                     "fmi_version": fmi,
                     "interface": interface,
                     "source_only": source_only,
+                    "platforms": [] if source_only else build.resolve_platforms(platforms),
                     "joint": joint.to_dict(),
                 }
             )
             return
         _print_joint(joint, f"FMI {fmi} FMU ({interface} interface)", path)
+        if not source_only:
+            console.print("  binaries: " + ", ".join(build.resolve_platforms(platforms)))
         if source_only:
             console.print(
                 "  no binary: build it from sources/ with 'python -m fmpy compile " + str(path) + "'"
             )
 
-    def snippet(fmt: str, suffix: str, title: str):
-        def command(
-            output: Annotated[Path, typer.Option("-o", "--output", help="the file to write")] = Path(
-                f"joint{suffix}"
-            ),
-            axis: Annotated[
-                list[str] | None, typer.Option(help="x y z theta phi psi; repeat for several")
-            ] = None,  # noqa: UP007
-            k: Floats = None,
-            c: Floats = None,
-            m: Floats = None,
-            density: Number = None,
-            length: Number = None,
-            width: Number = None,
-            height: Number = None,
-            layer: Number = None,
-            raster: Number = None,
-            from_: Annotated[
-                Path | None, typer.Option("--from", help="output of designer suggest --json")
-            ] = None,  # noqa: UP007
-            candidate: Annotated[int, typer.Option(help="candidate in --from, 1 = best")] = 1,
-            name: Annotated[str, typer.Option(help="joint (model) name")] = "FlexJoint",
-            allow_extrapolation: Annotated[
-                bool, typer.Option(help="accept a design outside the ranges")
-            ] = False,
-            json_out: Annotated[bool, typer.Option("--json", help="print the result as JSON")] = False,
-        ) -> None:
-            joint = _joint(
-                axis,
-                k,
-                c,
-                m,
-                density,
-                length,
-                width,
-                height,
-                layer,
-                raster,
-                from_,
-                candidate,
-                name,
-                allow_extrapolation,
-            )
-            if fmt == "modelica":
-                from designer.export.modelica import export_modelica
-
-                path = export_modelica(joint, output)
-            else:
-                from designer.export.robot import export_robot
-
-                path = export_robot(joint, output, fmt)
-            if json_out:
-                print_json({"path": str(path), "format": fmt, "joint": joint.to_dict()})
-                return
-            _print_joint(joint, title, path)
-
-        command.__doc__ = (
-            f"Write the joint as {title}, SI units, provenance in a comment.\n\n"
-            f"The joint comes from --k/--c [--m] ({JOINT_HELP}), the six print settings, or --from.\n\n"
-            f"Example: designer export {fmt} --k 0.8 --c 2e-3 --m 0.01 -o joint{suffix}"
-        )
-        export_app.command(fmt)(command)
-
-    snippet("modelica", ".mo", "a Modelica package (MSL SpringDamper, Mass/Inertia)")
-    snippet("mjcf", ".xml", "an MJCF model (joint stiffness, damping, armature)")
-    snippet("urdf", ".urdf", "a URDF chain (dynamics damping; URDF has no stiffness)")
+    _formats(_snippet)
     app.add_typer(export_app, name="export")
+
+
+#: where the joint came from when it is a suggestion's candidate: (suggestion file, candidate), else None
+Source = tuple[Path, int] | None  # noqa: UP007
+
+if TYPE_CHECKING:
+    from designer.joint import Joint
+
+
+def _option(name: str, annotation: object, default: object) -> inspect.Parameter:
+    """A keyword-only typer option for `_snippet`'s `extra`."""
+    return inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=annotation)
+
+
+INTO = _option(
+    "into",
+    Annotated[Path | None, typer.Option(help="the robot file to copy with --joint made flexible")],  # noqa: UP007
+    None,
+)
+ROBOT_JOINT = _option("joint_name", Annotated[str | None, typer.Option("--joint", help="robot joint")], None)
+REST = _option("rest", Annotated[float, typer.Option(help="spring rest position, rad or m")], 0.0)
+AXIS_PICK = _option(
+    "axis_pick", Annotated[str | None, typer.Option("--use-axis", help="joint axis to use")], None
+)
+
+
+def _mjcf(
+    joint: Joint,
+    output: Path,
+    _from: Source,
+    *,
+    into: Path | None,
+    joint_name: str | None,
+    rest: float,
+    axis_pick: str | None,
+    form: str,
+    motor_inertia: float | None,
+    motor_bandwidth: float | None,
+):
+    from designer.export.mjcf import export_mjcf
+
+    return export_mjcf(
+        joint,
+        output,
+        into=into,
+        joint_name=joint_name,
+        axis=axis_pick,
+        form=form,
+        rest=rest,
+        motor_inertia=motor_inertia,
+        motor_bandwidth=motor_bandwidth,
+    )
+
+
+def _urdf(
+    joint: Joint,
+    output: Path,
+    _from: Source,
+    *,
+    into: Path | None,
+    joint_name: str | None,
+    rest: float,
+    axis_pick: str | None,
+):
+    from designer.export.urdf import export_urdf
+
+    return export_urdf(joint, output, into=into, joint_name=joint_name, axis=axis_pick, rest=rest)
+
+
+def _sdf(joint: Joint, output: Path, _from: Source):
+    from designer.export.urdf import export_sdf
+
+    return export_sdf(joint, output)
+
+
+def _ssp(joint: Joint, output: Path, suggestion: Source, *, interface: str) -> Path:
+    """The SSP archive; from a suggestion, every candidate becomes an SSV parameter set."""
+    from designer.export.ssp import candidate_sets, export_ssp
+
+    sets = None
+    if suggestion is not None:
+        sets = {joint.name: candidate_sets(suggestion[0], axes=list(joint.axes), name=joint.name)}
+    return export_ssp(joint, output, alternatives=sets, interface=interface)
+
+
+def _formats(snippet: Callable[..., None]) -> None:
+    """The robot and Modelica sub-commands of `export`, each with its own options."""
+    from designer.export.modelica import export_modelica
+
+    snippet(
+        "modelica",
+        ".mo",
+        "a Modelica package (MSL SpringDamper, Mass/Inertia)",
+        lambda joint, output, _from, msl: export_modelica(joint, output, msl=msl),
+        "designer export modelica --k 0.8 --c 2e-3 --m 0.01 --msl 3.2.3 -o joint.mo",
+        (_option("msl", Annotated[str, typer.Option(help="MSL version: 4.0.0 or 3.2.3")], "4.0.0"),),
+    )
+    snippet(
+        "mjcf",
+        ".xml",
+        "an MJCF model (joint stiffness, damping; real link inertia)",
+        _mjcf,
+        "designer export mjcf --k 50 --c 0.5 --m 1e-5 --axis theta --into robot.xml --joint elbow "
+        "-o robot_flex.xml",
+        (
+            INTO,
+            ROBOT_JOINT,
+            REST,
+            AXIS_PICK,
+            _option(
+                "form", Annotated[str, typer.Option(help="parallel or series (motor -> flexure)")], "parallel"
+            ),
+            _option("motor_inertia", Annotated[float | None, typer.Option(help="series: SI")], None),  # noqa: UP007
+            _option("motor_bandwidth", Annotated[float | None, typer.Option(help="series: servo Hz")], None),  # noqa: UP007
+        ),
+    )
+    snippet(
+        "urdf",
+        ".urdf",
+        "a URDF chain (damping; spring in a <gazebo reference> extension)",
+        _urdf,
+        "designer export urdf --k 50 --c 0.5 --m 1e-5 --axis theta -o joint.urdf",
+        (INTO, ROBOT_JOINT, REST, AXIS_PICK),
+    )
+    snippet(
+        "sdf",
+        ".sdf",
+        "an SDFormat model (spring_stiffness, spring_reference, damping)",
+        _sdf,
+        "designer export sdf --k 50 --c 0.5 --m 1e-5 --axis theta -o joint.sdf",
+    )
+    snippet(
+        "ssp",
+        ".ssp",
+        "an SSP archive (SSD, FMI 2 FMU, SSV parameter sets in SI; --from: one set per candidate)",
+        _ssp,
+        "designer export ssp --from suggestion.json -o joint.ssp",
+        (_option("interface", Annotated[str, typer.Option(help="body (load in) or force")], "body"),),
+    )

@@ -31,17 +31,19 @@ _PUBLIC = {
     "load_table": "data",
     "Surrogate": "surrogate",
     "Prediction": "surrogate",
-    "suggest": "suggest",
-    "Suggestion": "suggest",
+    "suggest": "suggestions",
+    "Suggestion": "suggestions",
     "Joint": "joint",
     "export_fmu": "export",
     "export_modelica": "export",
     "export_mjcf": "export",
     "export_urdf": "export",
+    "export_sdf": "export",
+    "export_ssp": "export",
     "identify": "rig.identify",
 }
 #: public names that are subpackages
-_SUBPACKAGES = ("cosim",)
+_SUBPACKAGES = ("cosim", "sweep")
 
 __all__ = ["DesignerError", "__version__", *_PUBLIC, *_SUBPACKAGES]
 
@@ -53,12 +55,9 @@ def __getattr__(name: str) -> Any:
     if module is None:
         raise AttributeError(f"module 'designer' has no attribute {name!r}")
     mod = importlib.import_module(f".{module}", __name__)
-    # importing a submodule binds its name on the package (designer.suggest, the module, would
-    # hide designer.suggest, the function): bind every public name it defines again
-    for public, home in _PUBLIC.items():
-        if home == module:
-            globals()[public] = getattr(mod, public)
-    return globals()[name]
+    value = getattr(mod, name)
+    globals()[name] = value
+    return value
 
 
 def __dir__() -> list[str]:

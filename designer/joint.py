@@ -17,7 +17,7 @@ from .errors import DesignerError
 from .mass import specimen_mass
 
 if TYPE_CHECKING:
-    from .suggest import Suggestion
+    from .suggestions import Suggestion
     from .surrogate import Prediction, Surrogate
 
 #: Howell's pseudo-rigid-body characteristic radius factor for a fixed-guided/cantilever beam
@@ -167,7 +167,7 @@ class Joint:
         Raises:
             DesignerError: the file is not a suggestion, or the candidate does not exist.
         """
-        from .suggest import Suggestion
+        from .suggestions import Suggestion
 
         where = "the suggestion"
         if not isinstance(suggestion, Suggestion):
@@ -195,7 +195,7 @@ class Joint:
             "source": f"{where.removeprefix('the ')}, candidate {candidate}",
             "params": params,
             "surrogate": suggestion.surrogate_id,
-            "targets": {q: t.value for q, t in suggestion.targets.items()},
+            "targets": {q: t.value if t.kind == "target" else t.kind for q, t in suggestion.targets.items()},
             "desirability": cand.desirability,
             "reachable": suggestion.reachable,
         }

@@ -12,6 +12,10 @@ from .errors import DesignerError
 WALL_MM = 0.8
 #: Nozzle diameter, mm (Table 1): the narrowest infill line the printer lays.
 NOZZLE_MM = 0.4
+#: The thinnest printable width or height: two walls and one nozzle line between them, mm.
+PRINTABLE_MIN_MM = 2 * WALL_MM + NOZZLE_MM
+#: Infill density limits of a slicer, % (the power law needs a density above zero).
+DENSITY_LIMITS = (1.0, 100.0)
 
 
 @dataclass(frozen=True)
@@ -78,9 +82,45 @@ def check_value(name: str, value: float, allow_extrapolation: bool = False) -> f
             f"{name} = {v:g} {f.unit} is outside the tested range {f.describe_range()}",
             "choose a value inside it, or pass allow_extrapolation=True to accept an unsupported prediction",
         )
-    if v <= 0:
-        raise DesignerError(f"{name} = {v:g} {f.unit} must be positive", f"give {f.describe_range()}")
+    lo, hi = printable_limits(f)
+    if not lo - 1e-9 <= v <= hi + 1e-9:
+        why = {
+            "width": f"two {WALL_MM:g} mm walls and one {NOZZLE_MM:g} mm line need {PRINTABLE_MIN_MM:g} mm",
+            "height": f"two {WALL_MM:g} mm walls and one {NOZZLE_MM:g} mm line need {PRINTABLE_MIN_MM:g} mm",
+            "density": "a slicer's infill runs from 1 to 100 %",
+        }.get(name, "a length must be positive")
+        raise DesignerError(
+            f"{name} = {v:g} {f.unit} cannot be printed ({why})", f"give {lo:g} to {hi:g} {f.unit}"
+        )
     return v
+
+
+def printable_limits(f: Factor) -> tuple[float, float]:
+    """What a printer can make of a continuous factor, beyond any tested range (mm or %)."""
+    if f.name in ("width", "height"):
+        return PRINTABLE_MIN_MM, math.inf
+    if f.name == "density":
+        return DENSITY_LIMITS
+    return 1e-9, math.inf
+
+
+def extended_range(f: Factor) -> tuple[float, float]:
+    """The search range when extrapolation is allowed: half the tested span beyond each end,
+    within what can be printed (width and height >= 2.0 mm, infill 1 to 100 %)."""
+    half = (f.high - f.low) / 2
+    lo, hi = printable_limits(f)
+    return max(f.low - half, lo), min(f.high + half, hi)
+
+
+def infill_matters(params: Mapping[str, float]) -> bool:
+    """Whether the infill density changes the part: more than one nozzle line fits inside the walls."""
+    core = min(params["width"], params["height"]) - 2 * WALL_MM
+    return core > NOZZLE_MM + 1e-9
+
+
+def extrapolated(params: Mapping[str, float]) -> list[str]:
+    """The continuous factors of a design outside their tested range."""
+    return [f.name for f in CONTINUOUS if not f.low - 1e-9 <= params[f.name] <= f.high + 1e-9]
 
 
 def check_design(params: Mapping[str, float], allow_extrapolation: bool = False) -> dict[str, float]:
@@ -109,10 +149,11 @@ def round_printable(params: Mapping[str, float]) -> dict[str, float]:
 def printability_notes(params: Mapping[str, float]) -> list[str]:
     """Plain statements about how the printer realises a design (walls against infill)."""
     notes: list[str] = []
-    core_w = params["width"] - 2 * WALL_MM
-    if core_w <= NOZZLE_MM + 1e-9:
+    if not infill_matters(params):
+        side = "width" if params["width"] <= params["height"] else "height"
+        core = params[side] - 2 * WALL_MM
         notes.append(
-            f"at {params['width']:g} mm width the two {WALL_MM:g} mm walls leave {max(core_w, 0):.1f} mm "
-            "inside, at most one nozzle line: the infill density has no effect and the part prints solid"
+            f"at {params[side]:g} mm {side} the two {WALL_MM:g} mm walls leave {core:.1f} mm inside, "
+            "at most one nozzle line: the infill density has no effect and the part prints solid"
         )
     return notes

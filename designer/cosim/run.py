@@ -20,6 +20,7 @@ from .. import units
 from ..errors import DesignerError
 from ..files import atomic_path, atomic_write
 from .fmu import FmuSystem, read_parameters
+from .kernel import run_master
 from .master import Master, Trace
 from .metrics import joint_metrics
 from .robot import Robot, SpringDamper, load_spec
@@ -49,6 +50,8 @@ class Result:
     laws: dict[str, dict[str, float]]
     validation: dict[str, Any] | None = None
     notes: tuple[str, ...] = field(default_factory=tuple)
+    #: what ran the loop: "kernel" (compiled) or "python" (the reference master)
+    engine: str = "python"
 
     def column(self, name: str) -> np.ndarray:
         """The signal `name`, shape (n,).
@@ -75,6 +78,7 @@ class Result:
             "scenario": None if sc.path is None else str(sc.path),
             "kind": sc.kind,
             "step": sc.step,
+            "engine": self.engine,
             "metrics": self.metrics,
             "notes": list(self.notes),
         }
@@ -120,8 +124,9 @@ def robot_run(
     duration: float,
     algorithm: str,
     progress: Progress = None,
+    engine: str = "auto",
 ) -> Trace:
-    """The robot co-simulated with its joint FMUs at macro step `step`."""
+    """The robot co-simulated with its joint FMUs at macro step `step`, by `engine` (kernel.run_master)."""
     robot = Robot(load_spec(sc.model, sc.lengths, sc.masses), sc.motors, step, sc.integrator)
     systems: dict = {"robot": robot}
     connections = []
@@ -138,7 +143,8 @@ def robot_run(
                 (f"robot.{name}.v", f"{name}.{a}.v"),
                 (f"{name}.{a}.f", f"robot.{name}.tau"),
             ]
-        return Master(systems, connections, algorithm).run(duration, step, progress)
+        master = Master(systems, connections, algorithm)
+        return run_master(master, duration, step, progress=progress, engine=engine)
     finally:
         for s in systems.values():
             if isinstance(s, FmuSystem):
@@ -149,13 +155,19 @@ def robot_reference(sc: Scenario, laws: Mapping, step: float, duration: float, i
     """The same robot with every joint's spring-damper computed inside MuJoCo."""
     springs = {j: SpringDamper(p["k"], p["c"], p["offset"]) for j, p in laws.items()}
     robot = Robot(load_spec(sc.model, sc.lengths, sc.masses), sc.motors, step, integrator, in_engine=springs)
-    return Master({"robot": robot}, []).run(duration, step)
+    return run_master(Master({"robot": robot}, []), duration, step)
 
 
 def rig_run(
-    sc: Scenario, fmu: Path, params: Mapping, step: float, duration: float, progress: Progress = None
+    sc: Scenario,
+    fmu: Path,
+    params: Mapping,
+    step: float,
+    duration: float,
+    progress: Progress = None,
+    engine: str = "auto",
 ) -> Trace:
-    """The hub servo driving the joint FMU's body interface."""
+    """The hub servo driving the joint FMU's body interface, by `engine` (see kernel.run_master)."""
     from .rig import HubServo, check_stable, servo_gains
 
     check_stable(params["m"], params["c"], params["k"], step)
@@ -166,7 +178,8 @@ def rig_run(
             raise DesignerError("the rig's FMU has the force interface", "export it with interface='body'")
         hub = HubServo(sc.hub, *servo_gains(params["m"], params["c"], params["k"]))
         connections = [(f"joint.{a}.s", "hub.s"), (f"joint.{a}.v", "hub.v"), ("hub.f", f"joint.{a}.f")]
-        return Master({"joint": joint, "hub": hub}, connections, sc.algorithm).run(duration, step, progress)
+        master = Master({"joint": joint, "hub": hub}, connections, sc.algorithm)
+        return run_master(master, duration, step, progress=progress, engine=engine)
     finally:
         joint.close()
 
@@ -257,7 +270,9 @@ def rig_metrics(sc: Scenario, res: Trace, params: Mapping) -> dict:
     }
 
 
-def run(scenario: Scenario, *, validate: bool = False, progress: Progress = None) -> Result:
+def run(
+    scenario: Scenario, *, validate: bool = False, progress: Progress = None, engine: str = "auto"
+) -> Result:
     """Co-simulate `scenario` and return the result in memory; no file is written.
 
     Args:
@@ -265,6 +280,9 @@ def run(scenario: Scenario, *, validate: bool = False, progress: Progress = None
         validate: also compare with the reference (in-engine MuJoCo spring-damper and RK4 for a
             robot, a monolithic scipy solution for the rig) at the scenario's validation steps.
         progress: called with the fraction done, 0 to 1.
+        engine: "kernel" runs the loop compiled (fmus/kernel/, built on first use with the system C
+            compiler), "python" in the reference master, "auto" the kernel when there is a compiler
+            and it can run every system; `Result.engine` says which ran.
 
     Raises:
         DesignerError: an FMU that cannot be loaded, a co-simulation that diverges.
@@ -278,16 +296,18 @@ def run(scenario: Scenario, *, validate: bool = False, progress: Progress = None
     with joint_fmus(sc) as fmus:
         if sc.kind == "rig":
             laws = {"rig": law(sc.rig_joint, fmus["rig"])}
-            trace = rig_run(sc, fmus["rig"], laws["rig"], sc.step, sc.duration, part(0.0, share))
+            trace = rig_run(sc, fmus["rig"], laws["rig"], sc.step, sc.duration, part(0.0, share), engine)
             metrics = rig_metrics(sc, trace, laws["rig"])
             check = _validate_rig if validate else None
         else:
             laws = {j: law(src, fmus[j]) for j, src in sc.joints.items()}
-            trace = robot_run(sc, fmus, sc.step, sc.duration, sc.algorithm, part(0.0, share))
+            trace = robot_run(sc, fmus, sc.step, sc.duration, sc.algorithm, part(0.0, share), engine)
             metrics = robot_metrics(sc, trace, laws)
             check = _validate_robot if validate else None
         validation = None if check is None else check(sc, fmus, laws, part(share, 1.0 - share))
-    return Result(sc, trace.time, trace.columns, trace.values, metrics, laws, validation)
+    return Result(
+        sc, trace.time, trace.columns, trace.values, metrics, laws, validation, trace.delays, trace.engine
+    )
 
 
 def rig_log(result: Result) -> pd.DataFrame:
@@ -366,8 +386,10 @@ def _write_series(result: Result, out: Path, csv: bool, parquet: bool) -> list[P
     """The time series through pyarrow (its CSV writer is several times faster than pandas')."""
     import pyarrow as pa
 
-    names = ["t", *result.columns]
-    table = pa.table([result.time, *result.values.T], names=names)
+    # columns as buffers: pa.array / pa.table on numpy would import pandas (0.5 s) to check the type
+    columns = np.ascontiguousarray(np.column_stack([result.time, result.values]).T, dtype=float)
+    arrays = [pa.Array.from_buffers(pa.float64(), len(c), [None, pa.py_buffer(c)]) for c in columns]
+    table = pa.Table.from_arrays(arrays, names=["t", *result.columns])
     written = []
     if csv:
         import pyarrow.csv as pacsv

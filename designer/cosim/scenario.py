@@ -455,8 +455,14 @@ def _joint_source(spec: Any, key: str, d: _Doc, name: str) -> JointSource:
     if isinstance(candidate, bool) or not isinstance(candidate, int):
         raise DesignerError(f"{d.where(key)}.candidate = {candidate!r} is not a whole number", "1 = best")
     params = spec.get("parameters", {})
+    if isinstance(params, str):  # an SSV parameter set (SSP), units converted to SI
+        from ..export.ssp import read_ssv
+
+        params = read_ssv(d.file(params, f"{key}.parameters"))
     if not isinstance(params, dict):
-        raise DesignerError(f"{d.where(key)}.parameters must be a table", 'e.g. {"theta.k" = 0.3}')
+        raise DesignerError(
+            f"{d.where(key)}.parameters must be a table or an SSV file", 'e.g. {"theta.k" = 0.3} or "j1.ssv"'
+        )
     common = dict(axis=axis, fmi_version=spec.get("fmi_version", 2), parameters=params)
     if "fmu" in spec:
         return JointSource(fmu=d.file(spec["fmu"], f"{key}.fmu"), **common)

@@ -1,7 +1,8 @@
-"""Exporters of a Joint: FMU (FMI 2/3), Modelica package, MJCF and URDF.
+"""Exporters of a Joint: FMU (FMI 2/3), Modelica package, MJCF, URDF, SDF and SSP.
 
 Each writer takes a `designer.Joint` and a path, writes atomically, refuses a suffix that is not its
-format, and returns the path written.
+format, and returns the path written (the robot formats a `RobotExport`: the path, usable as one, and
+the step advice the file states).
 """
 
 from __future__ import annotations
@@ -12,8 +13,10 @@ from typing import Any
 _PUBLIC = {
     "export_fmu": "fmu",
     "export_modelica": "modelica",
-    "export_mjcf": "robot",
-    "export_urdf": "robot",
+    "export_mjcf": "mjcf",
+    "export_urdf": "urdf",
+    "export_sdf": "urdf",
+    "export_ssp": "ssp",
 }
 
 __all__ = list(_PUBLIC)

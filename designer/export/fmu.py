@@ -12,7 +12,7 @@ import json
 import math
 import uuid
 import zipfile
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
@@ -22,6 +22,7 @@ from ..errors import DesignerError
 from ..files import atomic_path, check_suffix
 from ..joint import AxisCoefficients, Joint
 from . import build
+from .layout import layout
 
 INTERFACES = ("force", "body")
 FMI_VERSIONS = (2, 3)
@@ -29,8 +30,6 @@ GENERATOR = f"flexjoint designer {__version__}"
 _ZIP_DATE = (1980, 1, 1, 0, 0, 0)
 _TOKEN = "@TOKEN@"
 
-#: value reference of a variable: 100 * (axis index + 1) + field (fmus/FlexJoint/config.h)
-_FIELDS = ("m", "c", "k", "offset", "enabled", "s", "v", "f", "a")
 
 # SI units and their base-unit exponents, for UnitDefinitions
 _BASE_UNITS: dict[str, dict[str, int]] = {
@@ -54,8 +53,8 @@ _BASE_ORDER = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
 
 
 def value_reference(axis: str, field: str) -> int:
-    """The fixed value reference of `axis.field`, the same in every FlexJoint FMU."""
-    return 100 * (units.AXES.index(axis) + 1) + _FIELDS.index(field)
+    """The fixed value reference of `axis.field` in every FlexJoint FMU (fmus/FlexJoint/config.h)."""
+    return layout().value_reference(axis, field)
 
 
 @dataclass(frozen=True)
@@ -72,7 +71,8 @@ class Variable:
     unit: str | None = None
     initial: str | None = None
     derivative_of: str | None = None  # name of the state this variable is the derivative of
-    depends_on: tuple[str, ...] | None = None  # for Outputs and derivatives
+    depends_on: tuple[str, ...] | None = None  # for Outputs and derivatives: inputs and states
+    parameters: tuple[str, ...] = ()  # the tunable parameters it depends on (FMI 3 dependencies)
 
 
 def _pi_text(ac: AxisCoefficients, quantity: str) -> str:
@@ -84,121 +84,146 @@ def _pi_text(ac: AxisCoefficients, quantity: str) -> str:
     return f", 95 % PI {lo:.4g} to {hi:.4g} {units.si_unit(quantity, axis)}"
 
 
+def _var(axis: str, field: str, *args, **kw) -> Variable:
+    """The variable `axis.field` with its fixed value reference."""
+    return Variable(f"{axis}.{field}", value_reference(axis, field), *args, **kw)
+
+
+def _parameter_variables(a: str, ac: AxisCoefficients) -> list[Variable]:
+    """The tunable parameters of axis `a`: m (if known), c, k, offset, enabled."""
+    si = ac.si()
+    rot = units.is_rotational(a)
+    out: list[Variable] = []
+
+    def var(field: str, *args, **kw) -> Variable:
+        return _var(a, field, *args, **kw)
+
+    if si["m"] is not None:
+        out.append(
+            var(
+                "m",
+                "Real",
+                "parameter",
+                "tunable",
+                f"{'inertia' if rot else 'mass'} on {a}; {ac.origin}",
+                si["m"],
+                units.si_unit("m", a),
+            )
+        )
+    out.append(
+        var(
+            "c",
+            "Real",
+            "parameter",
+            "tunable",
+            f"damping on {a}; {ac.origin}" + _pi_text(ac, "c"),
+            si["c"],
+            units.si_unit("c", a),
+        )
+    )
+    out.append(
+        var(
+            "k",
+            "Real",
+            "parameter",
+            "tunable",
+            f"stiffness on {a}; {ac.origin}" + _pi_text(ac, "k"),
+            si["k"],
+            units.si_unit("k", a),
+        )
+    )
+    r = units.si_unit("r", a)
+    out.append(var("offset", "Real", "parameter", "tunable", f"rest position on {a}", 0.0, r))
+    out.append(var("enabled", "Boolean", "parameter", "tunable", f"spring-damper on {a} active", True))
+    return out
+
+
+def _io_variables(a: str, interface: str) -> list[Variable]:
+    """Inputs, outputs and states of axis `a` for the force or the body interface."""
+    r, f = units.si_unit("r", a), units.si_unit("F", a)
+    rot = units.is_rotational(a)
+    what = "torque" if rot else "force"
+    out: list[Variable] = []
+
+    def var(field: str, *args, **kw) -> Variable:
+        return _var(a, field, *args, **kw)
+
+    if interface == "force":
+        out.append(
+            var(
+                "s",
+                "Real",
+                "input",
+                "continuous",
+                f"relative {'angle' if rot else 'displacement'}",
+                0.0,
+                r,
+            )
+        )
+        out.append(var("v", "Real", "input", "continuous", "relative velocity", 0.0, f"{r}/s"))
+        out.append(
+            var(
+                "f",
+                "Real",
+                "output",
+                "continuous",
+                f"{what} of the joint, -(k (s - offset) + c v)",
+                unit=f,
+                depends_on=(f"{a}.s", f"{a}.v"),
+                parameters=(f"{a}.c", f"{a}.k", f"{a}.offset"),
+            )
+        )
+    else:
+        out.append(
+            var(
+                "s",
+                "Real",
+                "output",
+                "continuous",
+                f"{'angle' if rot else 'displacement'} (state)",
+                0.0,
+                r,
+                "exact",
+                depends_on=(f"{a}.s",),
+            )
+        )
+        out.append(
+            var(
+                "v",
+                "Real",
+                "output",
+                "continuous",
+                "velocity (state), der(s)",
+                0.0,
+                f"{r}/s",
+                "exact",
+                derivative_of=f"{a}.s",
+                depends_on=(f"{a}.v",),
+            )
+        )
+        out.append(var("f", "Real", "input", "continuous", f"load {what} on the body", 0.0, f))
+        out.append(
+            var(
+                "a",
+                "Real",
+                "output",
+                "continuous",
+                "acceleration, der(v)",
+                unit=f"{r}/s^2",
+                derivative_of=f"{a}.v",
+                depends_on=(f"{a}.s", f"{a}.v", f"{a}.f"),
+                parameters=(f"{a}.m", f"{a}.c", f"{a}.k", f"{a}.offset"),
+            )
+        )
+    return out
+
+
 def _variables(joint: Joint, interface: str) -> list[Variable]:
+    """Every model variable of the joint: time, then per declared axis its parameters and I/O."""
     out = [Variable("time", 0, "Real", "independent", "continuous", "simulation time", unit="s")]
     for a in units.AXES:
-        if a not in joint.axes:
-            continue
-        ac: AxisCoefficients = joint.axes[a]
-        si = ac.si()
-        r, f = units.si_unit("r", a), units.si_unit("F", a)
-        rot = units.is_rotational(a)
-        what = "torque" if rot else "force"
-
-        def var(field: str, *args, **kw) -> Variable:
-            return Variable(f"{a}.{field}", value_reference(a, field), *args, **kw)  # noqa: B023
-
-        if si["m"] is not None:
-            out.append(
-                var(
-                    "m",
-                    "Real",
-                    "parameter",
-                    "tunable",
-                    f"{'inertia' if rot else 'mass'} on {a}; {ac.origin}",
-                    si["m"],
-                    units.si_unit("m", a),
-                )
-            )
-        out.append(
-            var(
-                "c",
-                "Real",
-                "parameter",
-                "tunable",
-                f"damping on {a}; {ac.origin}" + _pi_text(ac, "c"),
-                si["c"],
-                units.si_unit("c", a),
-            )
-        )
-        out.append(
-            var(
-                "k",
-                "Real",
-                "parameter",
-                "tunable",
-                f"stiffness on {a}; {ac.origin}" + _pi_text(ac, "k"),
-                si["k"],
-                units.si_unit("k", a),
-            )
-        )
-        out.append(var("offset", "Real", "parameter", "tunable", f"rest position on {a}", 0.0, r))
-        out.append(var("enabled", "Boolean", "parameter", "tunable", f"spring-damper on {a} active", True))
-        if interface == "force":
-            out.append(
-                var(
-                    "s",
-                    "Real",
-                    "input",
-                    "continuous",
-                    f"relative {'angle' if rot else 'displacement'}",
-                    0.0,
-                    r,
-                )
-            )
-            out.append(var("v", "Real", "input", "continuous", "relative velocity", 0.0, f"{r}/s"))
-            out.append(
-                var(
-                    "f",
-                    "Real",
-                    "output",
-                    "continuous",
-                    f"{what} of the joint, -(k (s - offset) + c v)",
-                    unit=f,
-                    depends_on=(f"{a}.s", f"{a}.v"),
-                )
-            )
-        else:
-            out.append(
-                var(
-                    "s",
-                    "Real",
-                    "output",
-                    "continuous",
-                    f"{'angle' if rot else 'displacement'} (state)",
-                    0.0,
-                    r,
-                    "exact",
-                    depends_on=(f"{a}.s",),
-                )
-            )
-            out.append(
-                var(
-                    "v",
-                    "Real",
-                    "output",
-                    "continuous",
-                    "velocity (state), der(s)",
-                    0.0,
-                    f"{r}/s",
-                    "exact",
-                    derivative_of=f"{a}.s",
-                    depends_on=(f"{a}.v",),
-                )
-            )
-            out.append(var("f", "Real", "input", "continuous", f"load {what} on the body", 0.0, f))
-            out.append(
-                var(
-                    "a",
-                    "Real",
-                    "output",
-                    "continuous",
-                    "acceleration, der(v)",
-                    unit=f"{r}/s^2",
-                    derivative_of=f"{a}.v",
-                    depends_on=(f"{a}.s", f"{a}.v", f"{a}.f"),
-                )
-            )
+        if a in joint.axes:
+            out += _parameter_variables(a, joint.axes[a]) + _io_variables(a, interface)
     return out
 
 
@@ -220,6 +245,17 @@ def _unit_definitions(variables: list[Variable]) -> list[str]:
         base = " ".join(f'{k}="{_BASE_UNITS[u][k]}"' for k in _BASE_ORDER if k in _BASE_UNITS[u])
         lines += [f"    <Unit name={quoteattr(u)}>", f"      <BaseUnit {base}/>", "    </Unit>"]
     return lines + ["  </UnitDefinitions>"]
+
+
+def _log_categories() -> list[str]:
+    """The categories the runtime logs in (runtime/instance.c setLogCategory)."""
+    return [
+        "  <LogCategories>",
+        '    <Category name="logEvents" description="life-cycle events"/>',
+        '    <Category name="logStatusDiscard" description="calls answered with Discard"/>',
+        '    <Category name="logStatusError" description="errors"/>',
+        "  </LogCategories>",
+    ]
 
 
 def _default_experiment(joint: Joint, interface: str) -> str:
@@ -255,28 +291,31 @@ def _fmi2_description(joint: Joint, interface: str, variables: list[Variable]) -
     variables = [v for v in variables if v.causality != "independent"]
     index = {v.name: i + 1 for i, v in enumerate(variables)}
     sources = "\n".join(f'      <File name="{Path(p).name}"/>' for p in build.c_sources(2))
+    lay = layout()
     caps = (
-        'canGetAndSetFMUstate="true" canSerializeFMUstate="true" providesDirectionalDerivative="true" '
+        f'canGetAndSetFMUstate="{lay.flag("CAN_GET_AND_SET_FMU_STATE")}" '
+        f'canSerializeFMUstate="{lay.flag("CAN_SERIALIZE_FMU_STATE")}" '
+        f'providesDirectionalDerivative="{lay.flag("PROVIDES_DIRECTIONAL_DERIVATIVES")}" '
         'canNotUseMemoryManagementFunctions="true"'
     )
+    not_needed = "false" if lay.capabilities["NEEDS_COMPLETED_INTEGRATOR_STEP"] else "true"
+    variable_step = lay.flag("CAN_HANDLE_VARIABLE_COMMUNICATION_STEP_SIZE")
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<fmiModelDescription fmiVersion="2.0" modelName={quoteattr(joint.name)} guid="{_TOKEN}"',
         f"  description={quoteattr(_description(joint, interface))}",
-        f'  generationTool="{GENERATOR}" variableNamingConvention="structured" numberOfEventIndicators="0">',
-        f'  <ModelExchange modelIdentifier="{build.MODEL_IDENTIFIER}" {caps} '
-        'completedIntegratorStepNotNeeded="true">',
+        f'  generationTool="{GENERATOR}" variableNamingConvention="structured" '
+        f'numberOfEventIndicators="{lay.capabilities["N_EVENT_INDICATORS"]}">',
+        f'  <ModelExchange modelIdentifier="{lay.model_identifier}" {caps} '
+        f'completedIntegratorStepNotNeeded="{not_needed}">',
         f"    <SourceFiles>\n{sources}\n    </SourceFiles>",
         "  </ModelExchange>",
-        f'  <CoSimulation modelIdentifier="{build.MODEL_IDENTIFIER}" {caps} '
-        'canHandleVariableCommunicationStepSize="true">',
+        f'  <CoSimulation modelIdentifier="{lay.model_identifier}" {caps} '
+        f'canHandleVariableCommunicationStepSize="{variable_step}">',
         f"    <SourceFiles>\n{sources}\n    </SourceFiles>",
         "  </CoSimulation>",
         *_unit_definitions(variables),
-        "  <LogCategories>",
-        '    <Category name="logEvents" description="life-cycle events"/>',
-        '    <Category name="logStatusError" description="errors"/>',
-        "  </LogCategories>",
+        *_log_categories(),
         _default_experiment(joint, interface),
         "  <ModelVariables>",
     ]
@@ -326,22 +365,26 @@ def _fmi2_description(joint: Joint, interface: str, variables: list[Variable]) -
 
 def _fmi3_description(joint: Joint, interface: str, variables: list[Variable]) -> str:
     vr = {v.name: v.vr for v in variables}
-    caps = 'canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="true"'
+    lay = layout()
+    caps = (
+        f'canGetAndSetFMUState="{lay.flag("CAN_GET_AND_SET_FMU_STATE")}" '
+        f'canSerializeFMUState="{lay.flag("CAN_SERIALIZE_FMU_STATE")}" '
+        f'providesDirectionalDerivatives="{lay.flag("PROVIDES_DIRECTIONAL_DERIVATIVES")}" '
+        f'providesAdjointDerivatives="{lay.flag("PROVIDES_ADJOINT_DERIVATIVES")}"'
+    )
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<fmiModelDescription fmiVersion="3.0" modelName={quoteattr(joint.name)}',
         f'  instantiationToken="{_TOKEN}"',
         f"  description={quoteattr(_description(joint, interface))}",
         f'  generationTool="{GENERATOR}" variableNamingConvention="structured">',
-        f'  <ModelExchange modelIdentifier="{build.MODEL_IDENTIFIER}" {caps} '
-        'needsCompletedIntegratorStep="false"/>',
-        f'  <CoSimulation modelIdentifier="{build.MODEL_IDENTIFIER}" {caps} '
-        'canHandleVariableCommunicationStepSize="true" hasEventMode="false"/>',
+        f'  <ModelExchange modelIdentifier="{lay.model_identifier}" {caps} '
+        f'needsCompletedIntegratorStep="{lay.flag("NEEDS_COMPLETED_INTEGRATOR_STEP")}"/>',
+        f'  <CoSimulation modelIdentifier="{lay.model_identifier}" {caps} '
+        f'canHandleVariableCommunicationStepSize="{lay.flag("CAN_HANDLE_VARIABLE_COMMUNICATION_STEP_SIZE")}" '
+        f'hasEventMode="{lay.flag("HAS_EVENT_MODE")}"/>',
         *_unit_definitions(variables),
-        "  <LogCategories>",
-        '    <Category name="logEvents" description="life-cycle events"/>',
-        '    <Category name="logStatusError" description="errors"/>',
-        "  </LogCategories>",
+        *_log_categories(),
         _default_experiment(joint, interface),
         "  <ModelVariables>",
     ]
@@ -365,7 +408,10 @@ def _fmi3_description(joint: Joint, interface: str, variables: list[Variable]) -
     lines += ["  </ModelVariables>", "  <ModelStructure>"]
 
     def unknown(tag: str, v: Variable, deps: bool = True) -> str:
-        d = f' dependencies="{" ".join(str(vr[n]) for n in v.depends_on)}"' if deps and v.depends_on else ""
+        # FMI 3 dependencies include the tunable parameters an unknown depends on (leaving them out
+        # would declare those partial derivatives identically zero)
+        known = sorted(vr[n] for n in (*(v.depends_on or ()), *v.parameters) if n in vr)
+        d = f' dependencies="{" ".join(map(str, known))}"' if deps and v.depends_on else ""
         return f'    <{tag} valueReference="{v.vr}"{d}/>'
 
     lines += [unknown("Output", v) for v in variables if v.causality == "output"]
@@ -385,7 +431,7 @@ def _build_description() -> str:
         [
             '<?xml version="1.0" encoding="UTF-8"?>',
             '<fmiBuildDescription fmiVersion="3.0">',
-            f'  <BuildConfiguration modelIdentifier="{build.MODEL_IDENTIFIER}">',
+            f'  <BuildConfiguration modelIdentifier="{layout().model_identifier}">',
             '    <SourceFileSet language="C99">',
             files,
             "    </SourceFileSet>",
@@ -427,9 +473,14 @@ def _check(joint: Joint, fmi_version: int, interface: str) -> None:
 
 
 def archive_entries(
-    joint: Joint, fmi_version: int = 2, interface: str = "force", source_only: bool = False
+    joint: Joint,
+    fmi_version: int = 2,
+    interface: str = "force",
+    source_only: bool = False,
+    platforms: str | Sequence[str] = "host",
 ) -> dict[str, bytes]:
-    """The files of the FMU archive, by name in the archive."""
+    """The files of the FMU archive, by name in the archive; binaries for `platforms` (see
+    `build.resolve_platforms`: "all", "host" or FMI 3 platform tuples) unless `source_only`."""
     _check(joint, fmi_version, interface)
     variables = _variables(joint, interface)
     describe = _fmi2_description if fmi_version == 2 else _fmi3_description
@@ -456,8 +507,9 @@ def archive_entries(
     if fmi_version == 3:
         entries["sources/buildDescription.xml"] = _build_description().encode()
     if not source_only:
-        binary = build.build_binary(fmi_version)
-        entries[f"binaries/{build.platform_folder(fmi_version)}/{build.library_name()}"] = binary.read_bytes()
+        for platform in build.resolve_platforms(platforms):
+            folder, name = build.platform_folder(fmi_version, platform), build.library_name(platform)
+            entries[f"binaries/{folder}/{name}"] = build.build_binary(fmi_version, platform).read_bytes()
     return entries
 
 
@@ -468,10 +520,18 @@ def export_fmu(
     interface: str = "force",
     source_only: bool = False,
     progress: Callable[[float], None] | None = None,
+    platforms: str | Sequence[str] = "host",
 ) -> Path:
-    """Write `joint` as an FMU at `path` (atomically); the same joint always gives the same bytes."""
+    """Write `joint` as an FMU at `path` (atomically); the same joint always gives the same bytes.
+
+    `platforms`: "host" (this machine, the default), "all" (linux, windows and macOS on x86_64 and
+    aarch64 as build.PLATFORMS lists; needs the ziglang package) or a list of FMI 3 platform tuples.
+
+    Raises:
+        DesignerError: bad arguments, or a binary that cannot be built.
+    """
     path = check_suffix(path, (".fmu",), what="an FMU")
-    entries = archive_entries(joint, fmi_version, interface, source_only)
+    entries = archive_entries(joint, fmi_version, interface, source_only, platforms)
     if progress:
         progress(0.5)
     with atomic_path(path) as tmp, zipfile.ZipFile(tmp, "w") as z:

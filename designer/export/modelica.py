@@ -1,4 +1,8 @@
-"""Export a Joint as a Modelica package built from the Modelica Standard Library (MSL 4)."""
+"""Export a Joint as a Modelica package built from the Modelica Standard Library (MSL 4, or 3.2.3).
+
+MSL 4 keeps SI types in `Modelica.Units.SI`; MSL 3.2.3 in `Modelica.SIunits`. The components used
+(Translational/Rotational SpringDamper with `c`, `d`; Mass `m`; Inertia `J`; flanges) are the same in both.
+"""
 
 from __future__ import annotations
 
@@ -7,8 +11,12 @@ import json
 from pathlib import Path
 
 from .. import units
+from ..errors import DesignerError
 from ..files import atomic_write, check_suffix
 from ..joint import Joint
+
+#: supported MSL versions and the package holding their SI types
+MSL_UNITS = {"4.0.0": "Modelica.Units.SI", "3.2.3": "Modelica.SIunits"}
 
 _MSL = {
     False: (
@@ -27,17 +35,23 @@ def _q(text: str) -> str:
     return text.replace("\\", "\\\\").replace('"', '\\"')
 
 
-def modelica_text(joint: Joint) -> str:
-    """The package: one model with, per axis, flanges, a SpringDamper and (m known) a Mass/Inertia."""
+def modelica_text(joint: Joint, *, msl: str = "4.0.0") -> str:
+    """The package: one model with, per axis, flanges, a SpringDamper and (m known) a Mass/Inertia.
+
+    Raises:
+        DesignerError: `msl` is not a supported MSL version.
+    """
+    if msl not in MSL_UNITS:
+        raise DesignerError(f"msl={msl!r} is not supported", f"use one of: {', '.join(MSL_UNITS)}")
+    si_types = MSL_UNITS[msl]
     decl, eqs = [], []
     for a, ac in joint.axes.items():
         lib, k_type, c_type, body, body_param, m_type = _MSL[units.is_rotational(a)]
         si = ac.si()
         mech = f"Modelica.Mechanics.{lib}"
         decl += [
-            f"  parameter Modelica.Units.SI.{k_type} k_{a} = {si['k']!r} "
-            f'"stiffness on {a}; {_q(ac.origin)}";',
-            f'  parameter Modelica.Units.SI.{c_type} c_{a} = {si["c"]!r} "damping on {a}; {_q(ac.origin)}";',
+            f'  parameter {si_types}.{k_type} k_{a} = {si["k"]!r} "stiffness on {a}; {_q(ac.origin)}";',
+            f'  parameter {si_types}.{c_type} c_{a} = {si["c"]!r} "damping on {a}; {_q(ac.origin)}";',
             f'  {mech}.Interfaces.Flange_a flange_a_{a} "fixed side of axis {a}";',
             f'  {mech}.Interfaces.Flange_b flange_b_{a} "moving side of axis {a}";',
             f"  {mech}.Components.SpringDamper springDamper_{a}(c = k_{a}, d = c_{a});",
@@ -47,7 +61,7 @@ def modelica_text(joint: Joint) -> str:
             eqs.append(f"  connect(springDamper_{a}.flange_b, flange_b_{a});")
         else:
             decl += [
-                f'  parameter Modelica.Units.SI.{m_type} m_{a} = {si["m"]!r} "moving {body.lower()} on {a}";',
+                f'  parameter {si_types}.{m_type} m_{a} = {si["m"]!r} "moving {body.lower()} on {a}";',
                 f"  {mech}.Components.{body} {body.lower()}_{a}({body_param} = m_{a});",
             ]
             eqs += [
@@ -65,16 +79,21 @@ def modelica_text(joint: Joint) -> str:
             *("  " + e for e in eqs),
             f'    annotation(Documentation(info = "{_q(info)}"));',
             "  end Joint;",
-            '  annotation(uses(Modelica(version = "4.0.0")));',
+            f'  annotation(uses(Modelica(version = "{msl}")));',
             f"end {joint.name};",
             "",
         ]
     )
 
 
-def export_modelica(joint: Joint, path: str | Path) -> Path:
-    """Write the package as a single .mo file (atomically) and return its path."""
+def export_modelica(joint: Joint, path: str | Path, *, msl: str = "4.0.0") -> Path:
+    """Write the package as a single .mo file (atomically) for MSL `msl` and return its path.
+
+    Raises:
+        DesignerError: a path not ending in .mo, or an unsupported `msl`.
+    """
     path = check_suffix(path, (".mo",), what="a Modelica")
+    text = modelica_text(joint, msl=msl)
     with atomic_write(path) as fh:
-        fh.write(modelica_text(joint))
+        fh.write(text)
     return path

@@ -1,106 +1,218 @@
-"""Export a Joint as MJCF (MuJoCo) or URDF snippets: stiffness, damping and moving mass per axis, SI units."""
+"""What the robot formats (MJCF, URDF, SDF) share: axis vectors, the joint's moving links, step advice.
+
+A robot format needs real bodies, never placeholder masses: a moving body without mass breaks MuJoCo
+("mass and inertia of moving bodies must be larger than mjMINVAL") and pybullet silently makes it 1 kg
+or recomputes its inertia from the collision shape. Each axis of a joint therefore gets a link that
+carries that axis' moving mass (translational axes) or moving inertia (rotational axes, with a mass
+from the design or from the pseudo-rigid-body model, see `links`), modelled as a sphere centred on the
+joint origin: its inertia is isotropic, so importers that recompute inertia from a collision sphere of
+that radius (pybullet by default) get the same number.
+"""
 
 from __future__ import annotations
 
 import json
+import math
+from dataclasses import dataclass
 from pathlib import Path
-from xml.sax.saxutils import quoteattr
 
-from .. import units
-from ..files import atomic_write, check_suffix
-from ..joint import Joint
+from .. import space, units
+from ..errors import DesignerError
+from ..joint import PRB_GAMMA, Joint
+from ..mass import specimen_mass
+from .stability import StepAdvice, step_advice
 
 #: the joint axis of each channel; the rotational ones follow roll (phi, x), pitch (theta, y), yaw (psi, z)
 AXIS_VECTORS = {"x": "1 0 0", "y": "0 1 0", "z": "0 0 1", "phi": "1 0 0", "theta": "0 1 0", "psi": "0 0 1"}
 
 
-def _comment(joint: Joint) -> str:
+@dataclass(frozen=True)
+class Sphere:
+    """A solid sphere on the joint origin: mass (kg), inertia about axes through it (kg.m^2), radius (m)."""
+
+    mass: float
+    inertia: float
+    radius: float
+    basis: str
+
+
+def sphere_with_mass(mass: float, basis: str) -> Sphere:
+    """The solid TPU sphere of `mass` kg (radius from the TPU density)."""
+    r = (3 * mass / (4 * math.pi * units.TPU_DENSITY)) ** (1 / 3)
+    return Sphere(mass, 0.4 * mass * r * r, r, basis)
+
+
+def sphere_with_inertia(inertia: float, mass: float, basis: str) -> Sphere:
+    """The sphere of `mass` kg with `inertia` kg.m^2 about its centre (radius from 2/5 m r^2)."""
+    return Sphere(mass, inertia, math.sqrt(2.5 * inertia / mass), basis)
+
+
+@dataclass(frozen=True)
+class RobotExport:
+    """What a robot-format export wrote: the path and, per joint name, the step advice it states."""
+
+    path: Path
+    advice: dict[str, StepAdvice]
+
+    def __fspath__(self) -> str:
+        return str(self.path)
+
+    def to_dict(self) -> dict[str, object]:
+        """Plain data for JSON: the path and each joint's step advice."""
+        return {"path": str(self.path), "advice": {n: a.to_dict() for n, a in self.advice.items()}}
+
+
+def pick_axis(joint: Joint, axis: str | None, rotational: bool | None = None) -> str:
+    """The joint's axis to export onto one robot joint: `axis`, or the only one (of the right kind)."""
+    if axis is not None:
+        return joint.axis(axis).axis
+    fits = [a for a in joint.axes if rotational is None or units.is_rotational(a) == rotational]
+    if not fits:
+        kind, names = (
+            ("rotational", units.ROTATIONAL) if rotational else ("translational", units.TRANSLATIONAL)
+        )
+        raise DesignerError(
+            f"joint '{joint.name}' has no {kind} axis for this {'hinge' if rotational else 'slide'}",
+            f"build the joint with a {kind} axis ({', '.join(names)})",
+        )
+    if len(fits) != 1:
+        raise DesignerError(
+            f"joint '{joint.name}' has axes {', '.join(joint.axes)}; cannot tell which one to export",
+            f"pass axis={fits[0]!r}, or another of them",
+        )
+    return fits[0]
+
+
+@dataclass(frozen=True)
+class Servo:
+    """A critically damped position servo: the motor's reflected inertia (its joint armature, SI), the
+    bandwidth (Hz), the proportional gain kp and the derivative gain kv (the motor joint's damping).
+
+    The motor body itself carries the flexure's clamped TPU part (see `links`); the rotor's inertia, as
+    a geared motor's usually is, is reflected through the gearbox and so modelled as armature.
+    """
+
+    motor_inertia: float
+    bandwidth: float
+    kp: float
+    kv: float
+
+    @classmethod
+    def for_flexure(
+        cls,
+        flex: StepAdvice,
+        *,
+        carried: float,
+        motor_inertia: float | None = None,
+        bandwidth: float | None = None,
+    ) -> Servo:
+        """Gains for a servo moving `motor_inertia` plus `carried` (what else turns with the motor).
+
+        Defaults: 10 x the flexure's moving inertia (`flex.inertia`), 10 x its natural frequency.
+
+        Raises:
+            DesignerError: a motor inertia or bandwidth that is not positive.
+        """
+        motor_inertia = 10 * flex.inertia if motor_inertia is None else motor_inertia
+        bandwidth = 10 * flex.natural_frequency if bandwidth is None else bandwidth
+        if not (motor_inertia > 0 and bandwidth > 0):
+            raise DesignerError(
+                f"motor_inertia={motor_inertia:g} and motor_bandwidth={bandwidth:g} must be positive",
+                "give positive numbers (SI inertia or mass, Hz)",
+            )
+        total = motor_inertia + carried
+        kp = total * (2 * math.pi * bandwidth) ** 2
+        return cls(motor_inertia, bandwidth, kp, 2 * math.sqrt(kp * total))
+
+
+def num(v: float) -> str:
+    """A number for XML: the shortest text that reads back as the same float."""
+    return repr(float(v))
+
+
+def inertial_xml(s: Sphere) -> str:
+    """The MJCF `<inertial>` of a sphere on the body's origin."""
+    i = num(s.inertia)
+    return f'<inertial pos="0 0 0" mass="{num(s.mass)}" diaginertia="{i} {i} {i}"/>'
+
+
+def with_masses(joint: Joint, why: str = "a robot link needs a real mass") -> Joint:
+    """The joint with every axis' moving mass: given, or from the design's geometry.
+
+    Raises:
+        DesignerError: an axis has no mass and the joint has no design to compute it from.
+    """
+    if all(ac.m is not None for ac in joint.axes.values()):
+        return joint
+    try:
+        return joint.with_masses()
+    except DesignerError:
+        missing = [a for a, ac in joint.axes.items() if ac.m is None]
+        raise DesignerError(
+            f"joint '{joint.name}' has no mass on axis {', '.join(missing)}: {why}",
+            "build the joint with m for every axis (kg, or kg.m^2 on rotational axes), or from a design",
+        ) from None
+
+
+def links(joint: Joint) -> dict[str, Sphere]:
+    """Per axis the moving link: its mass on a translational axis, its inertia on a rotational one.
+
+    A rotational link weighs the specimen's mass when the joint comes from a design; otherwise the
+    mass whose pseudo-rigid-body inertia m (gamma L)^2 is the axis' inertia, for the middle of the
+    tested lengths (bounds over the whole range stated). The joint must carry masses (`with_masses`).
+    """
+    params = joint.provenance.get("params")
+    lengths = space.BY_NAME["length"]
+    out = {}
+    for a, ac in joint.axes.items():
+        m = ac.si()["m"]
+        if not units.is_rotational(a):
+            out[a] = sphere_with_mass(m, f"the axis' moving mass {m:.4g} kg as a solid TPU sphere")
+        elif params is not None:
+            ms = specimen_mass(params)
+            out[a] = sphere_with_inertia(
+                m, ms, f"the axis' moving inertia {m:.4g} kg.m^2 with the specimen's mass {ms:.4g} kg"
+            )
+        else:
+
+            def mass(length_mm: float) -> float:
+                return m / (PRB_GAMMA * length_mm * units.MM) ** 2  # noqa: B023
+
+            mid = (lengths.low + lengths.high) / 2
+            out[a] = sphere_with_inertia(
+                m,
+                mass(mid),
+                f"the axis' moving inertia {m:.4g} kg.m^2 with mass {mass(mid):.3g} kg = m / (gamma L)^2 at "
+                f"L = {mid:g} mm ({mass(lengths.high):.3g} to {mass(lengths.low):.3g} kg over the tested "
+                f"{lengths.describe_range()})",
+            )
+    return out
+
+
+def chain(joint: Joint) -> tuple[dict[str, Sphere], dict[str, StepAdvice]]:
+    """The joint's links per axis, and the step advice per exported joint name (`<joint>_<axis>`).
+
+    The links form a chain, one per axis, all on the joint origin, so an axis sees the sum of the
+    masses (translational) or of the inertias (rotational) of its own and the following links, the
+    other axes held: on a joint with several axes that is more than the axis' own m, and the advice
+    (which states it) uses it. The joint must carry masses (see `with_masses`).
+    """
+    bodies = links(joint)
+    order = list(joint.axes)
+    advice = {}
+    for i, a in enumerate(order):
+        after = [bodies[b] for b in order[i:]]
+        inertia = sum(s.inertia if units.is_rotational(a) else s.mass for s in after)
+        si = joint.axes[a].si()
+        advice[f"{joint.name}_{a}"] = step_advice(si["k"], si["c"], inertia)
+    return bodies, advice
+
+
+def provenance_comment(joint: Joint) -> str:
+    """The joint's record as an XML comment (a '--' inside would end the comment early)."""
     text = json.dumps(joint.to_dict(), sort_keys=True, default=str).replace("--", "- -")
     return f"<!-- flexjoint designer: {text} -->"
 
 
-def mjcf_text(joint: Joint) -> str:
-    """A loadable MJCF model: one body carrying the joint's axes, moving mass as joint armature."""
-    joints = []
-    for a, ac in joint.axes.items():
-        si = ac.si()
-        kind = "hinge" if units.is_rotational(a) else "slide"
-        armature = f' armature="{si["m"]!r}"' if si["m"] is not None else ""
-        joints.append(
-            f'      <joint name="{joint.name}_{a}" type="{kind}" axis="{AXIS_VECTORS[a]}" '
-            f'stiffness="{si["k"]!r}" damping="{si["c"]!r}"{armature} springref="0"/>'
-        )
-    return "\n".join(
-        [
-            _comment(joint),
-            f"<mujoco model={quoteattr(joint.name)}>",
-            "  <!-- MJCF reads angles in degrees by default; these joints use radians -->",
-            '  <compiler angle="radian"/>',
-            "  <worldbody>",
-            f'    <body name="{joint.name}_link">',
-            "      <!-- the joint's moving mass is its armature; replace this placeholder inertial -->",
-            '      <inertial pos="0 0 0" mass="1e-9" diaginertia="1e-12 1e-12 1e-12"/>',
-            *joints,
-            "    </body>",
-            "  </worldbody>",
-            "</mujoco>",
-            "",
-        ]
-    )
-
-
-def urdf_text(joint: Joint) -> str:
-    """A URDF chain with one joint per axis; damping is declared, stiffness only stated (URDF has none)."""
-    lines = ['<?xml version="1.0"?>', _comment(joint), f"<robot name={quoteattr(joint.name)}>"]
-    lines.append(f'  <link name="{joint.name}_base"/>')
-    parent = f"{joint.name}_base"
-    for a, ac in joint.axes.items():
-        si = ac.si()
-        rot = units.is_rotational(a)
-        child = f"{joint.name}_{a}_link"
-        lines += [
-            f"  <!-- URDF has no joint stiffness: add k = {si['k']!r} {units.si_unit('k', a)} "
-            "on this joint in the simulator (a spring plugin or a controller) -->",
-            f'  <joint name="{joint.name}_{a}" type="{"revolute" if rot else "prismatic"}">',
-            f'    <parent link="{parent}"/>',
-            f'    <child link="{child}"/>',
-            f'    <axis xyz="{AXIS_VECTORS[a]}"/>',
-            f'    <limit lower="{-3.14159 if rot else -0.01}" upper="{3.14159 if rot else 0.01}" '
-            'effort="1000" velocity="100"/>',
-            f'    <dynamics damping="{si["c"]!r}" friction="0"/>',
-            "  </joint>",
-            f'  <link name="{child}">',
-        ]
-        if si["m"] is not None:
-            mass = si["m"] if not rot else 1e-9
-            inertia = si["m"] if rot else 1e-12
-            lines += [
-                "    <inertial>",
-                f'      <mass value="{mass!r}"/>',
-                f'      <inertia ixx="{inertia!r}" ixy="0" ixz="0" iyy="{inertia!r}" iyz="0" '
-                f'izz="{inertia!r}"/>',
-                "    </inertial>",
-            ]
-        lines.append("  </link>")
-        parent = child
-    lines += ["</robot>", ""]
-    return "\n".join(lines)
-
-
-def export_robot(joint: Joint, path: str | Path, fmt: str) -> Path:
-    """Write the MJCF ('mjcf') or URDF ('urdf') snippet atomically and return its path."""
-    text = mjcf_text(joint) if fmt == "mjcf" else urdf_text(joint)
-    path = check_suffix(path, (".xml", ".mjcf") if fmt == "mjcf" else (".urdf",), what=f"an {fmt.upper()}")
-    with atomic_write(path) as fh:
-        fh.write(text)
-    return path
-
-
-def export_mjcf(joint: Joint, path: str | Path) -> Path:
-    """Write the joint as an MJCF model at `path` (atomically); returns the path."""
-    return export_robot(joint, path, "mjcf")
-
-
-def export_urdf(joint: Joint, path: str | Path) -> Path:
-    """Write the joint as a URDF chain at `path` (atomically); returns the path."""
-    return export_robot(joint, path, "urdf")
+def xml_comment(text: str) -> str:
+    return "<!-- " + text.replace("--", "- -") + " -->"

@@ -1,4 +1,8 @@
-"""Predicted against observed under leave-one-out, with each prediction's 95 % interval."""
+"""Predicted against observed under leave-one-out, with each prediction's 95 % interval.
+
+Nested leave-one-out where the surrogate has it (the form and penalty chosen again without each run:
+the honest figure), else the selected form's own leave-one-out, labelled as such.
+"""
 
 from __future__ import annotations
 
@@ -12,7 +16,7 @@ from .common import new_figure, response_label, value_formatter
 def loo_table(surrogate, response: str) -> pd.DataFrame:
     """Per training run: observed, LOO prediction and its 95 % PI, and whether the PI covers the run."""
     model = surrogate.model(response)
-    pred = model.loo_predictions
+    pred = model.nested_predictions or model.loo_predictions
     observed = surrogate.table[response].to_numpy(float)
     return pd.DataFrame(
         {
@@ -52,10 +56,12 @@ def plot_loo(surrogate, *, responses: list[str] | None = None, fig: Figure | Non
         lim = [min(d.observed.min(), d.lo.min()), max(d.observed.max(), d.hi.max())]
         ax.plot(lim, lim, "k--", lw=0.8, label="predicted = observed")
         ax.set_xlabel(f"observed {response_label(resp)}")
-        ax.set_ylabel(f"leave-one-out prediction {response_label(resp)}")
-        loo = model.loo
+        nested = model.nested_predictions is not None
+        ax.set_ylabel(f"{'nested ' if nested else ''}leave-one-out prediction {response_label(resp)}")
+        loo = model.accuracy
         ax.set_title(
-            f"{resp}: {model.form}, Q2 {loo['q2']:.2f}, RMSE {loo['rmse']:.3g} {model.unit}\n"
+            f"{resp}: {model.form}, {'nested ' if nested else 'selected form, '}Q2 {loo['q2']:.2f}, "
+            f"RMSE {loo['rmse']:.3g} {model.unit}\n"
             f"95 % PI coverage {loo['coverage95']:.0%} of {len(d)} runs",
             fontsize=10,
         )

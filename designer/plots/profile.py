@@ -139,7 +139,7 @@ def _value_range(model: ResponseSurface, observed: np.ndarray, target: float | N
 
 def _target(surrogate: Surrogate, quantity: str, axis: str, value: float) -> dict[str, float]:
     """A target with its desirability bounds, as `designer suggest` sets them."""
-    from ..suggest import make_target
+    from ..suggestions import make_target
 
     t = make_target(surrogate, quantity, axis, value)
     return {"value": t.value, "low": t.low, "high": t.high, "importance": t.importance}
@@ -259,7 +259,7 @@ def build_profiler(
             f"tolerance={tolerance!r} is not a fraction between 0 and 1", "give e.g. tolerance=0.1"
         )
     start = space.check_design(DEFAULT_DESIGN | dict(design or {}))
-    from ..suggest import predictability
+    from ..suggestions import predictability
 
     info = predictability(surrogate, axis)
     responses = [

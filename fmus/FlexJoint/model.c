@@ -5,8 +5,11 @@
 
 #include "model.h"
 
-static const char *AXIS_NAMES[N_AXES] = {"x", "y", "z", "theta", "phi", "psi"};
-static const char *FIELD_NAMES[N_FIELDS] = {"m", "c", "k", "offset", "enabled", "s", "v", "f", "a"};
+static const char *AXIS_NAME[N_AXES] = AXIS_NAMES;
+static const char *FIELD_NAME[N_FIELDS] = FIELD_NAMES;
+/* the Float64 fields of an axis kept in a serialised state, in this order, then `enabled` as one byte */
+static const int SAVED_FIELDS[] = {F_M, F_C, F_K, F_OFFSET, F_S, F_V, F_F};
+#define N_SAVED (sizeof(SAVED_FIELDS) / sizeof(SAVED_FIELDS[0]))
 
 /* relative difference of step sizes under which the cached discretisation is reused */
 #define STEP_RTOL 1e-10
@@ -19,14 +22,14 @@ static Axis *lookup(ModelInstance *inst, unsigned vr, int *field) {
         return NULL;
     }
     if (inst->data.interface == ForceElement && *field == F_A) {
-        logError(inst, "%s.a does not exist in the force-element interface", AXIS_NAMES[i - 1]);
+        logError(inst, "%s.a does not exist in the force-element interface", AXIS_NAME[i - 1]);
         return NULL;
     }
     return &inst->data.axis[i - 1];
 }
 
 static const char *axisName(ModelInstance *inst, const Axis *a) {
-    return AXIS_NAMES[a - inst->data.axis];
+    return AXIS_NAME[a - inst->data.axis];
 }
 
 static double jointForce(const Axis *a) {
@@ -37,13 +40,13 @@ static double acceleration(const Axis *a) {
     return (a->f + jointForce(a)) / a->m;
 }
 
-static Status checkAxis(ModelInstance *inst, const char *n, const Axis *a) {
+static Status checkAxis(ModelInstance *inst, JointInterface interface, const char *n, const Axis *a) {
     double values[] = {a->m, a->c, a->k, a->offset, a->s, a->v, a->f};
     const int fields[] = {F_M, F_C, F_K, F_OFFSET, F_S, F_V, F_F};
     size_t i;
     for (i = 0; i < sizeof(values) / sizeof(values[0]); i++) {
         if (!isfinite(values[i])) {
-            logError(inst, "%s.%s = %g is not a finite number", n, FIELD_NAMES[fields[i]], values[i]);
+            logError(inst, "%s.%s = %g is not a finite number", n, FIELD_NAME[fields[i]], values[i]);
             return Error;
         }
     }
@@ -51,21 +54,22 @@ static Status checkAxis(ModelInstance *inst, const char *n, const Axis *a) {
         logError(inst, "%s: m, c and k must not be negative (m = %g, c = %g, k = %g)", n, a->m, a->c, a->k);
         return Error;
     }
-    if (inst->data.interface == Body && a->m <= 0) {
+    if (interface == Body && a->m <= 0) {
         logError(inst, "%s.m = %g: the body interface needs a positive mass or inertia", n, a->m);
         return Error;
     }
     return OK;
 }
 
-Status checkModel(ModelInstance *inst) {
+Status checkModel(ModelInstance *inst, const ModelData *data) {
     int i;
-    if (!inst->data.declared) {
+    if (!data->declared) {
         logError(inst, "the start values declare no axis");
         return Error;
     }
     for (i = 0; i < N_AXES; i++) {
-        if ((inst->data.declared & (1u << i)) && checkAxis(inst, AXIS_NAMES[i], &inst->data.axis[i]) > Warning) return Error;
+        if ((data->declared & (1u << i)) && checkAxis(inst, data->interface, AXIS_NAME[i], &data->axis[i]) > Warning)
+            return Error;
     }
     return OK;
 }
@@ -82,7 +86,7 @@ Status applyStart(ModelInstance *inst, const char *name, const char *value) {
     }
     if (strcmp(name, "axis") == 0) {
         for (i = 0; i < N_AXES; i++) {
-            if (strcmp(value, AXIS_NAMES[i]) == 0) {
+            if (strcmp(value, AXIS_NAME[i]) == 0) {
                 inst->data.declared |= 1u << i;
                 inst->data.axis[i].enabled = true;
                 return OK;
@@ -91,10 +95,10 @@ Status applyStart(ModelInstance *inst, const char *name, const char *value) {
         return Error;
     }
     for (i = 0; i < N_AXES; i++) {
-        size_t n = strlen(AXIS_NAMES[i]);
-        if (strncmp(name, AXIS_NAMES[i], n) != 0 || name[n] != '.') continue;
+        size_t n = strlen(AXIS_NAME[i]);
+        if (strncmp(name, AXIS_NAME[i], n) != 0 || name[n] != '.') continue;
         for (field = 0; field < N_FIELDS; field++) {
-            if (strcmp(name + n + 1, FIELD_NAMES[field]) != 0) continue;
+            if (strcmp(name + n + 1, FIELD_NAME[field]) != 0) continue;
             if (field == F_ENABLED) {
                 if (strcmp(value, "true") != 0 && strcmp(value, "false") != 0) return Error;
                 inst->data.axis[i].enabled = strcmp(value, "true") == 0;
@@ -111,7 +115,7 @@ Status applyStart(ModelInstance *inst, const char *name, const char *value) {
 Status getFloat64(ModelInstance *inst, unsigned vr, double *value) {
     int field;
     Axis *a;
-    if (vr == VR_TIME) {
+    if (vr == VR_TIME && inst->fmiVersion == 3) { /* FMI 2 leaves time implicit: no variable 0 */
         *value = inst->time;
         return OK;
     }
@@ -126,7 +130,7 @@ Status getFloat64(ModelInstance *inst, unsigned vr, double *value) {
         case F_F: *value = inst->data.interface == Body ? a->f : jointForce(a); return OK;
         case F_A: *value = acceleration(a); return OK;
         default:
-            logError(inst, "%s.%s is not a Float64 variable", axisName(inst, a), FIELD_NAMES[field]);
+            logError(inst, "%s.%s is not a Float64 variable", axisName(inst, a), FIELD_NAME[field]);
             return Error;
     }
 }
@@ -139,16 +143,18 @@ Status setFloat64(ModelInstance *inst, unsigned vr, double value) {
     if (!(a = lookup(inst, vr, &field))) return Error;
     const char *n = axisName(inst, a);
     if (field == F_A || field == F_ENABLED || (field == F_F && !body)) {
-        logError(inst, "%s.%s cannot be set with a Float64 value", n, FIELD_NAMES[field]);
+        logError(inst, "%s.%s cannot be set with a Float64 value", n, FIELD_NAME[field]);
         return Error;
     }
-    if (body && (field == F_S || field == F_V) && !(inst->state & (StartAndEnd | Instantiated | InitializationMode))) {
-        logError(inst, "the state %s.%s can only be given a start value before initialization ends", n,
-                 FIELD_NAMES[field]);
+    /* a continuous state may be set before initialization ends and, in Model Exchange, in Event and
+       Continuous-Time Mode; a co-simulation instance owns its states once it steps */
+    if (body && (field == F_S || field == F_V) &&
+        !(inst->state & (StartAndEnd | Instantiated | InitializationMode | EventMode | ContinuousTimeMode))) {
+        logError(inst, "the state %s.%s cannot be set while the co-simulation steps", n, FIELD_NAME[field]);
         return Error;
     }
     if (!isfinite(value)) {
-        logError(inst, "%s.%s = %g is not a finite number", n, FIELD_NAMES[field], value);
+        logError(inst, "%s.%s = %g is not a finite number", n, FIELD_NAME[field], value);
         return Error;
     }
     changed = *a;
@@ -162,7 +168,7 @@ Status setFloat64(ModelInstance *inst, unsigned vr, double value) {
         default: changed.f = value; break;
     }
     /* masses are checked once all start values are in, so that a start file may set m after k */
-    if (inst->state != StartAndEnd && checkAxis(inst, n, &changed) > Warning) return Error;
+    if (inst->state != StartAndEnd && checkAxis(inst, inst->data.interface, n, &changed) > Warning) return Error;
     if (field <= F_K) changed.cached = false;
     *a = changed;
     return OK;
@@ -191,23 +197,38 @@ Status setBoolean(ModelInstance *inst, unsigned vr, bool value) {
     return OK;
 }
 
+/* d force / d known (force element) on one axis, y = s - offset */
+static double forcePartial(const Axis *a, int known) {
+    double e = a->enabled ? 1.0 : 0.0;
+    switch (known) {
+        case F_S: return -e * a->k;
+        case F_V: return -e * a->c;
+        case F_K: return -e * (a->s - a->offset);
+        case F_C: return -e * a->v;
+        case F_OFFSET: return e * a->k;
+        default: return 0.0;
+    }
+}
+
 Status getPartial(ModelInstance *inst, unsigned unknown, unsigned known, double *value) {
     int fu, fk;
-    Axis *a = lookup(inst, unknown, &fu), *b = lookup(inst, known, &fk);
-    double e;
-    if (!a || !b) return Error;
+    Axis *a = lookup(inst, unknown, &fu), *b;
     *value = 0.0;
+    if (!a) return Error;
+    if (known == VR_TIME && inst->fmiVersion == 3) return OK; /* nothing depends on time explicitly */
+    if (!(b = lookup(inst, known, &fk))) return Error;
+    if (fu == F_ENABLED || fk == F_ENABLED) {
+        logError(inst, "partial derivatives: %s.enabled is Boolean and has none", AXIS_NAME[(fu == F_ENABLED ? a : b) - inst->data.axis]);
+        return Error;
+    }
     if (a != b) return OK;
-    e = a->enabled ? 1.0 : 0.0;
     if (fu == fk && (fu == F_S || fu == F_V)) {
         *value = 1.0; /* a state as output, or der(s) = v */
     } else if (fu == F_F && inst->data.interface == ForceElement) {
-        if (fk == F_S) *value = -e * a->k;
-        if (fk == F_V) *value = -e * a->c;
+        *value = forcePartial(a, fk);
     } else if (fu == F_A) {
-        if (fk == F_S) *value = -e * a->k / a->m;
-        if (fk == F_V) *value = -e * a->c / a->m;
-        if (fk == F_F) *value = 1.0 / a->m;
+        /* a = (f + force) / m */
+        *value = fk == F_F ? 1.0 / a->m : fk == F_M ? -acceleration(a) / a->m : forcePartial(a, fk) / a->m;
     }
     return OK;
 }
@@ -356,11 +377,60 @@ Status doStep(ModelInstance *inst, double h) {
         s = a->phi[0] * y + a->phi[1] * a->v + a->gamma[0] * a->f + a->offset;
         v = a->phi[2] * y + a->phi[3] * a->v + a->gamma[1] * a->f;
         if (!isfinite(s) || !isfinite(v)) {
-            logError(inst, "%s: the step of %g s gave a non-finite state", AXIS_NAMES[i], h);
+            logError(inst, "%s: the step of %g s gave a non-finite state", AXIS_NAME[i], h);
             return Error;
         }
         a->s = s;
         a->v = v;
     }
     return OK;
+}
+
+/* ---- the model's part of a serialised FMU state: per declared axis the saved Float64 fields, then enabled */
+
+size_t modelDataSize(ModelInstance *inst) {
+    size_t n = 0;
+    int i;
+    for (i = 0; i < N_AXES; i++) n += (inst->data.declared >> i) & 1u;
+    return n * (8 * N_SAVED + 1);
+}
+
+static double *field(Axis *a, int f) {
+    switch (f) {
+        case F_M: return &a->m;
+        case F_C: return &a->c;
+        case F_K: return &a->k;
+        case F_OFFSET: return &a->offset;
+        case F_S: return &a->s;
+        case F_V: return &a->v;
+        default: return &a->f;
+    }
+}
+
+void writeModelData(ModelInstance *inst, const ModelData *data, unsigned char bytes[]) {
+    int i;
+    size_t j;
+    for (i = 0; i < N_AXES; i++) {
+        Axis a = data->axis[i];
+        if (!(inst->data.declared & (1u << i))) continue;
+        for (j = 0; j < N_SAVED; j++, bytes += 8) putF64(bytes, *field(&a, SAVED_FIELDS[j]));
+        *bytes++ = a.enabled ? 1 : 0;
+    }
+}
+
+Status readModelData(ModelInstance *inst, const unsigned char bytes[], ModelData *data) {
+    int i;
+    size_t j;
+    for (i = 0; i < N_AXES; i++) {
+        Axis *a = &data->axis[i];
+        if (!(inst->data.declared & (1u << i))) continue;
+        for (j = 0; j < N_SAVED; j++, bytes += 8) *field(a, SAVED_FIELDS[j]) = getF64(bytes);
+        if (*bytes > 1) {
+            logError(inst, "deserialize FMU state: %s.enabled is neither true nor false", AXIS_NAME[i]);
+            return Error;
+        }
+        a->enabled = *bytes++ == 1;
+        a->cached = false;
+    }
+    return checkModel(inst, data);
 }

@@ -1,5 +1,6 @@
-/* The generic FMI 2.0 layer: calling-sequence checks with per-function state masks, the importer's logger,
-   status escalation; everything model-specific is delegated to model.h. */
+/* The generic FMI 2.0 layer: calling-sequence checks with per-function state masks (and the interface
+   type a function belongs to), the importer's logger, status escalation; everything model-specific is
+   delegated to model.h, the model's capabilities come from its config.h. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -18,32 +19,42 @@
 #define MASK_fmi2FMUstate (ANY_LIVE | ErrorState)
 #define MASK_fmi2GetDirectionalDerivative \
     (InitializationMode | EventMode | ContinuousTimeMode | StepMode | Terminated | ErrorState)
-#define MASK_fmi2EnterEventMode (EventMode | ContinuousTimeMode)
-#define MASK_fmi2NewDiscreteStates EventMode
-#define MASK_fmi2EnterContinuousTimeMode EventMode
-#define MASK_fmi2CompletedIntegratorStep ContinuousTimeMode
-#define MASK_fmi2SetTime (EventMode | ContinuousTimeMode)
-#define MASK_fmi2SetContinuousStates ContinuousTimeMode
-#define MASK_fmi2GetStates (InitializationMode | EventMode | ContinuousTimeMode | Terminated | ErrorState)
-#define MASK_fmi2InputDerivatives (Instantiated | InitializationMode | StepMode)
-#define MASK_fmi2OutputDerivatives (StepMode | Terminated | ErrorState)
-#define MASK_fmi2DoStep StepMode
-#define MASK_fmi2Status (StepMode | Terminated | ErrorState)
+#define MASK_fmi2EnterEventMode (ME_ONLY | EventMode | ContinuousTimeMode)
+#define MASK_fmi2NewDiscreteStates (ME_ONLY | EventMode)
+#define MASK_fmi2EnterContinuousTimeMode (ME_ONLY | EventMode)
+#define MASK_fmi2CompletedIntegratorStep (ME_ONLY | ContinuousTimeMode)
+#define MASK_fmi2SetTime (ME_ONLY | EventMode | ContinuousTimeMode)
+#define MASK_fmi2SetContinuousStates (ME_ONLY | ContinuousTimeMode)
+#define MASK_fmi2GetStates (ME_ONLY | InitializationMode | EventMode | ContinuousTimeMode | Terminated | ErrorState)
+#define MASK_fmi2GetNominals (MASK_fmi2GetStates | Instantiated)
+#define MASK_fmi2InputDerivatives (CS_ONLY | Instantiated | InitializationMode | StepMode)
+#define MASK_fmi2OutputDerivatives (CS_ONLY | StepMode | Terminated | ErrorState)
+#define MASK_fmi2DoStep (CS_ONLY | StepMode)
+#define MASK_fmi2Status (CS_ONLY | StepMode | Terminated | ErrorState)
 
 /* the instance, or return fmi2Error when it is NULL or `f` may not be called in its state */
 #define BEGIN(f)                                                          \
     ModelInstance *inst = (ModelInstance *)c;                             \
     if (!inst || !allowedIn(inst, #f, MASK_##f)) return fmi2Error
 
-#define CHECK_ARRAY(f, p, n)                                              \
-    if ((n) > 0 && !(p)) {                                                \
-        logError(inst, "%s: %s is NULL", #f, #p);                         \
-        return (fmi2Status)escalate(inst, Error);                         \
-    }
+#define RETURN(status) return (fmi2Status)escalate(inst, (status))
 
+#define CHECK_ARRAY(f, p, n) \
+    if (checkArray(inst, #f, #p, (p), (n)) > Warning) RETURN(Error)
+
+/* FMI 2's logger takes `message` as a printf format: every '%' of the text is doubled, so that an
+   instance name or path with '%' in it is printed as is (section 2.1.5) */
 static void logFmi2(ModelInstance *inst, Status status, const char *category, const char *message) {
     fmi2CallbackLogger logger = (fmi2CallbackLogger)(size_t)inst->logger;
-    if (logger) logger(inst->environment, inst->name, (fmi2Status)status, category, message);
+    char escaped[2048];
+    size_t i, n = 0;
+    if (!logger) return;
+    for (i = 0; message[i] && n + 2 < sizeof(escaped); i++) {
+        if (message[i] == '%') escaped[n++] = '%';
+        escaped[n++] = message[i];
+    }
+    escaped[n] = '\0';
+    logger(inst->environment, inst->name, (fmi2Status)status, category, escaped);
 }
 
 const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
@@ -55,16 +66,11 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nC
     size_t i;
     BEGIN(fmi2SetDebugLogging);
     CHECK_ARRAY(fmi2SetDebugLogging, categories, nCategories);
-    if (nCategories == 0) {
-        inst->logEvents = loggingOn;
-        inst->logErrors = true;
-    }
+    if (nCategories == 0) setLogCategory(inst, NULL, loggingOn != fmi2False);
     for (i = 0; i < nCategories; i++) {
-        if (strcmp(categories[i], "logEvents") == 0) inst->logEvents = loggingOn;
-        else if (strcmp(categories[i], "logStatusError") == 0) inst->logErrors = loggingOn;
-        else {
-            logError(inst, "unknown log category %s", categories[i]);
-            return (fmi2Status)escalate(inst, Error);
+        if (!categories[i] || !setLogCategory(inst, categories[i], loggingOn != fmi2False)) {
+            logError(inst, "fmi2SetDebugLogging: unknown log category %s", categories[i] ? categories[i] : "(NULL)");
+            RETURN(Error);
         }
     }
     return fmi2OK;
@@ -76,18 +82,20 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     (void)visible;
     if (!functions || !functions->logger) return NULL;
     if (fmuType != fmi2ModelExchange && fmuType != fmi2CoSimulation) {
-        functions->logger(functions->componentEnvironment, instanceName, fmi2Error, "logStatusError",
-                          "unknown fmuType");
+        if (loggingOn)
+            functions->logger(functions->componentEnvironment, instanceName ? instanceName : "?", fmi2Error,
+                              "logStatusError", "unknown fmuType");
         return NULL;
     }
     if (!instanceName || !fmuGUID || !fmuResourceLocation) {
-        functions->logger(functions->componentEnvironment, instanceName ? instanceName : "?", fmi2Error,
-                          "logStatusError", "instanceName, fmuGUID and fmuResourceLocation are required");
+        if (loggingOn)
+            functions->logger(functions->componentEnvironment, instanceName ? instanceName : "?", fmi2Error,
+                              "logStatusError", "instanceName, fmuGUID and fmuResourceLocation are required");
         return NULL;
     }
     return createInstance(instanceName, fmuGUID, fmuResourceLocation,
-                          fmuType == fmi2ModelExchange ? ModelExchange : CoSimulation, loggingOn, logFmi2,
-                          (void *)(size_t)functions->logger, functions->componentEnvironment);
+                          fmuType == fmi2ModelExchange ? ModelExchange : CoSimulation, 2, loggingOn != fmi2False,
+                          logFmi2, (void *)(size_t)functions->logger, functions->componentEnvironment);
 }
 
 void fmi2FreeInstance(fmi2Component c) { freeInstance((ModelInstance *)c); }
@@ -96,11 +104,8 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fm
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
     (void)toleranceDefined;
     (void)tolerance;
-    (void)stopTimeDefined;
-    (void)stopTime;
     BEGIN(fmi2SetupExperiment);
-    inst->time = startTime;
-    return fmi2OK;
+    RETURN(setupExperiment(inst, startTime, stopTimeDefined != fmi2False, stopTime));
 }
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
@@ -111,7 +116,7 @@ fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     BEGIN(fmi2ExitInitializationMode);
-    if (checkModel(inst) > Warning) return (fmi2Status)escalate(inst, Error);
+    if (checkModel(inst, &inst->data) > Warning) RETURN(Error);
     inst->state = inst->type == ModelExchange ? EventMode : StepMode;
     return fmi2OK;
 }
@@ -129,12 +134,12 @@ fmi2Status fmi2Reset(fmi2Component c) {
 
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
     BEGIN(fmi2Get);
-    return (fmi2Status)escalate(inst, getFloat64s(inst, vr, nvr, value));
+    RETURN(getFloat64s(inst, vr, nvr, value));
 }
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
     BEGIN(fmi2Set);
-    return (fmi2Status)escalate(inst, setFloat64s(inst, vr, nvr, value));
+    RETURN(setFloat64s(inst, vr, nvr, value));
 }
 
 fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]) {
@@ -144,7 +149,7 @@ fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
     CHECK_ARRAY(fmi2GetBoolean, vr, nvr);
     CHECK_ARRAY(fmi2GetBoolean, value, nvr);
     for (i = 0; i < nvr; i++) {
-        if (getBoolean(inst, vr[i], &b) > Warning) return (fmi2Status)escalate(inst, Error);
+        if (getBoolean(inst, vr[i], &b) > Warning) RETURN(Error);
         value[i] = b ? fmi2True : fmi2False;
     }
     return fmi2OK;
@@ -157,7 +162,7 @@ fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
     CHECK_ARRAY(fmi2SetBoolean, vr, nvr);
     CHECK_ARRAY(fmi2SetBoolean, value, nvr);
     for (i = 0; i < nvr; i++)
-        if (setBoolean(inst, vr[i], value[i] != fmi2False) > Warning) return (fmi2Status)escalate(inst, Error);
+        if (setBoolean(inst, vr[i], value[i] != fmi2False) > Warning) RETURN(Error);
     return fmi2OK;
 }
 
@@ -165,14 +170,14 @@ fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
     (void)vr;
     (void)value;
     BEGIN(fmi2Get);
-    return (fmi2Status)escalate(inst, noVariables(inst, "Integer", nvr));
+    RETURN(noVariables(inst, "Integer", nvr));
 }
 
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
     (void)vr;
     (void)value;
     BEGIN(fmi2Get);
-    return (fmi2Status)escalate(inst, noVariables(inst, "String", nvr));
+    RETURN(noVariables(inst, "String", nvr));
 }
 
 fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
@@ -180,73 +185,53 @@ fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
     (void)vr;
     (void)value;
     BEGIN(fmi2Set);
-    return (fmi2Status)escalate(inst, noVariables(inst, "Integer", nvr));
+    RETURN(noVariables(inst, "Integer", nvr));
 }
 
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
     (void)vr;
     (void)value;
     BEGIN(fmi2Set);
-    return (fmi2Status)escalate(inst, noVariables(inst, "String", nvr));
+    RETURN(noVariables(inst, "String", nvr));
 }
 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     BEGIN(fmi2FMUstate);
-    if (newSavedState(inst, FMUstate) > Warning) return (fmi2Status)escalate(inst, Error);
-    saveState(inst, (SavedState *)*FMUstate);
-    return fmi2OK;
+    RETURN(getFMUState(inst, FMUstate));
 }
 
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
     BEGIN(fmi2FMUstate);
-    CHECK_ARRAY(fmi2SetFMUstate, FMUstate, 1);
-    restoreState(inst, (const SavedState *)FMUstate);
-    return fmi2OK;
+    RETURN(setFMUState(inst, FMUstate));
 }
 
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     BEGIN(fmi2FMUstate);
-    if (FMUstate) {
-        free(*FMUstate);
-        *FMUstate = NULL;
-    }
-    return fmi2OK;
+    RETURN(freeFMUState(inst, FMUstate));
 }
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size) {
-    (void)FMUstate;
     BEGIN(fmi2FMUstate);
-    CHECK_ARRAY(fmi2SerializedFMUstateSize, size, 1);
-    *size = sizeof(SavedState);
-    return fmi2OK;
+    RETURN(serializedStateSize(inst, FMUstate, size));
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[],
                                  size_t size) {
     BEGIN(fmi2FMUstate);
-    CHECK_ARRAY(fmi2SerializeFMUstate, FMUstate, 1);
-    CHECK_ARRAY(fmi2SerializeFMUstate, serializedState, 1);
-    if (size < sizeof(SavedState)) {
-        logError(inst, "fmi2SerializeFMUstate: %zu bytes is too small for the state (%zu)", size,
-                 sizeof(SavedState));
-        return (fmi2Status)escalate(inst, Error);
-    }
-    memcpy(serializedState, FMUstate, sizeof(SavedState));
-    return fmi2OK;
+    RETURN(serializeState(inst, FMUstate, (unsigned char *)serializedState, size));
 }
 
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
                                    fmi2FMUstate *FMUstate) {
     BEGIN(fmi2FMUstate);
-    return (fmi2Status)escalate(inst, deserializeState(inst, (const unsigned char *)serializedState, size, FMUstate));
+    RETURN(deserializeState(inst, (const unsigned char *)serializedState, size, FMUstate));
 }
 
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[],
                                         size_t nUnknown, const fmi2ValueReference vKnown_ref[], size_t nKnown,
                                         const fmi2Real dvKnown[], fmi2Real dvUnknown[]) {
     BEGIN(fmi2GetDirectionalDerivative);
-    return (fmi2Status)escalate(
-        inst, partialDerivatives(inst, false, vUnknown_ref, nUnknown, vKnown_ref, nKnown, dvKnown, dvUnknown));
+    RETURN(partialDerivatives(inst, false, vUnknown_ref, nUnknown, vKnown_ref, nKnown, dvKnown, dvUnknown));
 }
 
 /* ---- Model Exchange */
@@ -283,46 +268,33 @@ fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStat
 
 fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time) {
     BEGIN(fmi2SetTime);
-    inst->time = time;
-    return fmi2OK;
+    RETURN(setTime(inst, time));
 }
 
 fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t nx) {
     BEGIN(fmi2SetContinuousStates);
-    return (fmi2Status)escalate(inst, setContinuousStates(inst, x, nx));
+    RETURN(setContinuousStates(inst, x, nx));
 }
 
 fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real derivatives[], size_t nx) {
     BEGIN(fmi2GetStates);
-    CHECK_ARRAY(fmi2GetDerivatives, derivatives, nx);
-    if (checkStateCount(inst, "fmi2GetDerivatives", nx) > Warning) return (fmi2Status)escalate(inst, Error);
-    getDerivatives(inst, derivatives);
-    return fmi2OK;
+    RETURN(getStateDerivatives(inst, "fmi2GetDerivatives", derivatives, nx));
 }
 
 fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real eventIndicators[], size_t ni) {
     (void)eventIndicators;
     BEGIN(fmi2GetStates);
-    if (ni == 0) return fmi2OK;
-    logError(inst, "fmi2GetEventIndicators: the model has no event indicators, ni = %zu", ni);
-    return (fmi2Status)escalate(inst, Error);
+    RETURN(noVariables(inst, "event indicator", ni));
 }
 
 fmi2Status fmi2GetContinuousStates(fmi2Component c, fmi2Real x[], size_t nx) {
     BEGIN(fmi2GetStates);
-    CHECK_ARRAY(fmi2GetContinuousStates, x, nx);
-    if (checkStateCount(inst, "fmi2GetContinuousStates", nx) > Warning) return (fmi2Status)escalate(inst, Error);
-    getStates(inst, x);
-    return fmi2OK;
+    RETURN(getContinuousStates(inst, "fmi2GetContinuousStates", x, nx));
 }
 
 fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, fmi2Real x_nominal[], size_t nx) {
-    size_t i;
-    BEGIN(fmi2GetStates);
-    CHECK_ARRAY(fmi2GetNominalsOfContinuousStates, x_nominal, nx);
-    if (checkStateCount(inst, "fmi2GetNominalsOfContinuousStates", nx) > Warning) return (fmi2Status)escalate(inst, Error);
-    for (i = 0; i < nx; i++) x_nominal[i] = 1.0;
-    return fmi2OK;
+    BEGIN(fmi2GetNominals);
+    RETURN(getNominals(inst, "fmi2GetNominalsOfContinuousStates", x_nominal, nx));
 }
 
 /* ---- Co-Simulation */
@@ -336,7 +308,7 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference
     if (nvr == 0) return fmi2OK;
     logError(inst, "fmi2SetRealInputDerivatives: inputs are held constant over a step (canInterpolateInputs "
                    "is false)");
-    return (fmi2Status)escalate(inst, Error);
+    RETURN(Error);
 }
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
@@ -347,27 +319,33 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
     BEGIN(fmi2OutputDerivatives);
     if (nvr == 0) return fmi2OK;
     logError(inst, "fmi2GetRealOutputDerivatives: maxOutputDerivativeOrder is 0");
-    return (fmi2Status)escalate(inst, Error);
+    RETURN(Error);
 }
 
 fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
                       fmi2Boolean noSetFMUStatePriorToCurrentCommunicationPoint) {
     (void)noSetFMUStatePriorToCurrentCommunicationPoint;
     BEGIN(fmi2DoStep);
-    return (fmi2Status)escalate(inst, stepInstance(inst, currentCommunicationPoint, communicationStepSize));
+    RETURN(stepInstance(inst, currentCommunicationPoint, communicationStepSize));
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c) {
     BEGIN(fmi2DoStep);
     logError(inst, "fmi2CancelStep: steps complete synchronously, there is nothing to cancel");
-    return (fmi2Status)escalate(inst, Error);
+    RETURN(Error);
 }
 
-/* steps never run asynchronously: the status functions answer for the last completed step */
+/* steps never run asynchronously: the status functions answer for the last completed step; a status
+   kind without an answer is fmi2Discard, logged in the category logStatusDiscard */
+static fmi2Status noStatus(ModelInstance *inst, const char *function, int kind) {
+    logDiscard(inst, "%s: no value for status kind %d (steps complete synchronously)", function, kind);
+    return fmi2Discard;
+}
+
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value) {
-    (void)s;
     BEGIN(fmi2Status);
     CHECK_ARRAY(fmi2GetStatus, value, 1);
+    if (s != fmi2DoStepStatus) return noStatus(inst, "fmi2GetStatus", (int)s);
     *value = fmi2OK;
     return fmi2OK;
 }
@@ -375,29 +353,27 @@ fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *va
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value) {
     BEGIN(fmi2Status);
     CHECK_ARRAY(fmi2GetRealStatus, value, 1);
-    if (s != fmi2LastSuccessfulTime) return fmi2Discard;
+    if (s != fmi2LastSuccessfulTime) return noStatus(inst, "fmi2GetRealStatus", (int)s);
     *value = inst->time;
     return fmi2OK;
 }
 
 fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value) {
-    (void)s;
     (void)value;
     BEGIN(fmi2Status);
-    return fmi2Discard;
+    return noStatus(inst, "fmi2GetIntegerStatus", (int)s);
 }
 
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
     BEGIN(fmi2Status);
     CHECK_ARRAY(fmi2GetBooleanStatus, value, 1);
-    if (s != fmi2Terminated) return fmi2Discard;
+    if (s != fmi2Terminated) return noStatus(inst, "fmi2GetBooleanStatus", (int)s);
     *value = fmi2False;
     return fmi2OK;
 }
 
 fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value) {
-    (void)s;
     (void)value;
     BEGIN(fmi2Status);
-    return fmi2Discard;
+    return noStatus(inst, "fmi2GetStringStatus", (int)s);
 }

@@ -1,5 +1,6 @@
 /* The generic FMI 3.0 layer: calling-sequence checks with per-function state masks, the importer's logger,
-   status escalation; everything model-specific is delegated to model.h. Scheduled Execution, clocks,
+   status escalation; everything model-specific is delegated to model.h, the model's capabilities come from
+   its config.h. Scheduled Execution, clocks,
    structural parameters and variable types other than Float64 and Boolean are not part of the model. */
 #include <stdlib.h>
 #include <string.h>
@@ -11,7 +12,7 @@
 #define MASK_fmi3SetDebugLogging (ANY_LIVE | ErrorState)
 #define MASK_fmi3EnterInitializationMode Instantiated
 #define MASK_fmi3ExitInitializationMode InitializationMode
-#define MASK_fmi3EnterEventMode (EventMode | ContinuousTimeMode)
+#define MASK_fmi3EnterEventMode (HAS_EVENT_MODE ? ContinuousTimeMode | StepMode : ME_ONLY | ContinuousTimeMode)
 #define MASK_fmi3Terminate (EventMode | ContinuousTimeMode | StepMode)
 #define MASK_fmi3Reset (ANY_LIVE | ErrorState)
 #define MASK_fmi3Get (ANY_LIVE | ErrorState)
@@ -21,19 +22,25 @@
 #define MASK_fmi3Partials (InitializationMode | EventMode | ContinuousTimeMode | StepMode | Terminated | ErrorState)
 #define MASK_fmi3EvaluateDiscreteStates (InitializationMode | EventMode | StepMode)
 #define MASK_fmi3UpdateDiscreteStates EventMode
-#define MASK_fmi3EnterContinuousTimeMode EventMode
-#define MASK_fmi3CompletedIntegratorStep ContinuousTimeMode
-#define MASK_fmi3SetTime (EventMode | ContinuousTimeMode)
-#define MASK_fmi3SetContinuousStates ContinuousTimeMode
-#define MASK_fmi3GetStates (InitializationMode | EventMode | ContinuousTimeMode | Terminated | ErrorState)
-#define MASK_fmi3DoStep StepMode
-#define MASK_fmi3EnterStepMode EventMode
+#define MASK_fmi3EnterContinuousTimeMode (ME_ONLY | EventMode)
+#define MASK_fmi3CompletedIntegratorStep (ME_ONLY | ContinuousTimeMode)
+#define MASK_fmi3SetTime (ME_ONLY | EventMode | ContinuousTimeMode)
+#define MASK_fmi3SetContinuousStates (ME_ONLY | ContinuousTimeMode)
+#define MASK_fmi3GetStates (ME_ONLY | InitializationMode | EventMode | ContinuousTimeMode | Terminated | ErrorState)
+#define MASK_fmi3GetNominals (MASK_fmi3GetStates | Instantiated)
+#define MASK_fmi3GetNumbers (ME_ONLY | ANY_LIVE | ErrorState)
+#define MASK_fmi3OutputDerivatives (CS_ONLY | StepMode | Terminated | ErrorState)
+#define MASK_fmi3DoStep (CS_ONLY | StepMode)
+#define MASK_fmi3EnterStepMode (CS_ONLY | EventMode)
 
 #define BEGIN(f)                                                          \
     ModelInstance *inst = (ModelInstance *)instance;                      \
     if (!inst || !allowedIn(inst, #f, MASK_##f)) return fmi3Error
 
 #define RETURN(status) return (fmi3Status)escalate(inst, (status))
+
+#define CHECK_ARRAY(f, p, n) \
+    if (checkArray(inst, #f, #p, (p), (n)) > Warning) RETURN(Error)
 
 static void logFmi3(ModelInstance *inst, Status status, const char *category, const char *message) {
     fmi3LogMessageCallback logMessage = (fmi3LogMessageCallback)(size_t)inst->logger;
@@ -59,12 +66,11 @@ fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, siz
                                const fmi3String categories[]) {
     size_t i;
     BEGIN(fmi3SetDebugLogging);
-    if (nCategories == 0) inst->logEvents = loggingOn;
+    CHECK_ARRAY(fmi3SetDebugLogging, categories, nCategories);
+    if (nCategories == 0) setLogCategory(inst, NULL, loggingOn);
     for (i = 0; i < nCategories; i++) {
-        if (categories && strcmp(categories[i], "logEvents") == 0) inst->logEvents = loggingOn;
-        else if (categories && strcmp(categories[i], "logStatusError") == 0) inst->logErrors = loggingOn;
-        else {
-            logError(inst, "unknown log category %s", categories ? categories[i] : "(NULL)");
+        if (!categories[i] || !setLogCategory(inst, categories[i], loggingOn)) {
+            logError(inst, "fmi3SetDebugLogging: unknown log category %s", categories[i] ? categories[i] : "(NULL)");
             RETURN(Error);
         }
     }
@@ -75,12 +81,12 @@ static fmi3Instance instantiate(fmi3String instanceName, fmi3String instantiatio
                                 InterfaceType type, fmi3Boolean loggingOn, fmi3InstanceEnvironment environment,
                                 fmi3LogMessageCallback logMessage) {
     if (!instanceName || !instantiationToken || !resourcePath) {
-        if (logMessage)
+        if (logMessage && loggingOn)
             logMessage(environment, fmi3Error, "logStatusError",
                        "instanceName, instantiationToken and resourcePath are required");
         return NULL;
     }
-    return createInstance(instanceName, instantiationToken, resourcePath, type, loggingOn, logFmi3,
+    return createInstance(instanceName, instantiationToken, resourcePath, type, 3, loggingOn, logFmi3,
                           (void *)(size_t)logMessage, environment);
 }
 
@@ -102,11 +108,16 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
                                          fmi3LogMessageCallback logMessage,
                                          fmi3IntermediateUpdateCallback intermediateUpdate) {
     (void)visible;
-    (void)eventModeUsed; /* hasEventMode is false: the FMU never asks for event handling */
     (void)earlyReturnAllowed;
     (void)requiredIntermediateVariables;
     (void)nRequiredIntermediateVariables;
     (void)intermediateUpdate;
+    if (eventModeUsed && !HAS_EVENT_MODE) {
+        if (logMessage && loggingOn)
+            logMessage(instanceEnvironment, fmi3Error, "logStatusError",
+                       "eventModeUsed = true, but the FMU has no event mode (hasEventMode = false)");
+        return NULL;
+    }
     return instantiate(instanceName, instantiationToken, resourcePath, CoSimulation, loggingOn,
                        instanceEnvironment, logMessage);
 }
@@ -121,11 +132,10 @@ fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3Stri
     (void)instantiationToken;
     (void)resourcePath;
     (void)visible;
-    (void)loggingOn;
     (void)clockUpdate;
     (void)lockPreemption;
     (void)unlockPreemption;
-    if (logMessage)
+    if (logMessage && loggingOn)
         logMessage(instanceEnvironment, fmi3Error, "logStatusError",
                    instanceName ? "Scheduled Execution is not supported by this FMU" : "instanceName is NULL");
     return NULL;
@@ -137,17 +147,15 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean tolera
                                        fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
     (void)toleranceDefined;
     (void)tolerance;
-    (void)stopTimeDefined;
-    (void)stopTime;
     BEGIN(fmi3EnterInitializationMode);
-    inst->time = startTime;
+    if (setupExperiment(inst, startTime, stopTimeDefined, stopTime) > Warning) RETURN(Error);
     inst->state = InitializationMode;
     return fmi3OK;
 }
 
 fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
     BEGIN(fmi3ExitInitializationMode);
-    if (checkModel(inst) > Warning) RETURN(Error);
+    if (checkModel(inst, &inst->data) > Warning) RETURN(Error);
     inst->state = inst->type == ModelExchange ? EventMode : StepMode;
     return fmi3OK;
 }
@@ -187,22 +195,16 @@ fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference valueR
 
 fmi3Status fmi3GetBoolean(fmi3Instance instance, const fmi3ValueReference valueReferences[],
                           size_t nValueReferences, fmi3Boolean values[], size_t nValues) {
-    size_t i;
     BEGIN(fmi3Get);
     if (checkValues(inst, nValueReferences, nValues) > Warning) RETURN(Error);
-    for (i = 0; i < nValueReferences; i++)
-        if (getBoolean(inst, valueReferences[i], &values[i]) > Warning) RETURN(Error);
-    return fmi3OK;
+    RETURN(getBooleans(inst, valueReferences, nValueReferences, values));
 }
 
 fmi3Status fmi3SetBoolean(fmi3Instance instance, const fmi3ValueReference valueReferences[],
                           size_t nValueReferences, const fmi3Boolean values[], size_t nValues) {
-    size_t i;
     BEGIN(fmi3Set);
     if (checkValues(inst, nValueReferences, nValues) > Warning) RETURN(Error);
-    for (i = 0; i < nValueReferences; i++)
-        if (setBoolean(inst, valueReferences[i], values[i]) > Warning) RETURN(Error);
-    return fmi3OK;
+    RETURN(setBooleans(inst, valueReferences, nValueReferences, values));
 }
 
 /* accessors of the types the model does not have: any value reference is unknown */
@@ -300,44 +302,28 @@ fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference
 
 fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState *FMUState) {
     BEGIN(fmi3FMUState);
-    if (newSavedState(inst, FMUState) > Warning) RETURN(Error);
-    saveState(inst, (SavedState *)*FMUState);
-    return fmi3OK;
+    RETURN(getFMUState(inst, FMUState));
 }
 
 fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState) {
     BEGIN(fmi3FMUState);
-    if (!FMUState) RETURN(unsupported(inst, "setting a NULL FMU state"));
-    restoreState(inst, (const SavedState *)FMUState);
-    return fmi3OK;
+    RETURN(setFMUState(inst, FMUState));
 }
 
 fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *FMUState) {
     BEGIN(fmi3FMUState);
-    if (FMUState) {
-        free(*FMUState);
-        *FMUState = NULL;
-    }
-    return fmi3OK;
+    RETURN(freeFMUState(inst, FMUState));
 }
 
 fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUState, size_t *size) {
-    (void)FMUState;
     BEGIN(fmi3FMUState);
-    if (!size) RETURN(unsupported(inst, "a NULL size pointer"));
-    *size = sizeof(SavedState);
-    return fmi3OK;
+    RETURN(serializedStateSize(inst, FMUState, size));
 }
 
 fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState, fmi3Byte serializedState[],
                                  size_t size) {
     BEGIN(fmi3FMUState);
-    if (!FMUState || !serializedState || size < sizeof(SavedState)) {
-        logError(inst, "fmi3SerializeFMUState: need a state and %zu bytes", sizeof(SavedState));
-        RETURN(Error);
-    }
-    memcpy(serializedState, FMUState, sizeof(SavedState));
-    return fmi3OK;
+    RETURN(serializeState(inst, FMUState, serializedState, size));
 }
 
 fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[], size_t size,
@@ -437,15 +423,16 @@ fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetF
                                        fmi3Boolean *enterEventMode, fmi3Boolean *terminateSimulation) {
     (void)noSetFMUStatePriorToCurrentPoint;
     BEGIN(fmi3CompletedIntegratorStep);
-    if (enterEventMode) *enterEventMode = false;
-    if (terminateSimulation) *terminateSimulation = false;
+    CHECK_ARRAY(fmi3CompletedIntegratorStep, enterEventMode, 1);
+    CHECK_ARRAY(fmi3CompletedIntegratorStep, terminateSimulation, 1);
+    *enterEventMode = false;
+    *terminateSimulation = false;
     return fmi3OK;
 }
 
 fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
     BEGIN(fmi3SetTime);
-    inst->time = time;
-    return fmi3OK;
+    RETURN(setTime(inst, time));
 }
 
 fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 continuousStates[],
@@ -457,9 +444,7 @@ fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 cont
 fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 derivatives[],
                                              size_t nContinuousStates) {
     BEGIN(fmi3GetStates);
-    if (checkStateCount(inst, "fmi3GetContinuousStateDerivatives", nContinuousStates) > Warning) RETURN(Error);
-    getDerivatives(inst, derivatives);
-    return fmi3OK;
+    RETURN(getStateDerivatives(inst, "fmi3GetContinuousStateDerivatives", derivatives, nContinuousStates));
 }
 
 fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 eventIndicators[], size_t nEventIndicators) {
@@ -471,30 +456,25 @@ fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 eventIndica
 fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 continuousStates[],
                                    size_t nContinuousStates) {
     BEGIN(fmi3GetStates);
-    if (checkStateCount(inst, "fmi3GetContinuousStates", nContinuousStates) > Warning) RETURN(Error);
-    getStates(inst, continuousStates);
-    return fmi3OK;
+    RETURN(getContinuousStates(inst, "fmi3GetContinuousStates", continuousStates, nContinuousStates));
 }
 
 fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 nominals[],
                                              size_t nContinuousStates) {
-    size_t i;
-    BEGIN(fmi3GetStates);
-    if (checkStateCount(inst, "fmi3GetNominalsOfContinuousStates", nContinuousStates) > Warning) RETURN(Error);
-    for (i = 0; i < nContinuousStates; i++) nominals[i] = 1.0;
-    return fmi3OK;
+    BEGIN(fmi3GetNominals);
+    RETURN(getNominals(inst, "fmi3GetNominalsOfContinuousStates", nominals, nContinuousStates));
 }
 
 fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *nEventIndicators) {
-    BEGIN(fmi3Get);
-    if (!nEventIndicators) RETURN(unsupported(inst, "a NULL pointer"));
-    *nEventIndicators = 0;
+    BEGIN(fmi3GetNumbers);
+    CHECK_ARRAY(fmi3GetNumberOfEventIndicators, nEventIndicators, 1);
+    *nEventIndicators = N_EVENT_INDICATORS;
     return fmi3OK;
 }
 
 fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *nContinuousStates) {
-    BEGIN(fmi3Get);
-    if (!nContinuousStates) RETURN(unsupported(inst, "a NULL pointer"));
+    BEGIN(fmi3GetNumbers);
+    CHECK_ARRAY(fmi3GetNumberOfContinuousStates, nContinuousStates, 1);
     *nContinuousStates = numberOfStates(inst);
     return fmi3OK;
 }
@@ -514,7 +494,7 @@ fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance, const fmi3ValueRefere
     (void)orders;
     (void)values;
     (void)nValues;
-    BEGIN(fmi3Get);
+    BEGIN(fmi3OutputDerivatives);
     if (nValueReferences == 0) return fmi3OK;
     RETURN(unsupported(inst, "output derivatives (maxOutputDerivativeOrder is 0)"));
 }

@@ -44,6 +44,23 @@ void logError(ModelInstance *inst, const char *fmt, ...) {
     va_end(args);
 }
 
+void logDiscard(ModelInstance *inst, const char *fmt, ...) {
+    va_list args;
+    if (!inst || !inst->logDiscards) return;
+    va_start(args, fmt);
+    vlog(inst, Discard, "logStatusDiscard", fmt, args);
+    va_end(args);
+}
+
+bool setLogCategory(ModelInstance *inst, const char *category, bool on) {
+    bool all = category == NULL;
+    bool known = all;
+    if (all || strcmp(category, "logEvents") == 0) inst->logEvents = on, known = true;
+    if (all || strcmp(category, "logStatusError") == 0) inst->logErrors = on, known = true;
+    if (all || strcmp(category, "logStatusDiscard") == 0) inst->logDiscards = on, known = true;
+    return known;
+}
+
 static int hexValue(char c) {
     if (c >= '0' && c <= '9') return c - '0';
     if (c >= 'a' && c <= 'f') return c - 'a' + 10;
@@ -138,19 +155,19 @@ static Status loadStartValues(ModelInstance *inst) {
         logError(inst, "%s has no token line", inst->startFile);
         status = Error;
     }
-    return status <= Warning ? checkModel(inst) : status;
+    return status <= Warning ? checkModel(inst, &inst->data) : status;
 }
 
 ModelInstance *createInstance(const char *name, const char *token, const char *resourceDir, InterfaceType type,
-                              bool loggingOn, LogFunction log, void *logger, void *environment) {
+                              int fmiVersion, bool loggingOn, LogFunction log, void *logger, void *environment) {
     ModelInstance *inst;
     if (!name || !token || !resourceDir) return NULL;
     inst = calloc(1, sizeof(ModelInstance));
     if (!inst) return NULL;
     inst->type = type;
+    inst->fmiVersion = fmiVersion;
     inst->state = Instantiated;
-    inst->logEvents = loggingOn;
-    inst->logErrors = true;
+    setLogCategory(inst, NULL, loggingOn);
     inst->log = log;
     inst->logger = logger;
     inst->environment = environment;
@@ -176,28 +193,22 @@ void freeInstance(ModelInstance *inst) {
 Status resetInstance(ModelInstance *inst) {
     Status status = loadStartValues(inst);
     inst->time = 0;
+    inst->stopTimeDefined = false;
     inst->state = status <= Warning ? Instantiated : ErrorState;
     return status;
 }
 
-void saveState(ModelInstance *inst, SavedState *saved) {
-    memset(saved, 0, sizeof(*saved));
-    saved->size = sizeof(*saved);
-    saved->state = inst->state;
-    saved->time = inst->time;
-    saved->data = inst->data;
-}
-
-void restoreState(ModelInstance *inst, const SavedState *saved) {
-    inst->state = saved->state;
-    inst->time = saved->time;
-    inst->data = saved->data;
-}
-
 bool allowedIn(ModelInstance *inst, const char *function, int mask) {
-    if (inst->state & mask) return true;
-    logError(inst, "%s must not be called in the current state (%d)", function, (int)inst->state);
-    inst->state = ErrorState;
+    if ((mask & ME_ONLY) && inst->type != ModelExchange) {
+        logError(inst, "%s is a Model Exchange function; this instance is co-simulation", function);
+    } else if ((mask & CS_ONLY) && inst->type != CoSimulation) {
+        logError(inst, "%s is a co-simulation function; this instance is Model Exchange", function);
+    } else if (inst->state & mask) {
+        return true;
+    } else {
+        logError(inst, "%s must not be called in the current state (%d)", function, (int)inst->state);
+    }
+    if (inst->state != FatalState) inst->state = ErrorState;
     return false;
 }
 
@@ -207,12 +218,17 @@ Status escalate(ModelInstance *inst, Status status) {
     return status;
 }
 
+Status checkArray(ModelInstance *inst, const char *function, const char *name, const void *p, size_t n) {
+    if (n == 0 || p) return OK;
+    logError(inst, "%s: %s is NULL but %zu elements were passed", function, name, n);
+    return Error;
+}
+
 Status getFloat64s(ModelInstance *inst, const unsigned vr[], size_t n, double value[]) {
     size_t i;
-    if (n > 0 && (!vr || !value)) {
-        logError(inst, "get: NULL value reference or value array");
+    if (checkArray(inst, "get Float64", "value references", vr, n) > Warning ||
+        checkArray(inst, "get Float64", "values", value, n) > Warning)
         return Error;
-    }
     for (i = 0; i < n; i++)
         if (getFloat64(inst, vr[i], &value[i]) > Warning) return Error;
     return OK;
@@ -220,12 +236,31 @@ Status getFloat64s(ModelInstance *inst, const unsigned vr[], size_t n, double va
 
 Status setFloat64s(ModelInstance *inst, const unsigned vr[], size_t n, const double value[]) {
     size_t i;
-    if (n > 0 && (!vr || !value)) {
-        logError(inst, "set: NULL value reference or value array");
+    if (checkArray(inst, "set Float64", "value references", vr, n) > Warning ||
+        checkArray(inst, "set Float64", "values", value, n) > Warning)
         return Error;
-    }
     for (i = 0; i < n; i++)
         if (setFloat64(inst, vr[i], value[i]) > Warning) return Error;
+    return OK;
+}
+
+Status getBooleans(ModelInstance *inst, const unsigned vr[], size_t n, bool value[]) {
+    size_t i;
+    if (checkArray(inst, "get Boolean", "value references", vr, n) > Warning ||
+        checkArray(inst, "get Boolean", "values", value, n) > Warning)
+        return Error;
+    for (i = 0; i < n; i++)
+        if (getBoolean(inst, vr[i], &value[i]) > Warning) return Error;
+    return OK;
+}
+
+Status setBooleans(ModelInstance *inst, const unsigned vr[], size_t n, const bool value[]) {
+    size_t i;
+    if (checkArray(inst, "set Boolean", "value references", vr, n) > Warning ||
+        checkArray(inst, "set Boolean", "values", value, n) > Warning)
+        return Error;
+    for (i = 0; i < n; i++)
+        if (setBoolean(inst, vr[i], value[i]) > Warning) return Error;
     return OK;
 }
 
@@ -240,11 +275,15 @@ Status partialDerivatives(ModelInstance *inst, bool adjoint, const unsigned unkn
     size_t i, j;
     double d;
     size_t nSeed = adjoint ? nUnknown : nKnown, nSensitivity = adjoint ? nKnown : nUnknown;
-    if ((nUnknown > 0 && !unknown) || (nKnown > 0 && !known) || (nSeed > 0 && !seed) ||
-        (nSensitivity > 0 && !sensitivity)) {
-        logError(inst, "partial derivatives: NULL array");
+    const char *f = adjoint ? "adjoint derivative" : "directional derivative";
+    if (adjoint ? !PROVIDES_ADJOINT_DERIVATIVES : !PROVIDES_DIRECTIONAL_DERIVATIVES) {
+        logError(inst, "the FMU does not provide the %s", f);
         return Error;
     }
+    if (checkArray(inst, f, "unknowns", unknown, nUnknown) > Warning ||
+        checkArray(inst, f, "knowns", known, nKnown) > Warning || checkArray(inst, f, "seed", seed, nSeed) > Warning ||
+        checkArray(inst, f, "sensitivity", sensitivity, nSensitivity) > Warning)
+        return Error;
     for (i = 0; i < nSensitivity; i++) sensitivity[i] = 0;
     for (i = 0; i < nUnknown; i++) {
         for (j = 0; j < nKnown; j++) {
@@ -262,16 +301,72 @@ Status checkStateCount(ModelInstance *inst, const char *function, size_t nx) {
     return Error;
 }
 
+Status getContinuousStates(ModelInstance *inst, const char *function, double x[], size_t nx) {
+    if (checkArray(inst, function, "states", x, nx) > Warning || checkStateCount(inst, function, nx) > Warning)
+        return Error;
+    getStates(inst, x);
+    return OK;
+}
+
 Status setContinuousStates(ModelInstance *inst, const double x[], size_t nx) {
     size_t i;
-    if (checkStateCount(inst, "set continuous states", nx) > Warning || (nx > 0 && !x)) return Error;
+    const char *f = "set continuous states";
+    if (checkArray(inst, f, "states", x, nx) > Warning || checkStateCount(inst, f, nx) > Warning) return Error;
     for (i = 0; i < nx; i++) {
         if (!isfinite(x[i])) {
-            logError(inst, "set continuous states: x[%zu] = %g is not a finite number", i, x[i]);
+            logError(inst, "%s: x[%zu] = %g is not a finite number", f, i, x[i]);
             return Error;
         }
     }
     setStates(inst, x);
+    return OK;
+}
+
+Status getStateDerivatives(ModelInstance *inst, const char *function, double dx[], size_t nx) {
+    if (checkArray(inst, function, "derivatives", dx, nx) > Warning || checkStateCount(inst, function, nx) > Warning)
+        return Error;
+    getDerivatives(inst, dx);
+    return OK;
+}
+
+Status getNominals(ModelInstance *inst, const char *function, double nominals[], size_t nx) {
+    size_t i;
+    if (checkArray(inst, function, "nominals", nominals, nx) > Warning ||
+        checkStateCount(inst, function, nx) > Warning)
+        return Error;
+    for (i = 0; i < nx; i++) nominals[i] = 1.0;
+    return OK;
+}
+
+/* ---- time */
+
+/* tolerance on time comparisons: communication points computed as n h or by summing steps agree to it */
+static double timeTolerance(double t) { return 1e-9 * fmax(1.0, fabs(t)); }
+
+Status setupExperiment(ModelInstance *inst, double startTime, bool stopTimeDefined, double stopTime) {
+    if (!isfinite(startTime) || (stopTimeDefined && (!isfinite(stopTime) || stopTime < startTime))) {
+        logError(inst, "the start time (%g) must be finite and the stop time (%g), if defined, finite and not "
+                       "before it", startTime, stopTime);
+        return Error;
+    }
+    inst->time = startTime;
+    inst->stopTimeDefined = stopTimeDefined;
+    inst->stopTime = stopTime;
+    return OK;
+}
+
+static Status checkStopTime(ModelInstance *inst, const char *what, double t) {
+    if (!inst->stopTimeDefined || t <= inst->stopTime + timeTolerance(inst->stopTime)) return OK;
+    logError(inst, "%s: t = %.17g is past the stop time %.17g set for the experiment", what, t, inst->stopTime);
+    return Error;
+}
+
+Status setTime(ModelInstance *inst, double time) {
+    if (!isfinite(time)) {
+        logError(inst, "set time: t = %g is not a finite number", time);
+        return Error;
+    }
+    inst->time = time;
     return OK;
 }
 
@@ -280,30 +375,13 @@ Status stepInstance(ModelInstance *inst, double currentTime, double h) {
         logError(inst, "do step: the step size must be positive and finite (got %g at t = %g)", h, currentTime);
         return Error;
     }
+    if (fabs(currentTime - inst->time) > timeTolerance(inst->time)) {
+        logError(inst, "do step: the current communication point %.17g is not the instance's time %.17g",
+                 currentTime, inst->time);
+        return Error;
+    }
+    if (checkStopTime(inst, "do step", currentTime + h) > Warning) return Error;
     if (doStep(inst, h) > Warning) return Error;
     inst->time = currentTime + h;
-    return OK;
-}
-
-Status newSavedState(ModelInstance *inst, void **saved) {
-    if (!saved) {
-        logError(inst, "FMU state: NULL pointer");
-        return Error;
-    }
-    if (!*saved && !(*saved = malloc(sizeof(SavedState)))) {
-        logError(inst, "FMU state: out of memory");
-        return Error;
-    }
-    return OK;
-}
-
-Status deserializeState(ModelInstance *inst, const unsigned char bytes[], size_t size, void **saved) {
-    SavedState s;
-    if (!bytes || size != sizeof(SavedState) || (memcpy(&s, bytes, size), s.size != size)) {
-        logError(inst, "deserialize FMU state: the bytes are not a state of this FMU");
-        return Error;
-    }
-    if (newSavedState(inst, saved) > Warning) return Error;
-    memcpy(*saved, &s, sizeof(s));
     return OK;
 }

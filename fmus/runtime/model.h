@@ -6,8 +6,8 @@
 
 /* one entry of the start-value file: `name value` (the file's `token` line is handled by the runtime) */
 Status applyStart(ModelInstance *inst, const char *name, const char *value);
-/* the start values are in place: check them before the instance is handed out */
-Status checkModel(ModelInstance *inst);
+/* check model data (the instance's after its start values, or a state being restored); logs problems */
+Status checkModel(ModelInstance *inst, const ModelData *data);
 
 Status getFloat64(ModelInstance *inst, unsigned vr, double *value);
 Status setFloat64(ModelInstance *inst, unsigned vr, double value);
@@ -20,6 +20,11 @@ size_t numberOfStates(ModelInstance *inst);
 void getStates(ModelInstance *inst, double x[]);
 void setStates(ModelInstance *inst, const double x[]);
 void getDerivatives(ModelInstance *inst, double dx[]);
+
+/* the model's part of a serialised FMU state: its size, writing it, reading and checking it */
+size_t modelDataSize(ModelInstance *inst);
+void writeModelData(ModelInstance *inst, const ModelData *data, unsigned char bytes[]);
+Status readModelData(ModelInstance *inst, const unsigned char bytes[], ModelData *data);
 
 /* advance the co-simulation by h, inputs held constant over the step */
 Status doStep(ModelInstance *inst, double h);

@@ -1,0 +1,243 @@
+"""Export a Joint as URDF (spring in a Gazebo extension) or SDFormat (spring in the joint's dynamics).
+
+URDF has damping (`<dynamics damping>`) but no joint spring: the stiffness goes into
+`<gazebo reference="joint"><springStiffness>`/`<springReference>`, which Gazebo's URDF converter turns
+into SDFormat's `//joint/axis/dynamics/spring_stiffness` and `spring_reference`; engines without a URDF
+spring (MuJoCo, pybullet) read those two values from there. Each axis' link has a real mass and an
+isotropic inertia and a collision sphere whose own inertia equals it (see `robot`), so pybullet's
+default of recomputing inertia from collision shapes gives the same number.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from .. import units
+from ..errors import DesignerError
+from ..files import atomic_path, atomic_write, check_suffix
+from ..joint import Joint
+from . import robot, xmltext
+from .stability import step_advice
+from .urdf_inertia import moved_inertia
+
+#: a prismatic URDF joint needs limits; these (m) are wide enough never to act on a flexure
+PRISMATIC_LIMIT = 1.0
+
+
+def _gazebo(name: str, k: float, rest: float) -> list[str]:
+    return [
+        f'  <gazebo reference="{name}">',
+        f"    <springStiffness>{robot.num(k)}</springStiffness>",
+        f"    <springReference>{robot.num(rest)}</springReference>",
+        "  </gazebo>",
+    ]
+
+
+def urdf_text(joint: Joint, *, rest: float = 0.0) -> tuple[str, dict[str, robot.StepAdvice]]:
+    """A fixed base link and one moving link per axis, chained; damping declared, spring in extensions
+    (springReference `rest`, rad or m)."""
+    bodies, advice = robot.chain(joint)
+    lines = ['<?xml version="1.0"?>', robot.provenance_comment(joint), f'<robot name="{joint.name}">']
+    lines += [
+        f'  <link name="{joint.name}_base">',
+        "    " + robot.xml_comment("fixed base: mass 0 said, as pybullet makes a link without inertial 1 kg"),
+        '    <inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/>'
+        "</inertial>",
+        "  </link>",
+    ]
+    parent = f"{joint.name}_base"
+    for a, ac in joint.axes.items():
+        si, name, s = ac.si(), f"{joint.name}_{a}", bodies[a]
+        rot = units.is_rotational(a)
+        limit = (
+            ""
+            if rot
+            else f'\n    <limit lower="{-PRISMATIC_LIMIT}" upper="{PRISMATIC_LIMIT}" effort="1e9" '
+            'velocity="1e9"/>'
+        )
+        i = robot.num(s.inertia)
+        lines += [
+            "  " + robot.xml_comment(f"{name}: {advice[name].text()}"),
+            f'  <joint name="{name}" type="{"continuous" if rot else "prismatic"}">',
+            f'    <parent link="{parent}"/>',
+            f'    <child link="{name}_link"/>',
+            f'    <axis xyz="{robot.AXIS_VECTORS[a]}"/>{limit}',
+            f'    <dynamics damping="{robot.num(si["c"])}" friction="0"/>',
+            "  </joint>",
+            *_gazebo(name, si["k"], rest),
+            f'  <link name="{name}_link">',
+            "    " + robot.xml_comment(s.basis + "; the collision sphere has the same inertia"),
+            "    <inertial>",
+            '      <origin xyz="0 0 0" rpy="0 0 0"/>',
+            f'      <mass value="{robot.num(s.mass)}"/>',
+            f'      <inertia ixx="{i}" ixy="0" ixz="0" iyy="{i}" iyz="0" izz="{i}"/>',
+            "    </inertial>",
+            f'    <collision><geometry><sphere radius="{robot.num(s.radius)}"/></geometry></collision>',
+            "  </link>",
+        ]
+        parent = f"{name}_link"
+    return "\n".join([*lines, "</robot>", ""]), advice
+
+
+def sdf_text(joint: Joint) -> tuple[str, dict[str, robot.StepAdvice]]:
+    """SDFormat 1.7: the same chain, fixed to the world, with spring_stiffness/spring_reference/damping."""
+    bodies, advice = robot.chain(joint)
+    lines = ['<?xml version="1.0"?>', robot.provenance_comment(joint), '<sdf version="1.7">']
+    lines += [f'  <model name="{joint.name}">', f'    <link name="{joint.name}_base"/>']
+    lines += [
+        f'    <joint name="{joint.name}_fixed" type="fixed">',
+        f"      <parent>world</parent><child>{joint.name}_base</child>",
+        "    </joint>",
+    ]
+    parent = f"{joint.name}_base"
+    for a, ac in joint.axes.items():
+        si, name, s = ac.si(), f"{joint.name}_{a}", bodies[a]
+        i = robot.num(s.inertia)
+        lines += [
+            "    " + robot.xml_comment(f"{name}: {advice[name].text()}"),
+            f'    <joint name="{name}" type="{"revolute" if units.is_rotational(a) else "prismatic"}">',
+            f"      <parent>{parent}</parent><child>{name}_link</child>",
+            f"      <axis><xyz>{robot.AXIS_VECTORS[a]}</xyz>",
+            f"        <dynamics><damping>{robot.num(si['c'])}</damping><friction>0</friction>"
+            f"<spring_reference>0</spring_reference><spring_stiffness>{robot.num(si['k'])}</spring_stiffness>"
+            "</dynamics>",
+            "      </axis>",
+            "    </joint>",
+            f'    <link name="{name}_link">',
+            "      " + robot.xml_comment(s.basis + "; the collision sphere has the same inertia"),
+            f"      <inertial><mass>{robot.num(s.mass)}</mass>",
+            f"        <inertia><ixx>{i}</ixx><ixy>0</ixy><ixz>0</ixz><iyy>{i}</iyy><iyz>0</iyz><izz>{i}</izz>"
+            "</inertia>",
+            "      </inertial>",
+            f'      <collision name="{name}_sphere"><geometry><sphere><radius>{robot.num(s.radius)}</radius>'
+            "</sphere></geometry></collision>",
+            "    </link>",
+        ]
+        parent = f"{name}_link"
+    return "\n".join([*lines, "  </model>", "</sdf>", ""]), advice
+
+
+def _into_urdf(
+    joint: Joint, host: Path, *, joint_name: str, axis: str | None, rest: float
+) -> tuple[bytes, dict[str, robot.StepAdvice]]:
+    """The host URDF's bytes with `joint_name`'s damping and Gazebo spring set, the rest as written;
+    and the joint's step advice (none when the links it moves declare no inertia)."""
+    from lxml import etree
+
+    if not host.is_file():
+        raise DesignerError(f"into={str(host)!r} does not exist", "give the path of the robot's URDF file")
+    try:
+        tree = etree.parse(str(host))
+    except etree.XMLSyntaxError as exc:
+        raise DesignerError(f"into={str(host)!r} is not XML: {exc}", "give a URDF file") from None
+    root = tree.getroot()
+    found = root.xpath("/robot/joint[@name=$n]", n=joint_name)
+    kinds = {"revolute": True, "continuous": True, "prismatic": False}
+    if len(found) != 1 or found[0].get("type") not in kinds:
+        have = [j.get("name") for j in root.xpath("/robot/joint") if j.get("type") in kinds]
+        raise DesignerError(
+            f"joint_name={joint_name!r}: the robot has no revolute, continuous or prismatic joint so named",
+            f"its movable joints are: {', '.join(have) or 'none'}",
+        )
+    rot = kinds[found[0].get("type")]
+    a = robot.pick_axis(joint, axis, rot)
+    if units.is_rotational(a) != rot:
+        raise DesignerError(
+            f"axis={a!r} does not match the kind of robot joint '{joint_name}' ({found[0].get('type')})",
+            "give an axis of the same kind as the robot joint",
+        )
+    si = joint.axes[a].si()
+    encoding = tree.docinfo.encoding or "utf-8"
+    text = _set_damping(host.read_bytes().decode(encoding), joint_name, robot.num(si["c"]))
+    moved = moved_inertia(root, joint_name)
+    advice = {joint_name: step_advice(si["k"], si["c"], moved)} if moved > 0 else {}
+    return _set_spring(text, joint_name, si["k"], rest).encode(encoding), advice
+
+
+def _set_damping(text: str, joint_name: str, damping: str) -> str:
+    """The joint element's `<dynamics damping>` set (a `<dynamics>` line added when it has none)."""
+    element = xmltext.find_one(text, "joint", "name", joint_name, whole=True)
+    body = element.group(0)
+    dynamics = re.search(r"<dynamics\b[^>]*>", body)
+    if dynamics:
+        body = (
+            body[: dynamics.start()]
+            + xmltext.set_attributes(dynamics.group(0), {"damping": damping})
+            + body[dynamics.end() :]
+        )
+    else:
+        close = body.rindex("</joint")
+        pad = xmltext.indent_before(text, element.start())
+        body = f'{body[:close].rstrip()}\n{pad}  <dynamics damping="{damping}"/>\n{pad}{body[close:]}'
+    return text[: element.start()] + body + text[element.end() :]
+
+
+def _set_spring(text: str, joint_name: str, k: float, rest: float) -> str:
+    """The Gazebo extension's springStiffness/springReference set: in the joint's block, or a new block."""
+    try:
+        block = xmltext.find_one(text, "gazebo", "reference", joint_name, whole=True)
+    except DesignerError:
+        block = None
+    values = {"springStiffness": robot.num(k), "springReference": robot.num(rest)}
+    if block is not None and all(f"<{tag}>" in block.group(0) for tag in values):
+        body = block.group(0)
+        for tag, value in values.items():
+            body = re.sub(rf"<{tag}>.*?</{tag}>", f"<{tag}>{value}</{tag}>", body, count=1, flags=re.S)
+        return text[: block.start()] + body + text[block.end() :]
+    if block is not None and any(f"<{tag}>" in block.group(0) for tag in values):
+        raise DesignerError(
+            f"the robot's <gazebo reference='{joint_name}'> has one of springStiffness/springReference",
+            "give both or neither",
+        )
+    end = text.rindex("</robot")
+    lines = "\n".join(_gazebo(joint_name, k, rest))
+    return f"{text[:end].rstrip()}\n{lines}\n{text[end:]}"
+
+
+def export_urdf(
+    joint: Joint,
+    path: str | Path,
+    *,
+    into: str | Path | None = None,
+    joint_name: str | None = None,
+    axis: str | None = None,
+    rest: float = 0.0,
+) -> robot.RobotExport:
+    """Write `joint` as URDF at `path` (.urdf) and return the path and the stated step advice.
+
+    Standalone: a chain of links with real masses (see `urdf_text`), every spring at `rest`. With
+    `into` (a URDF file) and
+    `joint_name`: a copy of that robot with the joint's damping set and a Gazebo spring extension
+    (stiffness, and `rest` in rad or m as springReference); its links are left as they are (URDF has
+    no armature, so the flexure's own moving inertia is not added). The advice uses the inertia the
+    joint moves according to the links' `<inertial>` (see `urdf_inertia`).
+
+    Raises:
+        DesignerError: a wrong suffix, a missing mass, or an `into` problem.
+    """
+    path = check_suffix(path, (".urdf",), what="a URDF")
+    if into is not None:
+        if joint_name is None:
+            raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
+        data, advice = _into_urdf(joint, Path(into), joint_name=joint_name, axis=axis, rest=rest)
+        with atomic_path(path) as tmp:
+            tmp.write_bytes(data)
+        return robot.RobotExport(path, advice)
+    text, advice = urdf_text(robot.with_masses(joint), rest=rest)
+    with atomic_write(path) as fh:
+        fh.write(text)
+    return robot.RobotExport(path, advice)
+
+
+def export_sdf(joint: Joint, path: str | Path) -> robot.RobotExport:
+    """Write `joint` as an SDFormat 1.7 model at `path` (.sdf); see `sdf_text`.
+
+    Raises:
+        DesignerError: a wrong suffix or a missing mass.
+    """
+    path = check_suffix(path, (".sdf",), what="an SDFormat")
+    text, advice = sdf_text(robot.with_masses(joint))
+    with atomic_write(path) as fh:
+        fh.write(text)
+    return robot.RobotExport(path, advice)

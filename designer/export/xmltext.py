@@ -1,0 +1,54 @@
+"""Edit a user's XML file as text, so every byte the edit does not touch stays as they wrote it.
+
+A parser would re-serialise the whole file (quotes, attribute layout, line breaks inside tags); these
+helpers change one start tag's attributes or insert a line, and the caller parses the result to check it.
+"""
+
+from __future__ import annotations
+
+import re
+
+from ..errors import DesignerError
+
+
+def _outside_comments(text: str, matches: list[re.Match]) -> list[re.Match]:
+    spans = [m.span() for m in re.finditer(r"<!--.*?-->", text, re.S)]
+    return [m for m in matches if not any(a <= m.start() < b for a, b in spans)]
+
+
+def find_one(text: str, tag: str, attr: str, value: str, *, whole: bool = False) -> re.Match:
+    """The one `<tag ... attr="value" ...>` start tag (or, `whole`, element up to `</tag>`) in `text`.
+
+    Raises:
+        DesignerError: none or several outside comments.
+    """
+    start = rf"<{tag}\b[^>]*?\s{attr}\s*=\s*(['\"]){re.escape(value)}\1[^>]*>"
+    pattern = re.compile(start + (rf".*?</{tag}\s*>" if whole else ""), re.S)
+    found = _outside_comments(text, list(pattern.finditer(text)))
+    if len(found) != 1:
+        raise DesignerError(
+            f"cannot find <{tag} {attr}={value!r}> once in the file's text ({len(found)} found)",
+            f"write it as one <{tag}> element outside comments",
+        )
+    return found[0]
+
+
+def set_attributes(start_tag: str, values: dict[str, str]) -> str:
+    """`start_tag` with each attribute in `values` set: replaced in place, or added before its end."""
+    for attr, value in values.items():
+        attr_re = re.compile(r"(\s" + re.escape(attr) + r"\s*=\s*)(['\"]).*?\2", re.S)
+        m = attr_re.search(start_tag)
+        if m:
+            start_tag = (
+                f"{start_tag[: m.start()]}{m.group(1)}{m.group(2)}{value}{m.group(2)}{start_tag[m.end() :]}"
+            )
+        else:
+            end = re.search(r"\s*/?>$", start_tag).start()
+            start_tag = f'{start_tag[:end]} {attr}="{value}"{start_tag[end:]}'
+    return start_tag
+
+
+def indent_before(text: str, pos: int) -> str:
+    """The indentation of the line holding `pos`."""
+    line = text[text.rfind("\n", 0, pos) + 1 : pos]
+    return line[: len(line) - len(line.lstrip())]

@@ -1,0 +1,181 @@
+"""The cases of a sweep, as plain data: per joint k and c on its axis (rig units), plus descriptive inputs.
+
+Cases are generated in the calling process (seeded), so every executor evaluates the same numbers;
+each case carries a key, a hash of its coefficients and of everything else its result depends on
+(the scenario and the evaluation path), by which a rerun recognises finished cases.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from .. import space, units
+from ..cosim.scenario import JointSource
+from ..errors import DesignerError
+from ..surrogate import Surrogate
+from .draws import joint_draws, on_axis, source_axis
+from .spec import Spec, sources
+
+
+@dataclass(frozen=True)
+class Case:
+    """One case: `coefficients` {joint: {"k", "c"}} in rig units on each joint's axis; `inputs` the
+    descriptive columns (print settings, candidate numbers, surrogate-axis draws); `key` its hash."""
+
+    index: int
+    coefficients: dict[str, dict[str, float]]
+    inputs: dict[str, float] = field(default_factory=dict)
+    key: str = ""
+
+
+def context_key(spec: Spec) -> str:
+    """Hash of what every case's result depends on besides its coefficients: scenario and path."""
+    with np.printoptions(threshold=2**31, precision=17):
+        text = repr(spec.scenario) + spec.path
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def finish(cases: list[Case], spec: Spec) -> list[Case]:
+    """The cases with k and c for every scenario joint (the scenario's own where a case leaves a joint
+    alone) and their keys: a hash of the coefficients and of the spec's context."""
+    context = context_key(spec)
+    base = {j: base_coefficients(src) for j, src in sources(spec.scenario).items()}
+    out = []
+    for case in cases:
+        coefficients = {j: case.coefficients.get(j, base[j]) for j in base}
+        payload = json.dumps({"c": coefficients, "ctx": context}, sort_keys=True)
+        out.append(
+            replace(case, coefficients=coefficients, key=hashlib.sha256(payload.encode()).hexdigest()[:20])
+        )
+    return out
+
+
+def base_coefficients(src: JointSource) -> dict[str, float]:
+    """The k and c (rig units, the joint's axis) a scenario joint runs with when a case leaves it alone."""
+    if src.joint is not None:
+        ac = src.joint.axis(src.axis)
+        out = {"k": ac.k, "c": ac.c}
+    else:
+        from ..cosim.fmu import read_parameters
+
+        si = read_parameters(src.fmu, src.axis)
+        out = {q: units.from_si(q, src.axis, si[q]) for q in ("k", "c")}
+    for q in ("k", "c"):
+        if f"{src.axis}.{q}" in src.parameters:
+            out[q] = units.from_si(q, src.axis, float(src.parameters[f"{src.axis}.{q}"]))
+    return out
+
+
+def design_of(spec: Spec, joint: str) -> dict[str, float]:
+    """The print settings of a joint: given in the sweep, or those its scenario joint was built from."""
+    if joint in spec.cases.designs:
+        return space.check_design(spec.cases.designs[joint])
+    src = sources(spec.scenario)[joint]
+    params = None if src.joint is None else src.joint.provenance.get("params")
+    params = params or (spec.scenario.factors if joint == "rig" else None)
+    if params is None:
+        raise DesignerError(
+            f"joint {joint} has no print settings to vary or draw around",
+            f"give the scenario joint a design or a suggestion, or add [cases.designs.{joint}]",
+        )
+    return dict(params)
+
+
+def load_surrogate(spec: Spec) -> Surrogate:
+    return Surrogate.load(spec.surrogate)
+
+
+def _predicted(surrogate: Surrogate, design: dict[str, float], axis: str) -> dict[str, float]:
+    src = source_axis(surrogate, axis)
+    pred = surrogate.predict(design, responses=[f"k_{src}", f"c_{src}"])
+    predicted = (float(pred[f"k_{src}"].value[0]), float(pred[f"c_{src}"].value[0]))
+    k, c = on_axis(predicted, source=src, axis=axis, length_mm=design["length"])
+    return {"k": k, "c": c}
+
+
+def grid(spec: Spec) -> list[Case]:
+    """Every combination of the grid's values; print settings go through the surrogate (predicted values)."""
+    axes = [(j, q, values) for j, table in spec.cases.joints.items() for q, values in table.items()]
+    surrogate = None
+    for j, table in spec.cases.joints.items():
+        keys = set(table)
+        if keys <= {"k", "c"}:
+            continue
+        bad = keys - set(space.FACTOR_NAMES)
+        if bad or keys & {"k", "c"}:
+            raise DesignerError(
+                f"grid of joint {j} mixes or misnames keys: {', '.join(sorted(keys))}",
+                f"vary k and c, or print settings ({', '.join(space.FACTOR_NAMES)}), not both",
+            )
+        surrogate = surrogate or load_surrogate(spec)
+    cases = []
+    for i, combo in enumerate(itertools.product(*[values for _, _, values in axes])):
+        chosen: dict[str, dict[str, float]] = {}
+        for (j, q, _), v in zip(axes, combo, strict=True):
+            chosen.setdefault(j, {})[q] = v
+        coefficients, inputs = {}, {}
+        for j, values in chosen.items():
+            inputs.update({f"{j}.{q}": v for q, v in values.items()})
+            if set(values) <= {"k", "c"}:
+                coefficients[j] = base_coefficients(sources(spec.scenario)[j]) | values
+            else:
+                design = space.check_design(design_of(spec, j) | values)
+                coefficients[j] = _predicted(surrogate, design, sources(spec.scenario)[j].axis)
+        cases.append(Case(i, coefficients, inputs))
+    return cases
+
+
+def suggestion(spec: Spec) -> list[Case]:
+    """One case per combination of suggestion candidates over the sweep's joints."""
+    from ..joint import Joint
+
+    path: Path = spec.cases.file
+    from ..suggestions import Suggestion
+
+    n = len(Suggestion.load(path).candidates)
+    numbers = spec.cases.candidates or tuple(range(1, n + 1))
+    joints = list(spec.cases.joints)
+    cases = []
+    for i, combo in enumerate(itertools.product(numbers, repeat=len(joints))):
+        coefficients, inputs = {}, {}
+        for j, cand in zip(joints, combo, strict=True):
+            src = sources(spec.scenario)[j]
+            joint = Joint.from_suggestion(path, candidate=cand, axes=[src.axis], name=f"joint_{j}")
+            ac = joint.axis(src.axis)
+            coefficients[j] = {"k": ac.k, "c": ac.c}
+            inputs[f"{j}.candidate"] = float(cand)
+            inputs.update({f"{j}.{f}": float(v) for f, v in joint.provenance["params"].items()})
+        cases.append(Case(i, coefficients, inputs))
+    return cases
+
+
+def montecarlo(spec: Spec) -> list[Case]:
+    """`n` seeded draws of every chosen joint's k and c from the surrogate's predictive distribution."""
+    surrogate = load_surrogate(spec)
+    rng = np.random.default_rng(spec.cases.seed)
+    n = spec.cases.n
+    draws = {}
+    for j in spec.cases.joints:
+        draws[j] = joint_draws(
+            surrogate, design=design_of(spec, j), axis=sources(spec.scenario)[j].axis, n=n, rng=rng
+        )
+    cases = []
+    for i in range(n):
+        coefficients = {j: {"k": float(d["k"][i]), "c": float(d["c"][i])} for j, d in draws.items()}
+        inputs = {
+            f"{j}.{q}": float(v[i]) for j, d in draws.items() for q, v in d.items() if q not in ("k", "c")
+        }
+        cases.append(Case(i, coefficients, inputs))
+    return cases
+
+
+def make_cases(spec: Spec) -> list[Case]:
+    """The spec's cases, each keyed by its hash."""
+    made = {"grid": grid, "suggestion": suggestion, "montecarlo": montecarlo}[spec.cases.type](spec)
+    return finish(made, spec)

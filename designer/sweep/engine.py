@@ -1,0 +1,85 @@
+"""The in-engine fast path: linear joints as MuJoCo `general` actuators with affine bias, batched through
+`mujoco.rollout`.
+
+It is the co-simulation's validation reference (designer.cosim.robot.Robot with `in_engine`) run
+for many cases at once: one compiled model per case differing only in the actuators' bias
+parameters (-k, -c), and an open-loop control k (q_motor(t) + offset) + c q_motor'(t) precomputed
+from the motor references, applied before each step exactly as `Robot.do_step` does.
+"""
+
+from __future__ import annotations
+
+import copy
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..cosim.master import Trace
+from ..cosim.robot import Robot, SpringDamper, load_spec
+from ..cosim.scenario import Scenario
+from ..errors import DesignerError
+from .cases import Case
+from .evaluate import si_law
+
+
+def _offsets(sc: Scenario) -> dict[str, float]:
+    return {j: float(src.parameters.get(f"{src.axis}.offset", 0.0)) for j, src in sc.joints.items()}
+
+
+def _motors(sc: Scenario, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Time (n + 1), motor angles and rates (n + 1, joints) at t = 0, h, ..., n h."""
+    t = np.arange(n + 1) * sc.step
+    mq = np.empty((n + 1, len(sc.joints)))
+    mv = np.empty_like(mq)
+    for i, ti in enumerate(t):
+        for k, j in enumerate(sc.joints):
+            mq[i, k], mv[i, k] = sc.motors[j](float(ti))
+    return t, mq, mv
+
+
+def rollout_traces(sc: Scenario, cases: Sequence[Case]) -> list[Trace | Exception]:
+    """The trace of each case (columns `robot.J.q|motor|v` as in a co-simulation's result, rows at
+    t = 0, h, ...), or a DesignerError for a case whose model diverged (MuJoCo reset it)."""
+    import mujoco
+    from mujoco import rollout
+
+    joints = list(sc.joints)
+    offsets = _offsets(sc)
+    laws = [{j: si_law(sc.joints[j], case.coefficients[j]) for j in joints} for case in cases]
+    first = {j: SpringDamper(laws[0][j]["k"], laws[0][j]["c"], offsets[j]) for j in joints}
+    robot = Robot(
+        load_spec(sc.model, sc.lengths, sc.masses), sc.motors, sc.step, sc.integrator, in_engine=first
+    )
+    base = robot.model
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    state0 = np.empty(mujoco.mj_stateSize(base, spec))
+    mujoco.mj_getState(base, robot.data, state0, spec)
+    n = int(round(sc.duration / sc.step))
+    t, mq, mv = _motors(sc, n)
+    models, controls = [], np.zeros((len(cases), n, base.nu))
+    for b, law in enumerate(laws):
+        model = copy.copy(base)
+        for k, (j, act) in enumerate(zip(joints, robot.actuators, strict=True)):
+            model.actuator_biasprm[act, 1] = -law[j]["k"]
+            model.actuator_biasprm[act, 2] = -law[j]["c"]
+            controls[b, :, act] = law[j]["k"] * (mq[:-1, k] + offsets[j]) + law[j]["c"] * mv[:-1, k]
+        models.append(model)
+    states, _ = rollout.rollout(models, mujoco.MjData(base), state0[None, :], controls)
+    qadr = 1 + robot.qpos  # FULLPHYSICS state: time, qpos, qvel, act, plugin
+    vadr = 1 + base.nq + robot.dof
+    columns = [f"robot.{j}.{x}" for x in ("q", "motor", "v") for j in joints]
+    out: list[Trace | Exception] = []
+    for b in range(len(cases)):
+        s = np.vstack([state0[None, :], states[b]])
+        wrong = np.flatnonzero(~np.isfinite(s).all(axis=1) | (np.abs(s[:, 0] - t) > 0.5 * sc.step))
+        if len(wrong):
+            out.append(
+                DesignerError(
+                    f"the robot diverged at t = {t[max(wrong[0] - 1, 0)]:g} s (MuJoCo reset it)",
+                    "use a smaller step",
+                )
+            )
+            continue
+        values = np.column_stack([s[:, qadr], mq, s[:, vadr] - mv])
+        out.append(Trace(t, columns, values))
+    return out

@@ -1,0 +1,159 @@
+"""Evaluate a batch of cases in one worker: the FMU co-simulation path, or the in-engine fast path.
+
+A task is plain data (the scenario, the path, the cases), so it pickles to any process or Dask
+worker; the worker builds its own FMU instances and MuJoCo model. A failing case becomes a row
+with status "failed" and its message; it does not stop the batch.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from .. import units
+from ..cosim.master import Trace
+from ..cosim.scenario import JointSource, Scenario
+from ..errors import DesignerError
+from .cases import Case
+
+
+@dataclass(frozen=True)
+class Task:
+    """A batch for one worker: the scenario, the evaluation path ("fmu" | "engine") and the cases."""
+
+    scenario: Scenario
+    path: str
+    cases: tuple[Case, ...]
+
+
+def si_law(src: JointSource, coefficients: dict[str, float]) -> dict[str, float]:
+    """The SI k and c of a case's joint (rig units in, on the joint's axis)."""
+    return {q: units.to_si(q, src.axis, coefficients[q]) for q in ("k", "c")}
+
+
+def metrics(sc: Scenario, *, trace: Trace, case: Case) -> dict[str, dict]:
+    """Per-joint metrics of an in-engine trace, as `designer cosim` computes them (its robot_metrics)."""
+    from ..cosim.run import robot_metrics
+
+    laws = {j: si_law(src, case.coefficients[j]) for j, src in sc.joints.items()}
+    return robot_metrics(sc, trace, laws)
+
+
+def fmu_result(sc: Scenario, *, fmus: dict[str, Path], case: Case):
+    """Co-simulate one case with `designer.cosim.run`: the batch's joint FMUs, the case's k and c set
+    as FMU parameters (SI). Returns the cosim `Result` (time series and per-joint metrics)."""
+    from ..cosim import run
+
+    joints = {}
+    for j, src in sc.joints.items():
+        params = dict(src.parameters)
+        params |= {f"{src.axis}.{q}": v for q, v in si_law(src, case.coefficients[j]).items()}
+        joints[j] = JointSource(axis=src.axis, fmu=fmus[j], fmi_version=src.fmi_version, parameters=params)
+    return run(replace(sc, joints=joints))
+
+
+#: per-case metrics of a rig sweep: the identified coefficients (rig units), their errors, the fit's R2
+RIG_METRICS = ("k_identified", "c_identified", "k_error_pct", "c_error_pct", "r2")
+
+
+def rig_identification(sc: Scenario, *, fmus: dict[str, Path], case: Case) -> dict[str, dict]:
+    """Run the virtual rig on one case's joint, identify its log, and compare with the case's k and c.
+
+    The log is the one `designer cosim` writes for the rig (designer.cosim.run.rig_log), read
+    through the rig-log validation and identified as a measured log would be.
+    """
+    from ..cosim import run
+    from ..cosim.run import rig_log
+    from ..rig.identify import identify
+    from ..rig.logs import validate_frame
+
+    src, true = sc.rig_joint, case.coefficients["rig"]
+    params = dict(src.parameters) | {f"{src.axis}.{q}": v for q, v in si_law(src, true).items()}
+    joint = JointSource(axis=src.axis, fmu=fmus["rig"], fmi_version=src.fmi_version, parameters=params)
+    log = validate_frame(rig_log(run(replace(sc, rig_joint=joint))), f"virtual rig log of case {case.index}")
+    fit = identify(log).axes[src.axis]
+    values = (fit.k, fit.c, 100 * (fit.k / true["k"] - 1), 100 * (fit.c / true["c"] - 1), fit.r2)
+    return {"rig": dict(zip(RIG_METRICS, map(float, values), strict=True))}
+
+
+def case_row(case: Case, *, outcome: dict | Exception, wall: float) -> dict:
+    """One table row: case number and key, inputs, k and c per joint, metrics, status, message, wall time."""
+    row: dict = {"case": case.index, "key": case.key, **case.inputs}
+    for j, coef in case.coefficients.items():
+        row.update({f"{j}.{q}": v for q, v in coef.items()})
+    if isinstance(outcome, Exception):
+        row.update({"status": "failed", "message": str(outcome)})
+    else:
+        for j, m in outcome.items():
+            row.update({f"{j}.{name}": (np.nan if v is None else v) for name, v in m.items()})
+        row.update({"status": "ok", "message": ""})
+    row["wall_s"] = wall
+    return row
+
+
+def _failure(exc: Exception) -> Exception:
+    return exc if isinstance(exc, DesignerError) else RuntimeError(f"{type(exc).__name__}: {exc}")
+
+
+def _fmu_batch(task: Task) -> list[dict]:
+    from ..cosim.run import joint_fmus
+
+    rows = []
+    with joint_fmus(task.scenario) as fmus:
+        for case in task.cases:
+            start = time.perf_counter()
+            try:
+                if task.scenario.kind == "rig":
+                    outcome: dict | Exception = rig_identification(task.scenario, fmus=fmus, case=case)
+                else:
+                    outcome = fmu_result(task.scenario, fmus=fmus, case=case).metrics
+            except Exception as exc:  # a failed case is recorded, never fatal to the sweep
+                outcome = _failure(exc)
+            rows.append(case_row(case, outcome=outcome, wall=time.perf_counter() - start))
+    return rows
+
+
+def _engine_batch(task: Task) -> list[dict]:
+    from .engine import rollout_traces
+
+    start = time.perf_counter()
+    try:
+        outcomes = rollout_traces(task.scenario, task.cases)
+    except Exception as exc:  # e.g. a model MuJoCo cannot compile: every case of the batch fails
+        outcomes = [_failure(exc)] * len(task.cases)
+    wall = (time.perf_counter() - start) / max(len(task.cases), 1)
+    rows = []
+    for case, out in zip(task.cases, outcomes, strict=True):
+        if not isinstance(out, Exception):
+            out = metrics(task.scenario, trace=out, case=case)
+        rows.append(case_row(case, outcome=out, wall=wall))
+    return rows
+
+
+@contextlib.contextmanager
+def _quiet_mujoco() -> Iterator[None]:
+    """MuJoCo's warnings (a diverging case) silenced: the row records them; no MUJOCO_LOG.TXT is written."""
+    import mujoco
+
+    previous = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(lambda message: None)
+    try:
+        yield
+    finally:
+        mujoco.set_mju_user_warning(previous)
+
+
+def evaluate(task: Task) -> list[dict]:
+    """The rows of a batch, in case order (the function an executor runs)."""
+    with _quiet_mujoco():
+        return _engine_batch(task) if task.path == "engine" else _fmu_batch(task)
+
+
+def batches(scenario: Scenario, *, path: str, cases: Sequence[Case], size: int) -> list[Task]:
+    """Cases split into tasks of at most `size`."""
+    return [Task(scenario, path, tuple(cases[i : i + size])) for i in range(0, len(cases), size)]

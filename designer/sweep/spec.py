@@ -1,0 +1,256 @@
+"""Sweep specifications (TOML): the scenario, where the cases come from, how they run, the task limits.
+
+Parsed and checked completely before anything runs; every problem is a DesignerError naming the key.
+The README documents every key; `examples/sweep_arm.toml` is a commented example.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:
+    import tomli as tomllib
+
+from ..cosim.scenario import Scenario
+from ..errors import DesignerError
+from .limits import Limit, parse_limit
+
+CASE_TYPES = ("grid", "suggestion", "montecarlo")
+PATHS = ("fmu", "engine")
+
+
+@dataclass(frozen=True)
+class Cases:
+    """Where the cases come from: `type` (grid | suggestion | montecarlo) and its options.
+
+    grid: `joints` maps a joint to {key: values}, keys k and c (rig units on the joint's axis) or
+    print settings (the others from the joint's design), values a list of numbers.
+    suggestion: `file` (a `designer suggest --json` output), `joints`, `candidates` (1-based).
+    montecarlo: `n` draws seeded by `seed` for `joints`, around each joint's design (`designs`
+    overrides the scenario's).
+    """
+
+    type: str
+    joints: dict[str, Any] = field(default_factory=dict)
+    n: int = 0
+    seed: int = 0
+    file: Path | None = None
+    candidates: tuple[int, ...] = ()
+    designs: dict[str, dict[str, float]] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Spec:
+    """A checked sweep: the scenario, the cases, the evaluation path and the task limits.
+
+    `path` "fmu" co-simulates every case with the joint FMUs; "engine" computes the linear
+    spring-dampers inside MuJoCo in batches through `mujoco.rollout`, and re-runs `check` of the
+    cases through the FMUs to compare. `workers` sets local processes; `cluster` the Dask cluster.
+    """
+
+    scenario: Scenario
+    cases: Cases
+    path: str = "fmu"
+    check: int = 3
+    limits: tuple[Limit, ...] = ()
+    surrogate: Path | None = None
+    workers: int | None = None
+    batch: int | None = None
+    cluster: dict[str, Any] = field(default_factory=dict)
+    source: Path | None = None
+
+
+def sources(scenario: Scenario) -> dict[str, Any]:
+    """The joints a sweep can vary, by name: a robot's joints, or the rig's joint as "rig"."""
+    return {"rig": scenario.rig_joint} if scenario.kind == "rig" else dict(scenario.joints)
+
+
+def _where(path: Path, key: str) -> str:
+    return f"{path.name}: {key}"
+
+
+def _count(table: dict, key: str, path: Path, default: int | None, minimum: int = 1) -> int | None:
+    value = table.get(key, default)
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+        raise DesignerError(f"{_where(path, key)} = {value!r} is not a whole number >= {minimum}", "fix it")
+    return value
+
+
+def _values(spec: Any, key: str, path: Path) -> list[float]:
+    """A grid axis: a list of numbers, or {from, to, n, scale = "linear" | "log"}."""
+    if isinstance(spec, dict):
+        try:
+            lo, hi, n = float(spec["from"]), float(spec["to"]), int(spec["n"])
+        except (KeyError, TypeError, ValueError):
+            raise DesignerError(
+                f"{_where(path, key)} must be a list or {{from, to, n}}", "e.g. {from = 100, to = 400, n = 5}"
+            ) from None
+        scale = spec.get("scale", "linear")
+        if scale not in ("linear", "log") or n < 1 or (scale == "log" and min(lo, hi) <= 0):
+            raise DesignerError(f"{_where(path, key)} is not a usable range", "n >= 1, log scales positive")
+        points = np.geomspace(lo, hi, n) if scale == "log" else np.linspace(lo, hi, n)
+        return [float(v) for v in points]
+    if not isinstance(spec, list) or not spec:
+        raise DesignerError(f"{_where(path, key)} must list values", "e.g. [100, 200, 300]")
+    for v in spec:
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise DesignerError(f"{_where(path, key)} has {v!r}, not a finite number", "fix it")
+    return [float(v) for v in spec]
+
+
+def _cases(doc: dict, path: Path, scenario: Scenario) -> Cases:
+    table = doc.get("cases")
+    if not isinstance(table, dict) or table.get("type") not in CASE_TYPES:
+        raise DesignerError(
+            f"{path.name} needs a [cases] table with a type", f"type = one of {', '.join(CASE_TYPES)}"
+        )
+    kind = table["type"]
+    designs = table.get("designs", {})
+    if not isinstance(designs, dict) or not all(isinstance(d, dict) for d in designs.values()):
+        raise DesignerError(
+            f"{_where(path, 'cases.designs')} must map joints to print settings", "see the README"
+        )
+    designs = {j: dict(d) for j, d in designs.items()}
+    joints = table.get("joints", list(sources(scenario)) if kind != "grid" else None)
+    if kind == "grid":
+        if not isinstance(joints, dict) or not joints:
+            raise DesignerError(
+                f"{_where(path, 'cases.joints')} must map joints to grid axes", "see the README"
+            )
+        grid = {}
+        for j, axes in joints.items():
+            if not isinstance(axes, dict) or not axes:
+                raise DesignerError(
+                    f"{_where(path, 'cases.joints.' + j)} must be a table of axes", "e.g. {k = [..]}"
+                )
+            grid[j] = {q: _values(v, f"cases.joints.{j}.{q}", path) for q, v in axes.items()}
+        return Cases(type=kind, joints=grid, designs=designs)
+    if not isinstance(joints, list) or not all(isinstance(j, str) for j in joints):
+        raise DesignerError(f"{_where(path, 'cases.joints')} must list joint names", 'e.g. ["j1", "j2"]')
+    if kind == "suggestion":
+        if not isinstance(table.get("file"), str):
+            raise DesignerError(f"{_where(path, 'cases.file')} is missing", 'give file = "suggestion.json"')
+        file = (path.parent / table["file"]).resolve()
+        cands = table.get("candidates", [])
+        if not isinstance(cands, list) or not all(isinstance(c, int) and c >= 1 for c in cands):
+            raise DesignerError(
+                f"{_where(path, 'cases.candidates')} must list numbers >= 1", "e.g. [1, 2, 3]"
+            )
+        return Cases(type=kind, joints={j: None for j in joints}, file=file, candidates=tuple(cands))
+    return Cases(
+        type=kind,
+        joints={j: None for j in joints},
+        n=_count(table, "n", path, None),
+        seed=_count(table, "seed", path, 0, minimum=0),
+        designs=designs,
+    )
+
+
+def _cluster(doc: dict, path: Path) -> dict[str, Any]:
+    cluster = doc.get("cluster", {})
+    if not isinstance(cluster, dict):
+        raise DesignerError(f"{_where(path, 'cluster')} must be a table", "see the README")
+    chosen = [k for k in ("scheduler", "workers", "slurm") if k in cluster]
+    if len(chosen) > 1:
+        raise DesignerError(f"{_where(path, 'cluster')} sets {', '.join(chosen)}", "give one of them")
+    if "workers" in cluster:
+        _count(cluster, "workers", path, None)
+    if "slurm" in cluster and not isinstance(cluster["slurm"], dict):
+        raise DesignerError(
+            f"{_where(path, 'cluster.slurm')} must be a table", "e.g. {cores = 4, memory = '8GB'}"
+        )
+    return dict(cluster)
+
+
+def load(path: str | Path) -> Spec:
+    """Read and check a sweep file and its scenario; every problem raises a DesignerError."""
+    from .. import cosim
+
+    path = Path(path).resolve()
+    if not path.is_file():
+        raise DesignerError(f"sweep file {path} does not exist", "give the path of a .toml sweep file")
+    try:
+        doc = tomllib.loads(path.read_text())
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise DesignerError(f"{path.name} is not valid TOML: {exc}", "fix the syntax") from None
+    if not isinstance(doc.get("scenario"), str):
+        raise DesignerError(f"{path.name} names no scenario", 'add scenario = "arm.toml" at the top')
+    scenario = cosim.load((path.parent / doc["scenario"]).resolve())
+    sweep = doc.get("sweep", {})
+    if not isinstance(sweep, dict):
+        raise DesignerError(f"{_where(path, 'sweep')} must be a table", "see the README")
+    if "duration" in sweep:
+        scenario = with_duration(scenario, sweep["duration"])
+    mode = sweep.get("path", "fmu")
+    if mode not in PATHS:
+        raise DesignerError(f"{_where(path, 'sweep.path')} = {mode!r} is not allowed", "use fmu or engine")
+    limits = sweep.get("limits", [])
+    if not isinstance(limits, list):
+        raise DesignerError(f"{_where(path, 'sweep.limits')} must list limits", 'e.g. ["overshoot<=5%"]')
+    surrogate = sweep.get("surrogate")
+    spec = Spec(
+        scenario=scenario,
+        cases=_cases(doc, path, scenario),
+        path=mode,
+        check=_count(sweep, "check", path, 3, minimum=0),
+        limits=tuple(parse_limit(x) for x in limits),
+        surrogate=None if surrogate is None else (path.parent / str(surrogate)).resolve(),
+        workers=_count(sweep, "workers", path, None),
+        batch=_count(sweep, "batch", path, None),
+        cluster=_cluster(doc, path),
+        source=path,
+    )
+    return check(spec)
+
+
+def with_duration(scenario: Scenario, duration: Any) -> Scenario:
+    """The scenario run for another duration (s)."""
+    if isinstance(duration, bool) or not isinstance(duration, (int, float)) or not duration >= scenario.step:
+        raise DesignerError(f"duration {duration!r} is not at least one step", f"give >= {scenario.step:g} s")
+    return dataclasses.replace(scenario, duration=float(duration))
+
+
+def check(spec: Spec) -> Spec:
+    """Check a spec built in code as `load` checks a file; returns it (a Monte Carlo or suggestion sweep
+    without joints varies them all).
+
+    Raises:
+        DesignerError: a rig scenario with the engine path or limits, a case naming an unknown
+            joint, or a Monte Carlo sweep without its count.
+    """
+    sc = spec.scenario
+    if sc.kind == "rig" and (spec.path != "fmu" or spec.limits):
+        raise DesignerError(
+            "a rig sweep identifies each case's virtual rig log through the FMU",
+            "use path='fmu' and no limits with a rig scenario",
+        )
+    if spec.path not in PATHS:
+        raise DesignerError(f"path={spec.path!r} is not allowed", "use path='fmu' or path='engine'")
+    if spec.cases.type not in CASE_TYPES:
+        raise DesignerError(
+            f"cases type {spec.cases.type!r} is unknown", f"use one of {', '.join(CASE_TYPES)}"
+        )
+    names = sources(sc)
+    if not spec.cases.joints:
+        if spec.cases.type == "grid":
+            raise DesignerError("a grid sweep needs its axes", "give joints={'j1': {'k': [100, 200]}}")
+        spec = dataclasses.replace(spec, cases=dataclasses.replace(spec.cases, joints=dict.fromkeys(names)))
+    for j in spec.cases.joints:
+        if j not in names:
+            raise DesignerError(
+                f"the sweep varies joint '{j}' the scenario lacks", f"it has {', '.join(names)}"
+            )
+    if spec.cases.type == "montecarlo" and not spec.cases.n:
+        raise DesignerError("a Monte Carlo sweep needs a number of draws", "give n (e.g. n = 200)")
+    return spec

@@ -1,0 +1,102 @@
+"""Honest accuracy of the surrogate: nested leave-one-out, influential runs, lack-of-fit test.
+
+Leave-one-out of the chosen form is optimistic, because the form was chosen by looking at those
+same errors. Nested leave-one-out repeats the whole procedure (form and ridge penalty chosen
+again) without each run and predicts that run: the accuracy a user can expect of `fit` on data
+like this. With replicated runs (equal factor settings), the pure error they measure splits the
+residual into pure error and lack of fit, the classic response-surface test (Montgomery, Design
+and Analysis of Experiments, sec. 6.8 / 11.2).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from . import space
+
+if TYPE_CHECKING:
+    from .surrogate import Prediction, Selection, _Fit, _Folds
+
+#: a run is influential when leaving it out moves the chosen form's LOO Q2 by more than this
+INFLUENCE_Q2 = 0.05
+
+
+def nested_loo(
+    folds: _Folds, full: Selection, forms: tuple[str, ...]
+) -> tuple[Prediction, list[dict[str, Any]]]:
+    """Predict each run from the whole selection procedure run on the others.
+
+    Args:
+        folds: the response's fits, cached by the rows left out (shared with the full selection).
+        full: the selection on all runs.
+        forms: the forms the procedure chooses from.
+
+    Returns:
+        (the nested predictions, shape (n,), and the influential
+        runs as [{"row", "form", "q2", "delta_q2", "press_share"}] with `row` 0-based, `q2` the LOO
+        Q2 of the form chosen without that run over the remaining runs, and `press_share` the
+        run's share of the chosen form's LOO squared error on all runs).
+    """
+    from .surrogate import Prediction, _point_metrics, select_on
+
+    y = folds.y
+    n = len(y)
+    full_q2 = _point_metrics(y, full.loo[full.form])["q2"]
+    sq = (y - full.loo[full.form]) ** 2
+    value, low, high = np.empty(n), np.empty(n), np.empty(n)
+    influence = []
+    for i in range(n):
+        rows = np.delete(np.arange(n), i)
+        sel = select_on(folds, rows, forms, out=frozenset({i}))
+        p = sel.fit.predict(folds.Z[sel.form][i : i + 1])
+        value[i], low[i], high[i] = p[0][0], p[1][0], p[2][0]
+        q2 = _point_metrics(y[rows], sel.loo[sel.form])["q2"]
+        if sel.form != full.form or abs(q2 - full_q2) > INFLUENCE_Q2:
+            share = float(sq[i] / sq.sum())
+            influence.append(
+                {"row": i, "form": sel.form, "q2": q2, "delta_q2": q2 - full_q2, "press_share": share}
+            )
+    return Prediction(value, low, high), influence
+
+
+def replicate_groups(X: Mapping[str, np.ndarray]) -> np.ndarray:
+    """Group label per run: runs with equal settings of all six factors share one, shape (n,)."""
+    rows = np.column_stack([np.asarray(X[n], dtype=float) for n in space.FACTOR_NAMES])
+    return np.unique(rows, axis=0, return_inverse=True)[1].ravel()
+
+
+def lack_of_fit(
+    X: Mapping[str, np.ndarray], y: np.ndarray, Z: np.ndarray, fit: _Fit, log: bool
+) -> dict[str, float] | None:
+    """Pure-error and lack-of-fit F test of a fit, in its fit space; None without replicates.
+
+    SS_pe sums the squared deviations of replicated runs from their group means (n - m dof for m
+    distinct designs); SS_lof = SSE - SS_pe with the fit's residual dof (n - trace of the ridge hat
+    matrix) less n - m; F = (SS_lof / df_lof) / (SS_pe / df_pe) against F(df_lof, df_pe). A small
+    p-value says the form misses structure the replicates show is there.
+    """
+    from scipy.stats import f as f_dist
+
+    groups = replicate_groups(X)
+    m, n = groups.max() + 1, len(y)
+    if m == n:
+        return None
+    yt = np.log(y) if log else np.asarray(y, dtype=float)
+    means = np.bincount(groups, weights=yt) / np.bincount(groups)
+    ss_pe = float(np.sum((yt - means[groups]) ** 2))
+    sse = float(np.sum((yt - Z @ fit.coef) ** 2))
+    df_pe, df_lof = float(n - m), fit.dof - (n - m)
+    out = {
+        "replicated_designs": int(np.sum(np.bincount(groups) > 1)),
+        "df_pure_error": df_pe,
+        "ss_pure_error": ss_pe,
+        "ss_lack_of_fit": sse - ss_pe,
+        "df_lack_of_fit": df_lof,
+    }
+    if df_lof <= 0 or ss_pe <= 0:
+        return out | {"f": None, "p_value": None}
+    F = ((sse - ss_pe) / df_lof) / (ss_pe / df_pe)
+    return out | {"f": float(F), "p_value": float(f_dist.sf(F, df_lof, df_pe))}
