@@ -21,60 +21,100 @@ def identify(
         list[Path], typer.Argument(help="rig logs (CSV or Parquet), each with its factor sidecar")
     ],
     output: Annotated[
-        Path | None, typer.Option("-o", "--output", help="write the coefficient table (CSV)")
+        Path | None,
+        typer.Option("-o", "--output", help="write the coefficient table (CSV) of the logs that pass"),
     ] = None,
-    window: Annotated[
-        float | None, typer.Option(help="Savitzky-Golay window, s (default: from the excitation)")
+    load_delay: Annotated[
+        float | None,
+        typer.Option(
+            help="s by which the load channel lags the position (default: sidecar load_delay_s, else 0)"
+        ),
     ] = None,
     json_out: JsonOpt = False,
 ) -> None:
-    """Identify m, c, k per axis from rig logs (least squares of F = m r'' + c r' + k r).
+    """Identify m, c, k per axis from rig logs (F = m r'' + c r' + k r); exit 1 if any log fails.
 
-    Example: designer identify run1.csv run2.parquet -o table.csv
+    Example: designer identify run1.csv run2.parquet --load-delay 0.002 -o table.csv
     """
     from designer.files import check_output
+    from designer.rig.identify import ESTIMATOR, results_table
     from designer.rig.identify import identify as run
-    from designer.rig.identify import results_table
 
     if output is not None:
         check_output(output, suffixes=TABLE_SUFFIXES)
-    if window is not None and not window > 0:
-        raise DesignerError(
-            f"--window {window:g}", "give the Savitzky-Golay window in seconds, > 0, or omit it"
-        )
-    results = []
+    if load_delay is not None and load_delay != load_delay:
+        raise DesignerError("--load-delay is NaN", "give the delay in seconds, e.g. --load-delay 0.002")
     with progress("identifying") as bar:
-        for i, path in enumerate(logs):
-            results.append(run(path, window_s=window, progress=lambda f, i=i: bar((i + f) / len(logs))))
-    if output is not None:
+        results = run(logs, load_delay_s=load_delay, progress=bar)
+    passed = [r for r in results if r.ok]
+    wrote = output is not None and bool(passed)
+    if wrote:
         from designer.data import write_frame
 
-        write_frame(results_table(results), output)
+        write_frame(results_table(passed), output)
     if json_out:
-        print_json({"logs": [r.to_dict() for r in results], "table": None if output is None else str(output)})
-        return
+        print_json(
+            {
+                "estimator": ESTIMATOR,
+                "logs": [r.to_dict() for r in results],
+                "failed": [str(r.path) for r in results if not r.ok],
+                "warnings": [f"{r.path}: {w}" for r in results for w in r.warnings],
+                "table": str(output) if wrote else None,
+            }
+        )
+    else:
+        for res in results:
+            _print_identification(res)
+        console.print(f"estimator: {ESTIMATOR}")
+        if wrote:
+            console.print(f"wrote {output} ({len(passed)} of {len(results)} logs)")
+        elif output is not None:
+            console.print(f"no log passed: {output} not written")
+    if len(passed) < len(results):
+        raise typer.Exit(1)
+
+
+def _print_identification(res) -> None:
+    """One log: its coefficients, band tables, warnings and failures, in rig units."""
     from rich.table import Table
 
     from designer import units
 
-    for res in results:
-        table = Table(title=f"{res.path}  ({res.rate:g} Hz)")
-        for col in ("axis", "k", "c", "m", "R2", "NRMSE"):
-            table.add_column(col)
-        for a, f in res.axes.items():
-            table.add_row(
-                a,
-                f"{f.k:.4g} +/- {f.k_se:.2g} {units.rig_unit('k', a)}",
-                f"{f.c:.4g} +/- {f.c_se:.2g} {units.rig_unit('c', a)}",
-                f"{f.m:.3g} +/- {f.m_se:.2g} {units.rig_unit('m', a)}",
-                f"{f.r2:.5f}",
-                f"{100 * f.nrmse:.3g} %",
-            )
-        console.print(table)
-        for f in res.axes.values():
-            console.print(f"  {f.axis}: {f.statement()}")
-    if output is not None:
-        console.print(f"wrote {output}")
+    table = Table(title=f"{res.path}  ({res.rate:g} Hz)")
+    for col in ("axis", "k", "c", "m", "R2", "band"):
+        table.add_column(col)
+    for a, f in res.axes.items():
+        table.add_row(
+            a,
+            f"{f.k:.4g} +/- {f.k_se:.2g} {units.rig_unit('k', a)}",
+            f"{f.c:.4g} +/- {f.c_se:.2g} {units.rig_unit('c', a)}",
+            f"{f.m:.3g} +/- {f.m_se:.2g} {units.rig_unit('m', a)}",
+            f"{f.r2:.5f}",
+            f"{f.band['low_hz']:.3g}-{f.band['high_hz']:.3g} Hz "
+            f"(filter flat to {f.band['filter_pass_hz']:.3g} Hz)",
+        )
+    console.print(table)
+    for f in res.axes.values():
+        ru, ku, cu = units.rig_unit("r", f.axis), units.rig_unit("k", f.axis), units.rig_unit("c", f.axis)
+        console.print(f"  {f.axis}: {f.statement()}")
+        console.print(
+            f"  {f.axis}: load delay corrected {1e3 * f.load_delay_s:.3g} ms; one more sample of skew "
+            f"changes c by {f.c_per_sample_skew:+.3g} {cu}"
+        )
+        amp = ", ".join(
+            f"{r['from']:.3g}-{r['to']:.3g} {ru}: {r['k']:.4g} +/- {r['k_se']:.2g}"
+            for r in f.k_amplitude["rows"]
+        )
+        console.print(f"  {f.axis}: k(amplitude) [{ku}] {amp} (p equal {f.k_amplitude['p_equal']:.2g})")
+        freq = ", ".join(
+            f"{r['from_hz']:.3g}-{r['to_hz']:.3g} Hz: {r['c']:.4g} +/- {r['c_se']:.2g}"
+            for r in f.c_frequency["rows"]
+        )
+        console.print(f"  {f.axis}: c(frequency) [{cu}] {freq} (p equal {f.c_frequency['p_equal']:.2g})")
+    for w in res.warnings:
+        console.print(f"  warning: {w}")
+    for a, why in res.failures.items():
+        console.print(f"  FAILED {a}: {why}")
 
 
 TABLE_SUFFIXES = (".csv", ".parquet", ".pq")

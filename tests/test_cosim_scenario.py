@@ -94,7 +94,7 @@ def test_rig_log_identifies_the_fmus_coefficients(tmp_path):
     result = run(load(write(tmp_path, RIG)), validate=True)
     write_outputs(result, out, plot=False)
     summary = result.summary()
-    fit = identify(out / "rig_log.csv").axes["theta"]
+    fit = identify(out / "rig_log.csv")[0].axes["theta"]
     assert fit.k == pytest.approx(330, rel=5e-3)
     assert fit.c == pytest.approx(0.83, rel=5e-3)
     rows = summary["validation"]["steps"]

@@ -32,7 +32,7 @@ def _cli(*args, **kw):
 def test_closed_loop_recovers_k_and_c_within_1_percent(k, c):
     df = simulate({"x": {"m": 0.001, "c": c, "k": k}}, duration=120, noise=0.01, dropouts=0.001, seed=7)
     assert df["Fx"].isna().any() and (df["Fx"] == 0).sum() >= 10  # dropouts of both kinds are present
-    fit = identify(validate_frame(df, factors=FACTORS)).axes["x"]
+    fit = identify(validate_frame(df, factors=FACTORS))[0].axes["x"]
     assert fit.k == pytest.approx(k, rel=0.01)
     assert fit.c == pytest.approx(c, rel=0.01)
     assert fit.r2 > 0.999 and 0 < fit.nrmse < 0.01
@@ -46,7 +46,7 @@ def test_strong_inertial_excitation_recovers_m_within_5_percent():
     df = simulate(
         {"x": {"m": 0.01, "c": 2e-3, "k": 0.8}}, duration=60, noise=0.01, dropouts=0.001, seed=3, f1=20
     )
-    fit = identify(validate_frame(df)).axes["x"]
+    fit = identify(validate_frame(df))[0].axes["x"]
     assert fit.m_identified
     assert fit.m == pytest.approx(0.01, rel=0.05)
     assert fit.k == pytest.approx(0.8, rel=0.01)
@@ -75,7 +75,7 @@ def test_write_read_round_trip_six_axes(tmp_path, suffix):
     assert log.rate == pytest.approx(1000.0) and log.factors == {k: float(v) for k, v in FACTORS.items()}
     assert np.allclose(log.data["Fx"].fillna(-1), df["Fx"].fillna(-1), rtol=1e-12, atol=0)
     assert all(log.dropouts[a].any() for a in log.axes) and log.dropout_segments("x")
-    res = identify(log)
+    res = identify(log)[0]
     assert res.axes["psi"].k == pytest.approx(0.5, rel=1e-3)
     table = results_table([res])
     assert list(table.columns[:8]) == [

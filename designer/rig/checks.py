@@ -30,7 +30,7 @@ def check_identification(ctx: Context) -> CheckResult:
     rows = []
     for i, (axis, coef) in enumerate(IDENTIFY_SETS):
         log = simulate({axis: coef}, duration=IDENTIFY_SECONDS, noise=0.01, dropouts=0.001, seed=i)
-        fit = identify(validate_frame(log, source="virtual rig")).axes[axis]
+        fit = identify(validate_frame(log, source="virtual rig"))[0].axes[axis]
         k_err, c_err = 100 * (fit.k / coef["k"] - 1), 100 * (fit.c / coef["c"] - 1)
         rows.append(
             {

@@ -1,19 +1,30 @@
-"""Identification: per axis, the least-squares fit of F = m r'' + c r' + k r (the study's Eq 5).
+"""Identification: per axis, m, c, k of F = m r'' + c r' + k r (the study's Eq 5) from a rig log.
 
-Velocity and acceleration come from Savitzky-Golay differentiation of the coordinate; rows in or
-near a dropout segment are left out. A constant sensor offset is fitted alongside and reported.
-At the study's frequencies a gram-scale specimen's inertial force is about a thousandth of its
-spring force, so m is often not identifiable: the result says so and gives the mass computed
-from the specimen's geometry, walls, infill and TPU density instead.
+How, and why (see `band` and `regress` for the details):
+- the band that carries the motion is read from the position's spectrum; r, r', r'' and the load
+  go through the same low-pass (flat to 1.5 x the band's top), so its gain and phase cancel, and
+  position noise above the band never reaches r' and r'';
+- the estimator is bias-compensated least squares: the position noise left in the band is measured
+  from the out-of-band spectrum and its covariance taken out of the normal equations, so the fit
+  stays consistent when r is noisy (ordinary least squares shrinks m and k);
+- standard errors are Newey-West (HAC), valid for the coloured residuals that filtering makes;
+- m counts as identified only when its standard error is under 10 % of it and the fits at two
+  wider derivative bandwidths agree with it within two standard errors; else the result gives the
+  mass from geometry;
+- a known delay of the load channel is removed exactly (a phase in the frequency domain), and the
+  change of c for one sample of skew is always reported (c shifts by about -k x delay);
+- k per amplitude band and c per frequency band test the linear model;
+- a log whose fit is impossible (k <= 0, c < 0, R2 < 0.5), or that cannot support a fit (too slow
+  a sampling rate, too few cycles, a mostly missing channel, time not in seconds), is failed with
+  its reason and never becomes a row of the coefficient table.
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import asdict, dataclass
-from functools import cache
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -22,22 +33,41 @@ import pandas as pd
 from .. import space, units
 from ..errors import DesignerError
 from ..mass import specimen_mass
-from .logs import LOAD, RigLog, read_log
+from . import band as bandlib
+from .logs import LOAD, RigLog, missing, read_log, validate_frame
+from .nonlinear import amplitude_table, frequency_table
+from .regress import solve
 
-#: longest Savitzky-Golay window, s: short against the fastest period of the study's chirp (0.54 s)
-WINDOW_S = 0.05
-#: the window spans at most this fraction of the shortest period carrying the coordinate's power
-WINDOW_PERIODS = 0.1
-POLYORDER = 5
+ESTIMATOR = (
+    "bias-compensated least squares (errors-in-variables correction with the position-noise level "
+    "measured from the out-of-band spectrum), Newey-West HAC standard errors"
+)
+#: pass edges of the main fit and of the two wider derivative bandwidths, as multiples of the band's top
+PASS_EDGES = (1.5, 2.25, 3.0)
 #: m counts as identified when its standard error is at most this fraction of it
 M_REL_SE = 0.1
-#: FFT block of the overlap-save derivative filter and of the low-band power test (fits in cache)
-BLOCK = 16384
+#: Newey-West truncation, in 1 / (filter transition width)
+LAG_TRANSITIONS = 1.5
+#: sanity limits
+MIN_RATE_OVER_BAND = 10.0
+MIN_CYCLES = 10.0
+#: fewest usable rows of the filtered grid (about 6 per cycle at the band's top)
+MIN_ROWS = 60
+MIN_VALID = 0.5
+MIN_R2 = 0.5
+PLAUSIBLE_RATE_HZ = (10.0, 1e6)
+PLAUSIBLE_DURATION_S = 1e5
+#: warn when one sample of channel skew moves c by more than this fraction
+SKEW_WARN = 0.1
+
+
+class AxisFailed(Exception):
+    """An axis whose log cannot give, or gave, a physically possible fit; the message is the reason."""
 
 
 @dataclass(frozen=True)
 class AxisFit:
-    """One axis: m, c, k in rig units (m in kg or kg.m^2) with standard errors and fit quality."""
+    """One axis: m, c, k in rig units (m in kg or kg.m^2) with HAC standard errors and fit quality."""
 
     axis: str
     m: float
@@ -46,16 +76,26 @@ class AxisFit:
     m_se: float
     c_se: float
     k_se: float
-    offset: float
+    #: R2 and RMS residual over the load's range, both on the band-limited signals
     r2: float
-    #: RMS residual over the range of the load
     nrmse: float
+    #: rows of the filtered grid in the fit (the band-limited signals resampled at 2.5x the stop edge)
     samples: int
     m_identified: bool
     #: mass from geometry (kg, translational axes with known factors) when m is not identified
     m_geometric: float | None
     #: inertial force against spring force at this excitation (RMS m r'' over RMS k r)
     inertia_ratio: float
+    band: dict
+    load_delay_s: float
+    #: change of c when the load is shifted by one more sample (rig units), and that over |c|
+    c_per_sample_skew: float
+    c_skew_relative: float
+    #: m at the main and the wider derivative bandwidths: {"pass_hz", "m", "m_se"}
+    m_bandwidths: list[dict]
+    k_amplitude: dict
+    c_frequency: dict
+    warnings: list[str] = field(default_factory=list)
 
     def mass(self) -> float | None:
         """The mass to use: the identified one, else the geometric one (None if neither)."""
@@ -64,9 +104,9 @@ class AxisFit:
     def statement(self) -> str:
         """One sentence on the mass, for people."""
         unit = units.rig_unit("m", self.axis)
-        fit = f"m = {self.m:.4g} +/- {self.m_se:.2g} {unit}"
+        fit = f"m = {self.m:.3g} +/- {self.m_se:.2g} {unit}"
         if self.m_identified:
-            return f"{fit} (identified)"
+            return f"{fit} (identified: precise, and stable across derivative bandwidths)"
         why = (
             f"m is not identifiable from this excitation ({fit}; inertial force about "
             f"{100 * self.inertia_ratio:.2g} % of the spring force)"
@@ -80,230 +120,309 @@ class AxisFit:
             return f"{why}; take the inertia from CAD"
         return f"{why}; give the specimen's factors in the log's sidecar to get the mass from geometry"
 
+    def to_dict(self) -> dict:
+        out = {k: getattr(self, k) for k in self.__dataclass_fields__}
+        return out | {"statement": self.statement(), "estimator": ESTIMATOR}
+
 
 @dataclass(frozen=True)
 class Identification:
-    """The fits of one log, keyed by axis, with where the log came from and its factors."""
+    """The fits of one log, keyed by axis; `failures` gives each failed axis' reason."""
 
     path: Path | None
     factors: dict[str, float] | None
     rate: float
     axes: dict[str, AxisFit]
+    failures: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        """Whether every axis gave a possible fit (only then is the log a row of the table)."""
+        return not self.failures
+
+    @property
+    def warnings(self) -> list[str]:
+        return [f"{a}: {w}" for a, f in self.axes.items() for w in f.warnings]
 
     def to_dict(self) -> dict:
         return {
             "path": None if self.path is None else str(self.path),
+            "ok": self.ok,
+            "failures": self.failures,
+            "warnings": self.warnings,
             "factors": self.factors,
             "rate_hz": self.rate,
-            "axes": {a: asdict(f) | {"statement": f.statement()} for a, f in self.axes.items()},
+            "axes": {a: f.to_dict() for a, f in self.axes.items()},
         }
 
 
-def _top_frequency(r: np.ndarray, rate: float) -> float:
-    """Frequency below which 99 % of the coordinate's power lies, Hz."""
-    from scipy.fft import next_fast_len, rfft
-
-    n = next_fast_len(r.size, real=True)
-    power = np.abs(rfft(r - r.mean(), n=n)) ** 2
-    cumulative = np.cumsum(power)
-    if cumulative[-1] == 0:
-        return rate / 2
-    return float(np.searchsorted(cumulative, 0.99 * cumulative[-1]) * rate / n)
+def _check_time(log: RigLog) -> None:
+    """Fail a log whose sampling rate or duration is implausible in seconds (t in ms, us, ns ...)."""
+    lo, hi = PLAUSIBLE_RATE_HZ
+    if not lo <= log.rate <= hi or log.duration > PLAUSIBLE_DURATION_S:
+        raise AxisFailed(
+            f"implausible time units: sampling rate {log.rate:.3g} Hz over {log.duration:.3g} s "
+            f"(expected {lo:g} Hz to {hi:g} Hz, at most {PLAUSIBLE_DURATION_S:g} s); t must be in seconds"
+        )
 
 
-@cache
-def _twiddles(n: int, cols: int, top: int) -> np.ndarray:
-    """exp(-2 pi i j k / n) for the columns j < cols and the bins k <= top of the four-step FFT."""
-    return np.exp(-2j * np.pi * (np.arange(cols)[:, None] * np.arange(top + 1) % n) / n)
+def _spectra(log: RigLog, axis: str) -> bandlib.Spectra:
+    """Spectra of the axis: block means at about PRE_RATE, or the full rate when the band needs it."""
+    r = log.data[axis].to_numpy()
+    f = log.data[LOAD[axis]].to_numpy()
+    valid = 1.0 - log.missing_fraction.get(LOAD[axis], float(missing(f).mean()))
+    if valid < MIN_VALID:
+        raise AxisFailed(f"the load channel {LOAD[axis]} has only {100 * valid:.3g} % valid samples")
+    usable = 1.0 - np.count_nonzero(log.dropouts[axis]) / log.dropouts[axis].size
+    if usable < MIN_VALID:
+        raise AxisFailed(f"only {100 * usable:.3g} % of the samples are valid")
+    factor = max(1, int(log.rate // bandlib.PRE_RATE))
+    spec = bandlib.spectra(r, f, log.dropouts[axis], log.rate, factor)
+    if spec.band is not None and factor > 1 and spec.band.high * bandlib.PRE_MARGIN > spec.rate:
+        spec = bandlib.spectra(r, f, log.dropouts[axis], log.rate, 1)
+    if spec.band is None or not np.isfinite([spec.scale_r, spec.scale_f]).all():
+        raise AxisFailed(f"no motion on {axis}: the position is constant or not finite")
+    return spec
 
 
-def _below_99(r: np.ndarray, rate: float, f_cap: float) -> bool:
-    """Whether 99 % of the coordinate's power lies at or below f_cap: `_top_frequency <= f_cap`.
+def _design(ch: bandlib.Channels) -> tuple[np.ndarray, np.ndarray]:
+    """Columns r'', r', r, constant, trend and their per-row noise covariance."""
+    span = max(float(ch.t[-1] - ch.t[0]), 1e-300)
+    x = np.column_stack([ch.x, np.ones_like(ch.t), 2 * (ch.t - ch.t[0]) / span - 1])
+    noise = np.zeros((5, 5))
+    noise[:3, :3] = ch.noise_cov
+    return x, noise
 
-    Same spectrum, same bins, at a fraction of the cost: the bins up to f_cap come from one
-    four-step pass (batched in-cache FFTs over the columns of the padded signal, then twiddles),
-    and the total power from Parseval in the time domain. False when that cannot be decided cheaply.
+
+def _lags(ch: bandlib.Channels) -> int:
+    transition = (bandlib.STOP_RATIO - 1.0) * ch.pass_edge
+    return int(np.ceil(LAG_TRANSITIONS / transition * ch.rate))
+
+
+def _cycles(ch: bandlib.Channels) -> float:
+    """Cycles of motion over the kept rows: half the zero crossings of the filtered position."""
+    r = ch.x[ch.keep, 2]
+    s = np.signbit(r - r.mean())
+    return float(np.count_nonzero(s[1:] != s[:-1]) / 2)
+
+
+def _fit(spec: bandlib.Spectra, pass_edge: float, delay: float, *, skew_s: float | None = None):
+    """Filter at `pass_edge` and fit; fail a log with too few cycles or usable rows.
+
+    With `skew_s`, the solution's `also_beta` is the fit with the load advanced by that much more.
     """
-    from scipy.fft import next_fast_len, rfft
-
-    n = next_fast_len(r.size, real=True)
-    top = int(np.floor(f_cap * n / rate))
-    while (top + 1) * rate / n <= f_cap:
-        top += 1
-    while top >= 0 and top * rate / n > f_cap:
-        top -= 1
-    cols = next((c for c in range(64, 1024) if n % c == 0 and n // c > 2 * (top + 1)), None)
-    if top < 0 or cols is None:
-        return False
-    x = np.zeros(n)
-    np.subtract(r, r.mean(), out=x[: r.size])
-    # X[k] = sum_j exp(-2 pi i j k / n) * FFT_{n/cols}(x[j::cols])[k], for k < n / cols
-    inner = rfft(x.reshape(n // cols, cols).T, axis=1)[:, : top + 1]
-    low = np.einsum("jk,jk->k", inner, _twiddles(n, cols, top))
-    spectrum0, nyquist = x.sum(), x[::2].sum() - x[1::2].sum()
-    total = (n * float(x @ x) + spectrum0**2 + nyquist**2) / 2
-    return total == 0 or float(np.sum(low.real**2 + low.imag**2)) >= 0.99 * total
-
-
-def _window(r: np.ndarray, rate: float, window_s: float | None, polyorder: int) -> int:
-    """Odd Savitzky-Golay window length in samples; by default from the excitation's top frequency."""
-    if window_s is None:
-        f_cap = WINDOW_PERIODS / WINDOW_S
-        if _below_99(r, rate, f_cap):
-            window_s = WINDOW_S
-        else:
-            window_s = min(WINDOW_S, WINDOW_PERIODS / max(_top_frequency(r, rate), 1e-9))
-    return max(int(round(window_s * rate)) | 1, (polyorder + 2) | 1)
-
-
-@cache
-def _kernel_spectra(win: int, polyorder: int, dt: float, block: int) -> np.ndarray:
-    """Spectra of the Savitzky-Golay kernels (r'', r', r) as circular correlations on one block."""
-    from scipy.fft import rfft
-    from scipy.signal import savgol_coeffs
-
-    half = win // 2
-    g = np.zeros((3, block))
-    for i, d in enumerate((2, 1, 0)):
-        g[i, -np.arange(-half, half + 1) % block] = savgol_coeffs(
-            win, polyorder, deriv=d, delta=dt, use="dot"
+    ch = bandlib.filtered(spec, pass_edge, delay, skew_s)
+    cycles = _cycles(ch)
+    if cycles < MIN_CYCLES:
+        raise AxisFailed(f"only {cycles:.3g} cycles of excitation (at least {MIN_CYCLES:g} needed)")
+    if ch.keep.sum() < MIN_ROWS:
+        raise AxisFailed(
+            f"only {int(ch.keep.sum())} usable rows after leaving out the ends and dropouts; record longer"
         )
-    return rfft(g, axis=1)
+    x, noise = _design(ch)
+    return ch, solve(x, ch.y, ch.keep, noise, _lags(ch), also=ch.y_skew)
 
 
-def _derivatives(r: np.ndarray, win: int, polyorder: int, dt: float) -> np.ndarray:
-    """Savitzky-Golay r'', r', r (rows) by overlap-save FFT filtering in cache-sized blocks.
-
-    Equal to `savgol_filter` away from the first and last win // 2 rows (which the fit leaves out),
-    and closer to the exact sums than its direct convolution.
-    """
-    from numpy.lib.stride_tricks import sliding_window_view
-    from scipy.fft import irfft, rfft
-
-    half = win // 2
-    block = max(BLOCK, 1 << (4 * win - 1).bit_length())
-    step = block - 2 * half
-    blocks = -(-r.size // step)
-    padded = np.zeros(blocks * step + 2 * half)
-    padded[half : half + r.size] = r
-    spectra = rfft(sliding_window_view(padded, block)[::step], axis=1)
-    out = np.empty((3, blocks * step))
-    for i, kernel in enumerate(_kernel_spectra(win, polyorder, dt, block)):
-        filtered = irfft(spectra * kernel, n=block, axis=1)
-        out[i].reshape(blocks, step)[:] = filtered[:, half : block - half]
-    return out[:, : r.size]
-
-
-def _dilate(mask: np.ndarray, size: int) -> np.ndarray:
-    """Rows within size // 2 of a True row (a 1-D maximum filter of a sparse mask)."""
-    rows = np.flatnonzero(mask)
-    edges = np.zeros(mask.size + 1, dtype=np.int32)
-    np.add.at(edges, np.clip(rows - size // 2, 0, mask.size), 1)
-    np.add.at(edges, np.clip(rows + size // 2 + 1, 0, mask.size), -1)
-    return np.cumsum(edges[:-1]) > 0
-
-
-def fit_axis(log: RigLog, axis: str, window_s: float | None = None, polyorder: int = POLYORDER) -> AxisFit:
-    """Least-squares m, c, k (and offset) of one axis of a validated log."""
-    if axis not in log.axes:
-        raise DesignerError(f"axis {axis} is not in the log", f"the log has {', '.join(log.axes)}")
-    r_filled = np.where(log.dropouts[axis], 0.0, log.data[axis].to_numpy())
-    win = _window(r_filled, log.rate, window_s, polyorder)
-    if win > len(log.data):
-        raise DesignerError(
-            f"the log has {len(log.data)} rows, fewer than the {win}-sample derivative window",
-            "record a longer run",
+def fit_axis(log: RigLog, axis: str, *, load_delay_s: float = 0.0) -> AxisFit:
+    """Fit one axis of a validated log; raise AxisFailed with the reason when it cannot or should not."""
+    spec = _spectra(log, axis)
+    top = spec.band.high
+    scale = spec.scale_f / spec.scale_r
+    ch, main = _fit(spec, PASS_EDGES[0] * top, load_delay_s, skew_s=1.0 / log.rate)
+    if log.rate < MIN_RATE_OVER_BAND * top:
+        raise AxisFailed(
+            f"sampling rate {log.rate:.4g} Hz is under {MIN_RATE_OVER_BAND:g} x the highest excitation "
+            f"frequency {top:.3g} Hz (or the excitation is aliased)"
         )
-    dt = 1.0 / log.rate
-    force = log.data[LOAD[axis]].to_numpy()
-    bad = _dilate(log.dropouts[axis], 2 * win + 1)
-    bad[: win // 2] = bad[-(win // 2) :] = True
-    keep = ~bad
-    if keep.sum() < 10 * win:
-        raise DesignerError(
-            f"axis {axis}: only {int(keep.sum())} samples outside dropouts",
-            "the log has too little valid data to identify; record again",
+    m_log, c, k = (float(v) * scale for v in main.beta[:3])
+    c_se, k_se = (float(v) * scale for v in main.se[1:3])
+    if not np.isfinite([m_log, c, k, c_se, k_se, main.r2]).all():
+        raise AxisFailed("the fit is not finite (values too large or degenerate)")
+    if k <= 0 or c < 0 or main.r2 < MIN_R2:
+        raise AxisFailed(
+            f"physically impossible fit: k = {k:.4g} {units.rig_unit('k', axis)}, "
+            f"c = {c:.4g} {units.rig_unit('c', axis)}, R2 = {main.r2:.3g} "
+            f"(needs k > 0, c >= 0, R2 >= {MIN_R2:g})"
         )
-    y = force[keep]
-    # columns r'', r', r (rows here) and the constant; left-out rows zeroed instead of copied out
-    bad_rows = np.flatnonzero(bad)
-    d = _derivatives(r_filled, win, polyorder, dt)
-    d[:, bad_rows] = 0.0
-    y0 = np.where(keep, force, 0.0)
-    gram = np.empty((4, 4))
-    gram[:3, :3] = d @ d.T
-    gram[:3, 3] = gram[3, :3] = d.sum(axis=1)
-    gram[3, 3] = y.size
-    moment = np.append(d @ y0, y.sum())
-    scale = np.sqrt(np.diag(gram) / y.size)
-    scale[scale == 0] = 1.0
-    # normal equations of the column-scaled problem: four well-scaled columns
-    gram_inv = np.linalg.pinv(gram / np.outer(scale, scale))
-    beta_s = gram_inv @ (moment / scale)
-    beta = beta_s / scale
-    resid = y0 - beta[:3] @ d - beta[3]
-    resid[bad_rows] = 0.0
-    rss = float(resid @ resid)
-    dof = max(y.size - gram.shape[0], 1)
-    sigma2 = rss / dof
-    se = np.sqrt(np.diag(sigma2 * gram_inv)) / scale
-    ss_tot = float(np.sum((y - y.mean()) ** 2))
-    r2 = 1.0 - rss / ss_tot if ss_tot > 0 else float("nan")
-    span = float(y.max() - y.min())
-    nrmse = float(np.sqrt(rss / y.size) / span) if span > 0 else float("nan")
-    m_log, c, k, offset = (float(v) for v in beta)
-    m = units.to_si("m_log", axis, m_log)
-    m_se = units.to_si("m_log", axis, float(se[0]))
-    identified = m > 0 and m_se <= M_REL_SE * m
-    geometric = (
-        specimen_mass(log.factors) if log.factors is not None and not units.is_rotational(axis) else None
+    c_skew = float(main.also_beta[1]) * scale - c
+    wide = [(ch, main)] + [_fit(spec, p * top, load_delay_s) for p in PASS_EDGES[1:]]
+    m_rows = [
+        {
+            "pass_hz": w_ch.pass_edge,
+            "m": units.to_si("m_log", axis, float(s.beta[0]) * scale),
+            "m_se": units.to_si("m_log", axis, float(s.se[0]) * scale),
+        }
+        for w_ch, s in wide
+    ]
+    m, m_se = m_rows[0]["m"], m_rows[0]["m_se"]
+    stable = all(abs(row["m"] - m) <= 2 * m_se for row in m_rows[1:])
+    identified = bool(m > 0 and m_se <= M_REL_SE * m and stable)
+    amp = amplitude_table(wide[-1][0], _lags(wide[-1][0]), scale, spec.scale_r)
+    freq = frequency_table(ch, float(main.beta[0]), _lags(ch), scale)
+    y = ch.y[ch.keep]
+    inertia = float(
+        np.std(main.beta[0] * ch.x[ch.keep, 0]) / max(np.std(main.beta[2] * ch.x[ch.keep, 2]), 1e-300)
     )
-    spring = abs(k) * float(scale[2])
-    inertia_ratio = abs(m_log) * float(scale[0]) / spring if spring > 0 else float("inf")
-    return AxisFit(
+    fit = AxisFit(
         axis=axis,
         m=m,
         c=c,
         k=k,
         m_se=m_se,
-        c_se=float(se[1]),
-        k_se=float(se[2]),
-        offset=offset,
-        r2=r2,
-        nrmse=nrmse,
-        samples=int(len(y)),
-        m_identified=bool(identified),
-        m_geometric=None if identified else geometric,
-        inertia_ratio=inertia_ratio,
+        c_se=c_se,
+        k_se=k_se,
+        r2=main.r2,
+        nrmse=float(np.sqrt(main.rss / main.rows) / max(float(y.max() - y.min()), 1e-300)),
+        samples=main.rows,
+        m_identified=identified,
+        m_geometric=None if identified else _geometric(log, axis),
+        inertia_ratio=inertia,
+        band=spec.band.to_dict()
+        | {"filter_pass_hz": ch.pass_edge, "filter_stop_hz": bandlib.STOP_RATIO * ch.pass_edge},
+        load_delay_s=load_delay_s,
+        c_per_sample_skew=c_skew,
+        c_skew_relative=abs(c_skew) / c if c > 0 else float("inf"),
+        m_bandwidths=m_rows,
+        k_amplitude=amp.to_dict(),
+        c_frequency=freq.to_dict(),
+    )
+    fit.warnings.extend(_warnings(fit, stable, amp.varies, freq.varies, log.rate))
+    return fit
+
+
+def _geometric(log: RigLog, axis: str) -> float | None:
+    if log.factors is None or units.is_rotational(axis):
+        return None
+    return specimen_mass(log.factors)
+
+
+def _warnings(fit: AxisFit, stable: bool, k_varies: bool, c_varies: bool, rate: float) -> list[str]:
+    """Doubtful but possible fits: skew sensitivity, nonlinearity, an unstable or imprecise m."""
+    out = []
+    cu, ku = units.rig_unit("c", fit.axis), units.rig_unit("k", fit.axis)
+    if fit.c_skew_relative > SKEW_WARN:
+        out.append(
+            f"one sample ({1e3 / rate:.3g} ms) of skew between the load and position channels changes c by "
+            f"{fit.c_per_sample_skew:+.3g} {cu} ({100 * fit.c_skew_relative:.3g} % of c): give the known "
+            "channel delay (load_delay_s) or c is uncertain by that much"
+        )
+    if k_varies:
+        rows = fit.k_amplitude["rows"]
+        out.append(
+            f"k depends on amplitude beyond its uncertainty ({rows[0]['k']:.4g} to {rows[-1]['k']:.4g} {ku} "
+            f"from the smallest to the largest deflection band, p = {fit.k_amplitude['p_equal']:.2g}): "
+            "the spring is not linear; k is an amplitude average"
+        )
+    if c_varies:
+        rows = fit.c_frequency["rows"]
+        out.append(
+            f"c depends on frequency beyond its uncertainty ({rows[0]['c']:.4g} to {rows[-1]['c']:.4g} {cu} "
+            f"from the lowest to the highest band, p = {fit.c_frequency['p_equal']:.2g}): the damping is "
+            "not viscous; c is a band average"
+        )
+    if fit.m > 0 and fit.m_se <= M_REL_SE * fit.m and not stable:
+        out.append("m is precise but changes with the derivative bandwidth (biased): not taken as identified")
+    if fit.c < 2 * fit.c_se:
+        out.append(f"c is within two standard errors of zero ({fit.c:.3g} +/- {fit.c_se:.2g} {cu})")
+    if fit.r2 < 0.9:
+        out.append(f"R2 = {fit.r2:.3g}: the linear model leaves much of the band-limited load unexplained")
+    return out
+
+
+LogSource = str | Path | pd.DataFrame | RigLog
+
+
+def _as_log(source: LogSource) -> RigLog:
+    if isinstance(source, RigLog):
+        return source
+    if isinstance(source, pd.DataFrame):
+        return validate_frame(source, source="frame")
+    if isinstance(source, (str, Path)):
+        return read_log(source)
+    raise DesignerError(
+        f"logs holds a {type(source).__name__}", "give paths, pandas DataFrames or RigLog objects"
+    )
+
+
+def identify_log(
+    source: LogSource, *, axes: list[str] | None = None, load_delay_s: float | None = None
+) -> Identification:
+    """Identify one log (path, DataFrame or RigLog); see `identify`.
+
+    Raises:
+        DesignerError: the log cannot be read or validated, an axis is not in it, or load_delay_s
+            is not a finite number.
+    """
+    log = _as_log(source)
+    chosen = log.axes if axes is None else list(axes)
+    absent = [a for a in chosen if a not in log.axes]
+    if absent:
+        raise DesignerError(f"axes={absent} not in the log", f"the log has {', '.join(log.axes)}")
+    delay = load_delay_s if load_delay_s is not None else (log.load_delay_s or 0.0)
+    if not np.isfinite(delay):
+        raise DesignerError(f"load_delay_s={load_delay_s} is not finite", "give the delay in seconds")
+
+    def one(axis: str) -> AxisFit | str:
+        try:
+            _check_time(log)
+            return fit_axis(log, axis, load_delay_s=float(delay))
+        except (AxisFailed, np.linalg.LinAlgError) as exc:
+            return str(exc) if isinstance(exc, AxisFailed) else "the fit is degenerate (singular equations)"
+
+    # one thread per axis: the FFTs and array arithmetic release the GIL
+    with ThreadPoolExecutor(max_workers=min(len(chosen), os.cpu_count() or 1)) as pool:
+        outcomes = dict(zip(chosen, pool.map(one, chosen), strict=True))
+    return Identification(
+        path=log.path,
+        factors=log.factors,
+        rate=log.rate,
+        axes={a: o for a, o in outcomes.items() if isinstance(o, AxisFit)},
+        failures={a: o for a, o in outcomes.items() if isinstance(o, str)},
     )
 
 
 def identify(
-    log_or_path: RigLog | str | Path,
+    logs: LogSource | Iterable[LogSource],
+    *,
     axes: list[str] | None = None,
-    window_s: float | None = None,
+    load_delay_s: float | None = None,
     progress: Callable[[float], None] | None = None,
-) -> Identification:
-    """Identify every axis of a log (or the listed ones): m, c, k with standard errors, R2, NRMSE."""
-    log = log_or_path if isinstance(log_or_path, RigLog) else read_log(log_or_path)
-    chosen = log.axes if axes is None else axes
-    # one thread per axis: the FFTs and array arithmetic release the GIL
-    with ThreadPoolExecutor(max_workers=min(len(chosen), os.cpu_count() or 1)) as pool:
-        futures = [pool.submit(fit_axis, log, axis, window_s) for axis in chosen]
-        fits = {}
-        for i, (axis, future) in enumerate(zip(chosen, futures, strict=True)):
-            fits[axis] = future.result()
-            if progress is not None:
-                progress((i + 1) / len(chosen))
-    return Identification(path=log.path, factors=log.factors, rate=log.rate, axes=fits)
+) -> list[Identification]:
+    """Identify m, c, k per axis of each log: a list of `Identification`, one per log, in order.
+
+    logs: a path (CSV or Parquet, with its JSON sidecar), a pandas DataFrame in the log schema, a
+    RigLog, or an iterable of these. axes: the axes to fit (default every axis in the log).
+    load_delay_s: seconds by which the load channel lags the position (default: the sidecar's
+    `load_delay_s`, else 0); it is corrected exactly. progress: called with the fraction done.
+    A log that cannot support a fit, or whose fit is physically impossible, is returned with
+    `ok` False and the reason in `failures`; doubtful fits carry `warnings`.
+
+    Raises:
+        DesignerError: a log cannot be read or validated (names the column and row), axes names an
+            axis not in a log, or load_delay_s is not finite.
+    """
+    sources = [logs] if isinstance(logs, (str, Path, pd.DataFrame, RigLog)) else list(logs)
+    out = []
+    for i, source in enumerate(sources):
+        out.append(identify_log(source, axes=axes, load_delay_s=load_delay_s))
+        if progress is not None:
+            progress((i + 1) / len(sources))
+    return out
 
 
 def results_table(results: list[Identification]) -> pd.DataFrame:
     """The coefficient table `designer fit` reads: factors, c and k per axis, m where identified.
 
-    An axis's m column appears only when m was identified in every log; fit quality (`r2_<axis>`,
-    `nrmse_<axis>`) and the log's path ride along as extra columns.
+    Only logs whose every axis passed (`ok`) become rows. An axis's m column appears only when m
+    was identified in every log; fit quality (`r2_<axis>`, `nrmse_<axis>`) and the log's path ride
+    along as extra columns.
+
+    Raises:
+        DesignerError: a log has no factors, no log passed, or the logs share no axis.
     """
+    results = [r for r in results if r.ok]
+    if not results:
+        raise DesignerError("no log passed identification", "fix or re-record the failed logs")
     rows = []
     for res in results:
         if res.factors is None:

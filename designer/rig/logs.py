@@ -4,7 +4,9 @@ A log has a time column `t` [s], per axis its coordinate (`x y z` [mm], `theta p
 its load (`Fx Fy Fz` [N], `Ttheta Tphi Tpsi` [N.mm]), any subset of axes, and optionally the hub
 angle `hub` [rad]. A column may carry its unit as `x [mm]` or `x_mm`; another unit is rejected.
 The specimen's six factors live in a JSON sidecar beside the log: `run7.csv` -> `run7.json`
-holding `{"factors": {"density": 60, "length": 24, ...}}`.
+holding `{"factors": {"density": 60, "length": 24, ...}}`; the sidecar may also give
+`"load_delay_s"`, how many seconds the load channel lags the position channels (identification
+corrects it).
 """
 
 from __future__ import annotations
@@ -67,6 +69,10 @@ class RigLog:
     axes: list[str]
     #: per axis, True where the coordinate or the load is NaN, stuck at zero, or beside a time gap
     dropouts: dict[str, np.ndarray] = field(default_factory=dict)
+    #: seconds by which the load channels lag the position channels (from the sidecar), if known
+    load_delay_s: float | None = None
+    #: per axis column, the fraction of samples the sensor did not deliver (NaN or stuck at zero)
+    missing_fraction: dict[str, float] = field(default_factory=dict)
 
     @property
     def duration(self) -> float:
@@ -135,6 +141,11 @@ def _runs(mask: np.ndarray, min_len: int) -> np.ndarray:
     return out
 
 
+def missing(values: np.ndarray) -> np.ndarray:
+    """Samples a sensor did not deliver: NaN or infinite, or inside a run stuck at exactly zero."""
+    return ~np.isfinite(values) | _runs(values == 0.0, STUCK_SAMPLES)
+
+
 def _check_factors(factors: dict | None, source: str) -> dict[str, float] | None:
     if factors is None:
         return None
@@ -144,19 +155,28 @@ def _check_factors(factors: dict | None, source: str) -> dict[str, float] | None
         raise DesignerError(f"{source}: {exc.problem}", exc.fix) from None
 
 
-def _read_sidecar(path: Path) -> dict[str, float] | None:
+def _read_sidecar(path: Path) -> tuple[dict[str, float] | None, float | None]:
+    """The sidecar's factors and load delay (s), each None when not given."""
     side = sidecar_path(path)
     if not side.exists():
-        return None
+        return None, None
     try:
         doc = json.loads(side.read_text())
     except (OSError, ValueError) as exc:
         raise DesignerError(f"cannot read {side}: {exc}", 'write it as {"factors": {...}}') from None
+    form = 'write it as {"factors": {"density": 60, ...}, "load_delay_s": 0.002}'
     if isinstance(doc, dict):
         check_keys(doc, SIDECAR_KEYS, where=side.name)
-    if not isinstance(doc, dict) or not isinstance(doc.get("factors"), dict):
-        raise DesignerError(f"{side}: no 'factors' object", 'write it as {"factors": {"density": 60, ...}}')
-    return _check_factors(doc["factors"], side.name)
+    if not isinstance(doc, dict) or not ("factors" in doc or "load_delay_s" in doc):
+        raise DesignerError(f"{side}: neither a 'factors' object nor 'load_delay_s'", form)
+    if "factors" in doc and not isinstance(doc["factors"], dict):
+        raise DesignerError(f"{side}: 'factors' is not an object", form)
+    delay = doc.get("load_delay_s")
+    if delay is not None and (
+        isinstance(delay, bool) or not isinstance(delay, (int, float)) or not np.isfinite(delay)
+    ):
+        raise DesignerError(f"{side}: load_delay_s = {delay!r} is not a number of seconds", form)
+    return _check_factors(doc.get("factors"), side.name), None if delay is None else float(delay)
 
 
 def validate_frame(
@@ -178,9 +198,9 @@ def validate_frame(
     for a in units.AXES:
         have_r, have_f = a in df.columns, LOAD[a] in df.columns
         if have_r != have_f:
-            missing = LOAD[a] if have_r else a
+            absent = LOAD[a] if have_r else a
             raise DesignerError(
-                f"{source}: missing column '{missing}' ({UNITS[missing]}) for axis {a}",
+                f"{source}: missing column '{absent}' ({UNITS[absent]}) for axis {a}",
                 f"give both {a} and {LOAD[a]}, or neither",
             )
         if have_r:
@@ -233,17 +253,18 @@ def validate_frame(
     gap_rows = np.zeros(len(t), dtype=bool)
     gap_rows[1:] |= gaps
     gap_rows[:-1] |= gaps
-    dropouts = {}
+    dropouts, fractions = {}, {}
     for a in axes:
         flagged = gap_rows.copy()
         for col in (a, LOAD[a]):
             v = cols[col]
-            nan = ~np.isfinite(v)
-            if nan.all():
+            if not np.isfinite(v).any():
                 raise DesignerError(
                     f"{source}: column '{col}' is all NaN", f"drop axis {a} or fix the sensor"
                 )
-            flagged |= nan | _runs(v == 0.0, STUCK_SAMPLES)
+            absent = missing(v)
+            fractions[col] = float(absent.mean())
+            flagged |= absent
         if flagged.all():
             raise DesignerError(
                 f"{source}: axis {a} ('{a}', '{LOAD[a]}') has no valid samples (all NaN or stuck at zero)",
@@ -259,11 +280,15 @@ def validate_frame(
         rate=1.0 / step,
         axes=axes,
         dropouts=dropouts,
+        missing_fraction=fractions,
     )
 
 
 def _read_frame(p: Path) -> pd.DataFrame:
-    """The file's columns read by pyarrow, as a frame sharing its arrays (no consolidating copy)."""
+    """The file's columns read by pyarrow, one block per column (no consolidating copy).
+
+    `self_destruct` frees each Arrow column as it is converted, so the peak holds one copy.
+    """
     import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
 
@@ -271,10 +296,7 @@ def _read_frame(p: Path) -> pd.DataFrame:
 
     check_table_file(p, parquet=is_parquet(p))
     table = pq.read_table(p) if is_parquet(p) else pacsv.read_csv(p)
-    if len(set(table.column_names)) < table.num_columns:
-        return table.to_pandas()
-    columns = (col.to_numpy(zero_copy_only=False) for col in table.columns)
-    return pd.DataFrame(dict(zip(table.column_names, columns, strict=True)), copy=False)
+    return table.to_pandas(split_blocks=True, self_destruct=True)
 
 
 def read_log(path: str | Path) -> RigLog:
@@ -289,7 +311,10 @@ def read_log(path: str | Path) -> RigLog:
     except (ValueError, OSError, pd.errors.ParserError, UnicodeDecodeError) as exc:
         first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise DesignerError(f"cannot read {p}: {first}", "give a CSV or Parquet rig log") from None
-    return validate_frame(raw, source=p.name, factors=_read_sidecar(p), path=p)
+    factors, delay = _read_sidecar(p)
+    log = validate_frame(raw, source=p.name, factors=factors, path=p)
+    log.load_delay_s = delay
+    return log
 
 
 def write_log(df: pd.DataFrame, path: str | Path, factors: dict | None = None) -> Path:

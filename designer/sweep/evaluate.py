@@ -76,7 +76,10 @@ def rig_identification(sc: Scenario, *, fmus: dict[str, Path], case: Case) -> di
     params = dict(src.parameters) | {f"{src.axis}.{q}": v for q, v in si_law(src, true).items()}
     joint = JointSource(axis=src.axis, fmu=fmus["rig"], fmi_version=src.fmi_version, parameters=params)
     log = validate_frame(rig_log(run(replace(sc, rig_joint=joint))), f"virtual rig log of case {case.index}")
-    fit = identify(log).axes[src.axis]
+    res = identify(log)[0]
+    if src.axis in res.failures:
+        raise DesignerError(f"case {case.index}: the rig log failed identification: {res.failures[src.axis]}")
+    fit = res.axes[src.axis]
     values = (fit.k, fit.c, 100 * (fit.k / true["k"] - 1), 100 * (fit.c / true["c"] - 1), fit.r2)
     return {"rig": dict(zip(RIG_METRICS, map(float, values), strict=True))}
 

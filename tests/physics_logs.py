@@ -1,0 +1,126 @@
+"""Rig logs written from the physics, independently of `designer` (no code shared with it).
+
+The study's rig imposes a linear chirp on the specimen: r(t) = A sin(phi(t)) with
+phi = 2 pi (f0 t + (f1 - f0) t^2 / (2 T)). The load on the specimen is whatever its equation of
+motion needs, F = m r'' + c r' + k r (+ k3 r^3 for a stiffening spring, + the force of a Maxwell
+arm k2, tau for viscoelastic, frequency-dependent damping, integrated as an ODE). With
+`servo`, the motion is not imposed but comes from the hub pulling the specimen through a stiff
+spring and damper, solved as an ODE. The sensors then add what real rigs add: white noise on
+position and load, offsets and linear drift, timestamps with jitter, a delay of the load channel,
+and dropouts (both channels NaN, or the load stuck at zero).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+from scipy.signal import lsim
+
+LOADS = {"x": "Fx", "y": "Fy", "z": "Fz", "theta": "Ttheta", "phi": "Tphi", "psi": "Tpsi"}
+#: kg (kg.m^2) -> the log's inertia coefficient: N per mm/s^2 is 1000 kg, N.mm per rad/s^2 1e-3 kg.m^2
+INERTIA = {"x": 1e-3, "y": 1e-3, "z": 1e-3, "theta": 1e3, "phi": 1e3, "psi": 1e3}
+
+
+def sweep(t, f0: float, f1: float, T: float, amplitude: float):
+    """The imposed chirp and its first two time derivatives (closed form)."""
+    rate = (f1 - f0) / T  # Hz per second
+    angle = 2.0 * np.pi * (f0 * t + 0.5 * rate * t * t)
+    speed = 2.0 * np.pi * (f0 + rate * t)  # d angle / dt
+    r = amplitude * np.sin(angle)
+    dr = amplitude * speed * np.cos(angle)
+    ddr = amplitude * (2.0 * np.pi * rate * np.cos(angle) - speed * speed * np.sin(angle))
+    return r, dr, ddr
+
+
+def _maxwell(t, dr: np.ndarray, k2: float, tau: float) -> np.ndarray:
+    """Force of a spring k2 in series with a damper k2 tau, driven by the deflection rate r'(t).
+
+    f' = k2 r' - f / tau, integrated exactly for r' linear between samples (scipy's lsim).
+    """
+    system = ([[-1.0 / tau]], [[k2]], [[1.0]], [[0.0]])
+    return lsim(system, dr, t)[1]
+
+
+def _servo(t, spec: dict, f0: float, f1: float, T: float, m: float) -> tuple[np.ndarray, np.ndarray]:
+    """Specimen pulled by the hub through stiffness K = 20 k and damping C: returns r(t), F(t).
+
+    m r'' + c r' + k r = K (q - r) + C (q' - r'), a linear ODE driven by the hub's q and q',
+    integrated exactly for inputs linear between samples (scipy's lsim).
+    """
+    c, k, A = spec["c"], spec["k"], spec["amplitude"]
+    big_k = 20.0 * k
+    big_c = 2.0 * np.sqrt(big_k * m)
+    a = [[0.0, 1.0], [-(k + big_k) / m, -(c + big_c) / m]]
+    b = [[0.0, 0.0], [big_k / m, big_c / m]]
+    q, dq, _ = sweep(t, f0, f1, T, A)
+    _, _, state = lsim((a, b, np.eye(2), np.zeros((2, 2))), np.column_stack([q, dq]), t)
+    r, dr = state.T
+    return r, big_k * (q - r) + big_c * (dq - dr)
+
+
+def _load(t, spec: dict, f0: float, f1: float, T: float, axis: str) -> tuple[np.ndarray, np.ndarray]:
+    """True position and load at the sampling instants t (the load at t - skew comes separately)."""
+    m = spec.get("m", 0.0) * INERTIA[axis]
+    if spec.get("servo"):
+        return _servo(t, spec, f0, f1, T, m)
+    r, dr, ddr = sweep(t, f0, f1, T, spec["amplitude"])
+    load = m * ddr + spec["c"] * dr + spec["k"] * r + spec.get("k3", 0.0) * r**3
+    if "maxwell" in spec:
+        k2, tau = spec["maxwell"]
+        load = load + _maxwell(t, dr, k2, tau)
+    return r, load
+
+
+def make_log(
+    axes: dict[str, dict],
+    *,
+    duration: float,
+    rate: float,
+    f0: float = 0.2,
+    f1: float = 1.85,
+    position_noise: float = 0.002,
+    load_noise: float = 0.02,
+    skew_s: float = 0.0,
+    jitter: float = 0.0,
+    dropouts: float = 0.0,
+    offsets: bool = False,
+    time_scale: float = 1.0,
+    seed: int = 0,
+) -> pd.DataFrame:
+    """A log in the rig schema (t [s], coordinates mm or rad, loads N or N.mm).
+
+    axes: {axis: {"k", "c", "m" (kg or kg.m^2), "amplitude", optional "k3", "maxwell": (k2, tau),
+    "servo": True}}
+    in rig units. position_noise: white noise as a fraction of the amplitude; load_noise: as a
+    fraction of the load's RMS. skew_s: the load channel lags by this much. jitter: sampling
+    instants move by up to this fraction of the interval. dropouts: fraction of samples in 40 ms
+    segments, alternately NaN in both channels and the load stuck at zero. offsets: add sensor
+    offsets and linear drift. time_scale: multiplies the t column (1e9 writes nanoseconds).
+    """
+    rng = np.random.default_rng(seed)
+    n = int(round(duration * rate)) + 1
+    t = np.arange(n) / rate
+    if jitter:
+        t = t + rng.uniform(-jitter / 2, jitter / 2, n) / rate
+        t[0] = 0.0
+    cols = {"t": t * time_scale}
+    seg = max(int(0.04 * rate), 6)
+    starts = rng.integers(0, n - seg, size=int(round(dropouts * n / seg)))
+    for axis, spec in axes.items():
+        r, load = _load(t, spec, f0, f1, duration, axis)
+        if skew_s:
+            load = _load(np.clip(t - skew_s, 0.0, None), spec, f0, f1, duration, axis)[1]
+        r = r + position_noise * spec["amplitude"] * rng.standard_normal(n)
+        load = load + load_noise * np.sqrt(np.mean(load**2)) * rng.standard_normal(n)
+        if offsets:
+            r = r + 0.05 * spec["amplitude"] + 0.01 * spec["amplitude"] * t / duration
+            rms = np.sqrt(np.mean(load**2))
+            load = load - 0.1 * rms + 0.03 * rms * t / duration
+        for i, s in enumerate(starts):
+            if i % 2:
+                load[s : s + seg] = 0.0
+            else:
+                r[s : s + seg] = np.nan
+                load[s : s + seg] = np.nan
+        cols[axis], cols[LOADS[axis]] = r, load
+    return pd.DataFrame(cols)
