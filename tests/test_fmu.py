@@ -27,12 +27,8 @@ S, V, FV = value_reference("x", "s"), value_reference("x", "v"), value_reference
 
 
 @pytest.fixture(scope="module", autouse=True)
-def cache(tmp_path_factory):
-    """Build into a throw-away cache, never the user's."""
-    mp = pytest.MonkeyPatch()
-    mp.setenv("XDG_CACHE_HOME", str(tmp_path_factory.mktemp("cache")))
-    yield
-    mp.undo()
+def cache(fmu_cache):
+    """Every test here builds into a throw-away cache."""
 
 
 @pytest.fixture(scope="module")

@@ -25,11 +25,8 @@ VR = {f: value_reference("x", f) for f in ("m", "c", "k", "offset", "enabled", "
 
 
 @pytest.fixture(scope="module", autouse=True)
-def cache(tmp_path_factory):
-    mp = pytest.MonkeyPatch()
-    mp.setenv("XDG_CACHE_HOME", str(tmp_path_factory.mktemp("cache")))
-    yield
-    mp.undo()
+def cache(fmu_cache):
+    """Every test here builds into a throw-away cache."""
 
 
 @pytest.fixture(scope="module")

@@ -15,21 +15,18 @@ import sys
 from pathlib import Path
 
 from ..errors import DesignerError
+from ..export.build import FLAGS as BUILD_FLAGS
 from ..export.build import cache_dir, compile_c, find_compiler, source_dir
 from ..files import atomic_path
 
-#: -ffp-contract=off and no sin/cos builtins: the arithmetic of the Python master, bit for bit
+#: the FMU binary's flags, plus -ffp-contract=off and no sin/cos builtins: the arithmetic of the
+#: Python master, bit for bit
 FLAGS: tuple[str, ...] = (
-    "-std=gnu99",
-    "-O2",
-    "-fPIC",
-    "-shared",
-    "-fvisibility=hidden",
+    *BUILD_FLAGS,
     "-ffp-contract=off",
     "-fno-builtin-sin",
     "-fno-builtin-cos",
     "-pthread",
-    "-Werror=implicit-function-declaration",
 )
 SOURCES = ("kernel/master.c", "kernel/systems.c", "kernel/references.c")
 HEADERS = (

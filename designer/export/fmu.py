@@ -98,40 +98,14 @@ def _parameter_variables(a: str, ac: AxisCoefficients) -> list[Variable]:
     def var(field: str, *args, **kw) -> Variable:
         return _var(a, field, *args, **kw)
 
-    if si["m"] is not None:
-        out.append(
-            var(
-                "m",
-                "Real",
-                "parameter",
-                "tunable",
-                f"{'inertia' if rot else 'mass'} on {a}; {ac.origin}",
-                si["m"],
-                units.si_unit("m", a),
-            )
-        )
-    out.append(
-        var(
-            "c",
-            "Real",
-            "parameter",
-            "tunable",
-            f"damping on {a}; {ac.origin}" + _pi_text(ac, "c"),
-            si["c"],
-            units.si_unit("c", a),
-        )
-    )
-    out.append(
-        var(
-            "k",
-            "Real",
-            "parameter",
-            "tunable",
-            f"stiffness on {a}; {ac.origin}" + _pi_text(ac, "k"),
-            si["k"],
-            units.si_unit("k", a),
-        )
-    )
+    what = {
+        "m": f"{'inertia' if rot else 'mass'} on {a}; {ac.origin}",
+        "c": f"damping on {a}; {ac.origin}" + _pi_text(ac, "c"),
+        "k": f"stiffness on {a}; {ac.origin}" + _pi_text(ac, "k"),
+    }
+    for q, text in what.items():
+        if si[q] is not None:
+            out.append(var(q, "Real", "parameter", "tunable", text, si[q], units.si_unit(q, a)))
     r = units.si_unit("r", a)
     out.append(var("offset", "Real", "parameter", "tunable", f"rest position on {a}", 0.0, r))
     out.append(var("enabled", "Boolean", "parameter", "tunable", f"spring-damper on {a} active", True))

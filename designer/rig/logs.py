@@ -183,6 +183,31 @@ def validate_frame(
     raw: pd.DataFrame, source: str = "log", factors: dict | None = None, path: Path | None = None
 ) -> RigLog:
     """Check a log's columns, time and units, flag dropouts; raise DesignerError naming column and row."""
+    df, axes = _columns(raw, source)
+    cols = _numbers(df, source)
+    t = cols["t"]
+    step, gaps = _time_step(t, source)
+    gap_rows = np.zeros(len(t), dtype=bool)
+    gap_rows[1:] |= gaps
+    gap_rows[:-1] |= gaps
+    dropouts, fractions = {}, {}
+    for a in axes:
+        dropouts[a] = _dropouts(cols, a, gap_rows, fractions, source)
+    order = ["t"] + [c for a in axes for c in (a, LOAD[a])] + (["hub"] if "hub" in cols else [])
+    return RigLog(
+        # one block per column, sharing the arrays: no consolidating copy of a long log
+        data=pd.DataFrame({c: cols[c] for c in order}, copy=False),
+        path=path,
+        factors=_check_factors(factors, source),
+        rate=1.0 / step,
+        axes=axes,
+        dropouts=dropouts,
+        missing_fraction=fractions,
+    )
+
+
+def _columns(raw: pd.DataFrame, source: str) -> tuple[pd.DataFrame, list[str]]:
+    """The log's known columns under their canonical names, and the axes that have both r and load."""
     mapping: dict[str, str] = {}
     for col in raw.columns:
         name = _canonical(col, source)
@@ -212,6 +237,11 @@ def validate_frame(
         )
     if len(df) < 3:
         raise DesignerError(f"{source}: only {len(df)} rows", "a rig log needs a time series")
+    return df, axes
+
+
+def _numbers(df: pd.DataFrame, source: str) -> dict[str, np.ndarray]:
+    """Every column as float64; a cell that is text and not a number is an error naming its row."""
     cols = {}
     for col in df.columns:
         values = df[col]
@@ -226,7 +256,11 @@ def validate_frame(
                 )
             values = numeric
         cols[col] = values.to_numpy(dtype=np.float64)
-    t = cols["t"]
+    return cols
+
+
+def _time_step(t: np.ndarray, source: str) -> tuple[float, np.ndarray]:
+    """The sample interval (median) and the gaps; time must be finite, increasing and regular."""
     if not np.isfinite(t).all():
         raise DesignerError(
             f"{source}: column 't' row {_first_bad_row(~np.isfinite(t))} is empty or not finite",
@@ -250,38 +284,27 @@ def validate_frame(
             f"(interval {dt[row - 2]:g} s against {step:g} s)",
             "resample the log to a constant rate",
         )
-    gap_rows = np.zeros(len(t), dtype=bool)
-    gap_rows[1:] |= gaps
-    gap_rows[:-1] |= gaps
-    dropouts, fractions = {}, {}
-    for a in axes:
-        flagged = gap_rows.copy()
-        for col in (a, LOAD[a]):
-            v = cols[col]
-            if not np.isfinite(v).any():
-                raise DesignerError(
-                    f"{source}: column '{col}' is all NaN", f"drop axis {a} or fix the sensor"
-                )
-            absent = missing(v)
-            fractions[col] = float(absent.mean())
-            flagged |= absent
-        if flagged.all():
-            raise DesignerError(
-                f"{source}: axis {a} ('{a}', '{LOAD[a]}') has no valid samples (all NaN or stuck at zero)",
-                f"drop axis {a} or fix the sensor",
-            )
-        dropouts[a] = flagged
-    order = ["t"] + [c for a in axes for c in (a, LOAD[a])] + (["hub"] if "hub" in cols else [])
-    return RigLog(
-        # one block per column, sharing the arrays: no consolidating copy of a long log
-        data=pd.DataFrame({c: cols[c] for c in order}, copy=False),
-        path=path,
-        factors=_check_factors(factors, source),
-        rate=1.0 / step,
-        axes=axes,
-        dropouts=dropouts,
-        missing_fraction=fractions,
-    )
+    return step, gaps
+
+
+def _dropouts(
+    cols: dict[str, np.ndarray], a: str, gap_rows: np.ndarray, fractions: dict[str, float], source: str
+) -> np.ndarray:
+    """Rows of axis `a` to leave out (gaps, empty or stuck samples); records each column's missing share."""
+    flagged = gap_rows.copy()
+    for col in (a, LOAD[a]):
+        v = cols[col]
+        if not np.isfinite(v).any():
+            raise DesignerError(f"{source}: column '{col}' is all NaN", f"drop axis {a} or fix the sensor")
+        absent = missing(v)
+        fractions[col] = float(absent.mean())
+        flagged |= absent
+    if flagged.all():
+        raise DesignerError(
+            f"{source}: axis {a} ('{a}', '{LOAD[a]}') has no valid samples (all NaN or stuck at zero)",
+            f"drop axis {a} or fix the sensor",
+        )
+    return flagged
 
 
 def _read_frame(p: Path) -> pd.DataFrame:
