@@ -1,10 +1,17 @@
-"""Checking the keys of a user's table (TOML, JSON): unknown keys are named with the closest valid one."""
+"""Users' tables (TOML, JSON): reading a TOML file, and unknown keys named with the closest valid one."""
 
 from __future__ import annotations
 
 import difflib
+import sys
 from collections.abc import Iterable, Mapping
+from pathlib import Path
 from typing import Any
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:
+    import tomli as tomllib
 
 from .errors import DesignerError
 
@@ -24,3 +31,18 @@ def check_keys(table: Mapping[str, Any], allowed: Iterable[str], *, where: str) 
         close = difflib.get_close_matches(str(key), allowed, n=1, cutoff=0.6)
         hint = f"did you mean '{close[0]}'?" if close else f"valid keys: {', '.join(allowed)}"
         raise DesignerError(f"unknown key '{key}' in {where}", hint)
+
+
+def read_toml(path: str | Path, *, what: str) -> tuple[Path, dict[str, Any]]:
+    """The absolute path and the contents of the TOML file `path`, a `what` ("scenario", "sweep").
+
+    Raises:
+        DesignerError: the file does not exist or is not valid TOML.
+    """
+    path = Path(path).resolve()
+    if not path.is_file():
+        raise DesignerError(f"{what} file {path} does not exist", f"give the path of a .toml {what} file")
+    try:
+        return path, tomllib.loads(path.read_text())
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise DesignerError(f"{path.name} is not valid TOML: {exc}", "fix the syntax") from None

@@ -9,21 +9,15 @@ keys and types and names the file and key of the first problem. The README docum
 from __future__ import annotations
 
 import math
-import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:
-    import tomli as tomllib
-
 from .. import units
 from ..errors import DesignerError
 from ..joint import Joint, from_one_source
-from ..keys import check_keys
+from ..keys import check_keys, read_toml
 from .master import ALGORITHMS
 from .references import Chirp, Reference, Sine, Step, Trajectory
 from .robot import ARM_LENGTHS, ARM_MASSES, INTEGRATORS
@@ -319,13 +313,7 @@ def load(path: str | Path) -> Scenario:
         DesignerError: a missing or malformed file, an unknown key (with the closest valid one), a
             value of the wrong type or out of range, naming the file and the key.
     """
-    path = Path(path).resolve()
-    if not path.is_file():
-        raise DesignerError(f"scenario {path} does not exist", "give the path of a .toml scenario file")
-    try:
-        doc = tomllib.loads(path.read_text())
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise DesignerError(f"{path.name} is not valid TOML: {exc}", "fix the syntax") from None
+    path, doc = read_toml(path, what="scenario")
     d = _Doc(path)
     check_keys(doc, KEYS[""], where=path.name)
     sim = d.table(doc, "simulation", "simulation", required=True)

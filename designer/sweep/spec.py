@@ -8,20 +8,15 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:
-    import tomli as tomllib
-
 from ..cosim.scenario import Scenario
 from ..errors import DesignerError
+from ..keys import read_toml
 from .limits import Limit, parse_limit
 
 CASE_TYPES = ("grid", "suggestion", "montecarlo")
@@ -177,13 +172,7 @@ def load(path: str | Path) -> Spec:
     """Read and check a sweep file and its scenario; every problem raises a DesignerError."""
     from .. import cosim
 
-    path = Path(path).resolve()
-    if not path.is_file():
-        raise DesignerError(f"sweep file {path} does not exist", "give the path of a .toml sweep file")
-    try:
-        doc = tomllib.loads(path.read_text())
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise DesignerError(f"{path.name} is not valid TOML: {exc}", "fix the syntax") from None
+    path, doc = read_toml(path, what="sweep")
     if not isinstance(doc.get("scenario"), str):
         raise DesignerError(f"{path.name} names no scenario", 'add scenario = "arm.toml" at the top')
     scenario = cosim.load((path.parent / doc["scenario"]).resolve())
