@@ -61,36 +61,12 @@ def fit(
     sur = Surrogate().fit(table)
     if out is not None:
         sur.save(out)
-    report = {
-        "surrogate_id": sur.id,
-        "table_hash": sur.table_hash,
-        "n_runs": len(table),
-        "out": str(out) if out else None,
-        "responses": {r: _fit_report(sur, m) for r, m in sur.models.items()},
-    }
+    report = sur.report() | {"out": str(out) if out else None}
     if as_json:
         print_json(report)
         return
     _print_fit(report, len(table))
     console.print(f"surrogate id {sur.id}" + (f", written to {out}" if out else " (not saved: give -o FILE)"))
-
-
-def _fit_report(sur, m) -> dict:
-    """One response's part of `fit --json`: nested figures first, the chosen form's own LOO labelled."""
-    runs = sur.training["run"]
-    return {
-        "form": m.form,
-        "unit": m.unit,
-        "alpha": m.alpha,
-        "predictable": m.predictable,
-        "loo_nested": m.loo_nested,
-        "loo": m.loo,
-        "loo_label": "the selected form's own leave-one-out (optimistic: the form was chosen on these "
-        "errors); loo_nested repeats the whole selection without each run",
-        "influence": [d | {"run": int(runs[d["row"]])} for d in m.influence],
-        "lack_of_fit": m.lack_of_fit,
-        "candidates": m.candidates,
-    }
 
 
 def _print_fit(report: dict, n_runs: int) -> None:

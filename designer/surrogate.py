@@ -728,6 +728,32 @@ class Surrogate:
         }
         return json.dumps(payload, indent=1)
 
+    def report(self) -> dict[str, Any]:
+        """What the fit found, as plain data: per response its form, nested and own leave-one-out
+        accuracy (labelled), influential runs, lack of fit where the table has replicates."""
+        runs = self.training["run"]
+        return {
+            "surrogate_id": self.id,
+            "table_hash": self.table_hash,
+            "n_runs": len(runs),
+            "responses": {
+                r: {
+                    "form": m.form,
+                    "unit": m.unit,
+                    "alpha": m.alpha,
+                    "predictable": m.predictable,
+                    "loo_nested": m.loo_nested,
+                    "loo": m.loo,
+                    "loo_label": "the selected form's own leave-one-out (optimistic: the form was chosen on "
+                    "these errors); loo_nested repeats the whole selection without each run",
+                    "influence": [d | {"run": int(runs[d["row"]])} for d in m.influence],
+                    "lack_of_fit": m.lack_of_fit,
+                    "candidates": m.candidates,
+                }
+                for r, m in self.models.items()
+            },
+        }
+
     def save(self, path: str | Path) -> Path:
         with atomic_write(path) as fh:
             fh.write(self._payload_json() + "\n")
