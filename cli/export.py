@@ -200,47 +200,18 @@ AXIS_PICK = _option(
 )
 
 
-def _mjcf(
-    joint: Joint,
-    output: Path,
-    _from: Source,
-    *,
-    into: Path | None,
-    joint_name: str | None,
-    rest: float,
-    axis_pick: str | None,
-    form: str,
-    motor_inertia: float | None,
-    motor_bandwidth: float | None,
-):
+def _mjcf(joint: Joint, output: Path, _from: Source, *, axis_pick: str | None, **options):
+    """MJCF standalone or --into a robot; the CLI's --use-axis is the writer's `axis`."""
     from designer.export.mjcf import export_mjcf
 
-    return export_mjcf(
-        joint,
-        output,
-        into=into,
-        joint_name=joint_name,
-        axis=axis_pick,
-        form=form,
-        rest=rest,
-        motor_inertia=motor_inertia,
-        motor_bandwidth=motor_bandwidth,
-    )
+    return export_mjcf(joint, output, axis=axis_pick, **options)
 
 
-def _urdf(
-    joint: Joint,
-    output: Path,
-    _from: Source,
-    *,
-    into: Path | None,
-    joint_name: str | None,
-    rest: float,
-    axis_pick: str | None,
-):
+def _urdf(joint: Joint, output: Path, _from: Source, *, axis_pick: str | None, **options):
+    """URDF standalone or --into a robot; the CLI's --use-axis is the writer's `axis`."""
     from designer.export.urdf import export_urdf
 
-    return export_urdf(joint, output, into=into, joint_name=joint_name, axis=axis_pick, rest=rest)
+    return export_urdf(joint, output, axis=axis_pick, **options)
 
 
 def _sdf(joint: Joint, output: Path, _from: Source):
