@@ -1,0 +1,187 @@
+"""Simulated printers with a known truth, written independently of `designer` (no code shared with it).
+
+A printed joint's stiffness and damping along x are smooth functions of the six print settings; a
+user's printer and spool multiply the study's by unknown factors; every print scatters around its
+printer's truth. This module is the reference the design loop (calibrate, next prints, suggest) is
+measured against, so it imports nothing from `designer` and reads the study's table as a plain CSV.
+
+The truth:
+- The section's effective solid fraction carries the infill: the perimeter is two 0.8 mm walls, and a
+  core of 0.4 mm or less is one extrusion line, so a width or height of 2.0 mm or less is solid
+  whatever the nominal infill:
+  ``phi = 1 - (1 - density) * core_b * core_h / (b * h)`` with ``core = side - 1.6 mm`` when both
+  cores exceed 0.4 mm, else ``phi = 1``.
+- log k and log c are thin-plate-spline smoothers (scipy's RBFInterpolator with a linear trend) of
+  the study's 44 measured runs over (phi, length, width, height, layer, raster) scaled to [0, 1]:
+  the study's measurements, smoothed. No response-surface form of the tool is used. The smoothing
+  of c is heavy (the study cannot predict c from the factors; its truth varies mildly around the
+  study's mean).
+- A printer multiplies k by ``factor_k`` and c by ``factor_c``, each drawn uniformly in 0.6-1.5.
+- A print scatters log-normally around its printer's truth: 2.5 % for k and for c (the study's
+  replicate pair, runs 28 and 35, differs by 2.5 % in k).
+
+API (designs are mappings or DataFrames with the columns ``FACTORS``, in the study's units: density %,
+length/width/height mm, layer mm, raster deg):
+- ``Truth()``: ``k(designs)`` N/mm, ``c(designs)`` N.s/mm, ``solid_fraction(designs)`` (arrays).
+- ``Printer(seed)``: ``factor_k``, ``factor_c``, ``k(designs)``, ``c(designs)`` (its truth),
+  ``prints(designs, rng)`` -> a coefficient table (``density_pct, length_mm, width_mm, height_mm,
+  layer_mm, raster_deg, k_x_N_per_mm, c_x_Ns_per_mm``), one row per print.
+- ``printers(n, seed=0)``: n printers with independent factors.
+- ``Printer.best(k=..., c=..., fixed=..., tolerance=0.1)``: the best true design on a dense printable
+  grid and whether the target is reachable (every given target within tolerance in truth).
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Mapping
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy.interpolate import RBFInterpolator
+
+FACTORS = ("density", "length", "width", "height", "layer", "raster")
+COLUMNS = {
+    "density": "density_pct",
+    "length": "length_mm",
+    "width": "width_mm",
+    "height": "height_mm",
+    "layer": "layer_mm",
+    "raster": "raster_deg",
+}
+RANGES = {"density": (20.0, 100.0), "length": (18.0, 30.0), "width": (2.0, 7.0), "height": (4.0, 14.0)}
+LEVELS = {"layer": (0.12, 0.16, 0.2), "raster": (0.0, 45.0)}
+WALL_MM = 0.8
+LINE_MM = 0.4
+PRINTER_FACTORS = (0.6, 1.5)
+PRINT_NOISE = 0.025
+STUDY = Path(__file__).resolve().parents[1] / "designer" / "bundled" / "study_table3_x.csv"
+# smoothing of the splines on the scaled log data (chosen by eye: k keeps the study's structure
+# without chasing single runs; c stays within about +-25 % of the study's mean)
+SMOOTHING_K = 0.5
+SMOOTHING_C = 50.0
+
+
+def _frame(designs) -> pd.DataFrame:
+    """Designs as a DataFrame with the short factor names (accepts mappings, lists, DataFrames)."""
+    if isinstance(designs, Mapping):
+        designs = pd.DataFrame({f: np.atleast_1d(designs[f]) for f in FACTORS})
+    elif not isinstance(designs, pd.DataFrame):
+        designs = pd.DataFrame(list(designs))
+    renamed = designs.rename(columns={v: k for k, v in COLUMNS.items()})
+    return renamed.loc[:, list(FACTORS)].astype(float)
+
+
+def solid_fraction(designs) -> np.ndarray:
+    """Share of the b x h section that is plastic: walls, single-line cores and infill."""
+    d = _frame(designs)
+    b, h = d["width"].to_numpy(), d["height"].to_numpy()
+    core_b, core_h = b - 2 * WALL_MM, h - 2 * WALL_MM
+    hollow = (core_b > LINE_MM) & (core_h > LINE_MM)
+    rho = d["density"].to_numpy() / 100.0
+    core = np.where(hollow, np.clip(core_b, 0, None) * np.clip(core_h, 0, None), 0.0)
+    return 1.0 - (1.0 - rho) * core / (b * h)
+
+
+def _coordinates(designs) -> np.ndarray:
+    """(n, 6) spline coordinates: solid fraction and the other five settings scaled to [0, 1]."""
+    d = _frame(designs)
+    cols = [solid_fraction(d)]
+    for name in ("length", "width", "height"):
+        lo, hi = RANGES[name]
+        cols.append((d[name].to_numpy() - lo) / (hi - lo))
+    cols.append((d["layer"].to_numpy() - 0.12) / 0.08)
+    cols.append(d["raster"].to_numpy() / 45.0)
+    return np.column_stack(cols)
+
+
+@lru_cache(maxsize=1)
+def _splines() -> tuple[RBFInterpolator, RBFInterpolator]:
+    study = pd.read_csv(STUDY)
+    x = _coordinates(study)
+    log_k = np.log(study["k_x_N_per_mm"].to_numpy())
+    log_c = np.log(study["c_x_Ns_per_mm"].to_numpy())
+    fit = {"kernel": "thin_plate_spline", "degree": 1}
+    return (
+        RBFInterpolator(x, log_k, smoothing=SMOOTHING_K, **fit),
+        RBFInterpolator(x, log_c, smoothing=SMOOTHING_C, **fit),
+    )
+
+
+class Truth:
+    """The study printer's true mean k (N/mm) and c (N.s/mm) at any design in the printable box."""
+
+    def k(self, designs) -> np.ndarray:
+        return np.exp(_splines()[0](_coordinates(designs)))
+
+    def c(self, designs) -> np.ndarray:
+        return np.exp(_splines()[1](_coordinates(designs)))
+
+    solid_fraction = staticmethod(solid_fraction)
+
+
+def grid(fixed: Mapping[str, float] | None = None, points: int = 9) -> pd.DataFrame:
+    """A dense printable grid: `points` values per continuous factor, the study's levels, `fixed` held."""
+    fixed = dict(fixed or {})
+    axes = []
+    for name in FACTORS:
+        if name in fixed:
+            axes.append([float(fixed[name])])
+        elif name in LEVELS:
+            axes.append(list(LEVELS[name]))
+        else:
+            axes.append(list(np.linspace(*RANGES[name], points)))
+    return pd.DataFrame(list(itertools.product(*axes)), columns=list(FACTORS))
+
+
+class Printer:
+    """One user's printer and spool: the study's truth times its own factors, and its print scatter."""
+
+    def __init__(self, seed: int, *, noise: float = PRINT_NOISE):
+        rng = np.random.default_rng(seed)
+        self.seed = seed
+        self.factor_k, self.factor_c = rng.uniform(*PRINTER_FACTORS, size=2)
+        self.noise = noise
+        self._truth = Truth()
+
+    def k(self, designs) -> np.ndarray:
+        return self.factor_k * self._truth.k(designs)
+
+    def c(self, designs) -> np.ndarray:
+        return self.factor_c * self._truth.c(designs)
+
+    def prints(self, designs, rng: np.random.Generator) -> pd.DataFrame:
+        """Print and measure each design once: a coefficient table in the study's column names."""
+        d = _frame(designs)
+        n = len(d)
+        table = d.rename(columns=COLUMNS)
+        table["k_x_N_per_mm"] = self.k(d) * np.exp(rng.normal(0.0, self.noise, n))
+        table["c_x_Ns_per_mm"] = self.c(d) * np.exp(rng.normal(0.0, self.noise, n))
+        return table.reset_index(drop=True)
+
+    def best(
+        self,
+        *,
+        k: float | None = None,
+        c: float | None = None,
+        fixed: Mapping[str, float] | None = None,
+        tolerance: float = 0.1,
+        points: int = 9,
+    ) -> tuple[dict[str, float], bool]:
+        """The grid design closest to the targets in truth (largest relative miss smallest), and
+        whether every given target is within `tolerance` there (the target is reachable)."""
+        g = grid(fixed, points)
+        miss = np.zeros(len(g))
+        if k is not None:
+            miss = np.maximum(miss, np.abs(self.k(g) / k - 1.0))
+        if c is not None:
+            miss = np.maximum(miss, np.abs(self.c(g) / c - 1.0))
+        i = int(np.argmin(miss))
+        return {f: float(g.iloc[i][f]) for f in FACTORS}, bool(miss[i] <= tolerance)
+
+
+def printers(n: int, seed: int = 0) -> list[Printer]:
+    """`n` printers with independent factors (seeds seed, seed + 1, ...)."""
+    return [Printer(seed + i) for i in range(n)]

@@ -1,0 +1,66 @@
+"""The simulated printers (tests/printers.py) are a reference independent of `designer`."""
+
+import ast
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+sys.path.insert(0, str(Path(__file__).parent))
+import printers  # noqa: E402
+
+
+def test_imports_nothing_from_designer():
+    tree = ast.parse(Path(printers.__file__).read_text())
+    names = [a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names]
+    names += [n.module or "" for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)]
+    assert not [n for n in names if n.split(".")[0] == "designer"]
+
+
+def test_solid_section_ignores_infill():
+    # width 2.0 mm = two 0.8 mm walls + one 0.4 mm line: solid at any infill
+    d = pd.DataFrame(
+        {
+            "density": [20.0, 60.0, 100.0],
+            "length": 24.0,
+            "width": 2.0,
+            "height": 9.0,
+            "layer": 0.16,
+            "raster": 0.0,
+        }
+    )
+    assert np.allclose(printers.solid_fraction(d), 1.0)
+    k = printers.Truth().k(d)
+    assert np.ptp(k) < 1e-12 * k.max()
+    # a hollow section: 4.5 x 9 mm at 20 % has a 2.9 x 7.4 mm core, 80 % of it empty
+    hollow = d.assign(width=4.5, density=20.0).iloc[:1]
+    assert np.isclose(printers.solid_fraction(hollow)[0], 1 - 0.8 * 2.9 * 7.4 / (4.5 * 9))
+
+
+def test_truth_follows_the_study_within_its_scatter():
+    study = pd.read_csv(printers.STUDY)
+    log_ratio = np.log(printers.Truth().k(study) / study["k_x_N_per_mm"])
+    assert abs(log_ratio.mean()) < 0.05 and log_ratio.std() < 0.15
+    c = printers.Truth().c(printers.grid(points=5))
+    assert 0.4 < c.min() / study["c_x_Ns_per_mm"].mean() and c.max() / study["c_x_Ns_per_mm"].mean() < 2.0
+
+
+def test_printer_factors_and_print_scatter():
+    ps = printers.printers(50, seed=1)
+    fk = np.array([p.factor_k for p in ps])
+    assert fk.min() >= 0.6 and fk.max() <= 1.5 and np.ptp(fk) > 0.5
+    p = ps[0]
+    design = {"density": 60.0, "length": 24.0, "width": 4.5, "height": 9.0, "layer": 0.16, "raster": 0.0}
+    runs = p.prints(pd.DataFrame([design] * 2000), np.random.default_rng(0))
+    ratio = np.log(runs["k_x_N_per_mm"] / p.k(design)[0])
+    assert abs(ratio.mean()) < 0.003 and abs(ratio.std() - printers.PRINT_NOISE) < 0.002
+    assert list(runs.columns[:6]) == [printers.COLUMNS[f] for f in printers.FACTORS]
+
+
+def test_best_design_is_reachable_in_truth():
+    p = printers.Printer(7)
+    design, ok = p.best(k=0.8, fixed={"raster": 0.0})
+    assert ok and design["raster"] == 0.0 and abs(p.k(design)[0] / 0.8 - 1) <= 0.1
+    _, ok = p.best(k=50.0)
+    assert not ok
