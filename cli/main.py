@@ -32,7 +32,7 @@ import typer  # noqa: E402
 
 from designer.errors import DesignerError  # noqa: E402
 
-from . import cosim, design, export, plots, rig, sweep  # noqa: E402
+from . import cosim, design, export, loop, plots, rig, sweep  # noqa: E402
 from .common import flag_message  # noqa: E402
 
 try:  # typer 0.28 vendors click
@@ -80,6 +80,7 @@ def _options(
 
 design.register(design_app)
 design.register(app)
+loop.register(app)
 rig.register(app)
 export.register(app)
 cosim.register(app)

@@ -7,6 +7,8 @@ The public API (computing returns data; writing and plotting are separate calls)
     sur = designer.Surrogate().fit(table)              # or designer.Surrogate.load()
     pred = sur.predict(design)["k_x"]                  # designer.Prediction: value, low, high
     sug = designer.suggest(sur, k=0.8, c=2e-3)         # designer.Suggestion, ranked candidates
+    mine = designer.calibrate(sur, "my_runs.csv")      # the surrogate updated by your own prints
+    nxt = designer.next_prints(mine, k=0.8, n=3)       # what to print and measure next
     joint = designer.Joint.from_suggestion(sug)        # or Joint.from_design / from_coefficients
     designer.export_fmu(joint, "joint.fmu")            # export_modelica, export_mjcf, export_urdf
     fits = designer.identify(["run1.csv"])             # rig logs -> coefficients
@@ -33,6 +35,8 @@ _PUBLIC = {
     "Prediction": "surrogate",
     "suggest": "suggestions",
     "Suggestion": "suggestions",
+    "calibrate": "calibration",
+    "next_prints": "next_prints",
     "Joint": "joint",
     "export_fmu": "export",
     "export_modelica": "export",

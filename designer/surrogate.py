@@ -614,6 +614,10 @@ class Surrogate:
     table_hash: str = ""
     #: the training runs: the six factors and the responses, in rig units
     training: dict[str, list[float]] = field(default_factory=dict)
+    #: the study surrogate a calibrated one was updated from (`designer.calibrate`), else None
+    prior: Surrogate | None = None
+    #: a calibrated surrogate's user runs ("table", a DataFrame) and settings, else None
+    calibration: dict[str, Any] | None = None
 
     @property
     def responses(self) -> list[str]:
@@ -664,6 +668,7 @@ class Surrogate:
         X = {n: table[n].to_numpy(dtype=float) for n in space.FACTOR_NAMES}
         _check_varied(X)
         self.models = {r: select(X, table[r].to_numpy(dtype=float), r, nested=nested) for r in responses}
+        self.prior = self.calibration = None
         self.table_hash = table_hash(table)
         self.training = {c: table[c].astype(float).tolist() for c in list(space.FACTOR_NAMES) + responses}
         self.training["run"] = (
@@ -726,6 +731,8 @@ class Surrogate:
             "responses": {r: m.to_dict() for r, m in self.models.items()},
             "training": self.training,
         }
+        if self.calibration is not None:
+            payload["calibration"] = _calibration_payload(self)
         return json.dumps(payload, indent=1)
 
     def report(self) -> dict[str, Any]:
@@ -777,11 +784,42 @@ class Surrogate:
             raise DesignerError(f"{p} is not a {FORMAT} surrogate", "refit it with designer fit")
         try:
             models = {r: ResponseSurface.from_dict(r, m) for r, m in d["responses"].items()}
-            return cls(models=models, table_hash=d["table_hash"], training=d["training"])
+            surrogate = cls(models=models, table_hash=d["table_hash"], training=d["training"])
         except (KeyError, TypeError, ValueError) as exc:
             raise DesignerError(
                 f"surrogate {p} is incomplete ({exc})", "refit it with designer fit"
             ) from None
+        if "calibration" not in d:
+            return surrogate
+        return _recalibrate(surrogate, d["calibration"], p)
+
+
+def _calibration_payload(surrogate: Surrogate) -> dict[str, Any]:
+    """A calibrated surrogate's user runs and settings, as saved beside the study's surfaces."""
+    cal = surrogate.calibration or {}
+    table = cal["table"]
+    settings = {r: m.settings() for r, m in surrogate.models.items() if hasattr(m, "settings")}
+    return {
+        "printer_sd": cal["printer_sd"],
+        "runs": {c: [None if v != v else float(v) for v in table[c]] for c in table.columns},
+        "settings": settings,
+    }
+
+
+def _recalibrate(prior: Surrogate, d: Any, path: Path) -> Surrogate:
+    """Rebuild a saved calibrated surrogate: its study surfaces updated again by its saved runs."""
+    import pandas as pd
+
+    from .calibration import calibrate
+
+    try:
+        table = pd.DataFrame(d["runs"], dtype=float)
+        return calibrate(prior, table, printer_sd=float(d["printer_sd"]))
+    except (KeyError, TypeError, ValueError) as exc:
+        raise DesignerError(
+            f"the calibration block of {path} is incomplete ({exc})",
+            "recalibrate it with designer calibrate",
+        ) from None
 
 
 def _check_varied(X: Mapping[str, np.ndarray]) -> None:

@@ -1,0 +1,149 @@
+"""`designer calibrate` and `designer next`: the design loop with the user's own printer and prints."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from .common import FixOpt, JsonOpt, SurrogateOpt, console, output_option, parse_fix, print_json
+from .design import AxisOpt, _load, _parse_goal, _pi, _tolerance
+
+#: the calibrate report's significant digits for a factor and its interval
+_FACTOR = "{:.2f}"
+
+
+def calibrate(
+    runs: Annotated[
+        Path,
+        typer.Argument(help="Your measured runs: a coefficient table (CSV or Parquet), e.g. identify's."),
+    ],
+    out: Annotated[Path | None, output_option("Where to write the calibrated surrogate JSON.")] = None,
+    surrogate: SurrogateOpt = None,
+    as_json: JsonOpt = False,
+) -> None:
+    """Calibrate the study's surrogate to your printer with your own measured runs.
+
+    The study's surrogate is the prior; your runs estimate a printer/material factor per response
+    (with its 95 % interval) and a local correction that is strong near the designs you printed and
+    fades away from them. The result is a surrogate file every --surrogate option accepts.
+    The report gives the nested leave-one-out accuracy over your runs (each predicted from the others).
+
+    Example: designer calibrate my_runs.csv -o mine.json
+    """
+    from designer.calibration import calibrate as run_calibrate
+    from designer.calibration import report
+    from designer.files import check_output
+
+    if out is not None:
+        check_output(out, suffixes=[".json"])
+    calibrated = run_calibrate(_load(surrogate), runs)
+    if out is not None:
+        calibrated.save(out)
+    data = report(calibrated) | {"out": str(out) if out else None}
+    if as_json:
+        print_json(data)
+        return
+    _print_calibration(data)
+    console.print(
+        f"surrogate id {calibrated.id}" + (f", written to {out}" if out else " (not saved: give -o FILE)")
+    )
+
+
+def _print_calibration(data: dict) -> None:
+    console.print(f"{data['n_runs']} run(s) of yours on top of the study's {data['n_study_runs']}")
+    for r, m in data["responses"].items():
+        if m["n_runs"] == 0:
+            console.print(f"- {r}: no measured value in your runs: the study's prediction, unchanged")
+            continue
+        f = m["printer_factor"]
+        line = (
+            f"- {r}: printer factor {_FACTOR.format(f['value'])} "
+            f"[{_FACTOR.format(f['low'])}, {_FACTOR.format(f['high'])}] (95 %) from {m['n_runs']} run(s)"
+        )
+        nested = m["loo_user"]
+        if nested:
+            line += (
+                f"; each of your runs predicted from the others: median error {nested['mape']:.0f} %, "
+                f"{100 * nested['coverage95']:.0f} % inside the 95 % PI"
+            )
+        console.print(line)
+        console.print(f"  {m['statement']}")
+
+
+def next_(
+    k: Annotated[
+        str | None, typer.Option("--k", help="Stiffness target (N/mm; N.mm/rad rotational).")
+    ] = None,
+    c: Annotated[
+        str | None, typer.Option("--c", help="Damping goal: a target (N.s/mm; N.mm.s/rad), min or max.")
+    ] = None,
+    axis: AxisOpt = "x",
+    fix: FixOpt = None,
+    n: Annotated[int, typer.Option("--n", help="How many designs to print now (1-10).")] = 3,
+    tolerance: Annotated[
+        float, typer.Option("--tolerance", help="Band around a target that counts as met, % (+-).")
+    ] = 10.0,
+    stop: Annotated[
+        float,
+        typer.Option("--stop", help="Print the recommendation once it lands with this probability (0-1)."),
+    ] = 0.9,
+    surrogate: SurrogateOpt = None,
+    as_json: JsonOpt = False,
+) -> None:
+    """The designs to print and measure next so that the recommendation lands on your target.
+
+    Each proposed print is chosen for how much measuring it raises the chance that the best design
+    afterwards lands within --tolerance of the targets (a knowledge gradient), among printable
+    designs near the target. When the current best already lands with probability --stop or more,
+    it says to print design #1 and proposes nothing else.
+
+    Example: designer next --k 0.8 --n 3 --surrogate mine.json
+    """
+    from designer.next_prints import next_prints
+
+    result = next_prints(
+        _load(surrogate),
+        k=_parse_goal(k, "--k"),
+        c=_parse_goal(c, "--c"),
+        axis=axis,
+        fixed=parse_fix(fix),
+        n=n,
+        tolerance=_tolerance(tolerance),
+        stop=stop,
+    )
+    data = result.to_dict()
+    if as_json:
+        print_json(data)
+        return
+    _print_next(data)
+
+
+def _design(params: dict) -> str:
+    return (
+        f"infill {params['density']:g} %, l {params['length']:g} mm, b {params['width']:g} mm, "
+        f"h {params['height']:g} mm, layer {params['layer']:g} mm, raster {params['raster']:g} deg"
+    )
+
+
+def _print_next(data: dict) -> None:
+    rec = data["recommendation"]
+    console.print(f"Design #1 now: {_design(rec['params'])}")
+    console.print(
+        f"  k {_pi(rec['predicted']['k'])}, c {_pi(rec['predicted']['c'])}; "
+        f"lands within +-{100 * data['tolerance']:g} % with probability {data['p_now']:.2f}"
+    )
+    for i, p in enumerate(data["prints"], 1):
+        mark = " (design #1 itself)" if p["recommended"] else ""
+        console.print(f"Print {i}{mark}: {_design(p['params'])}")
+        console.print(
+            f"  predicted k {_pi(p['predicted']['k'])}, c {_pi(p['predicted']['c'])}; {p['reason']}"
+        )
+    for s in data["statements"]:
+        console.print(f"- {s}")
+
+
+def register(app: typer.Typer) -> None:
+    app.command()(calibrate)
+    app.command("next")(next_)

@@ -1,0 +1,361 @@
+"""Calibration of the study's surrogate to a user's printer from the user's own runs.
+
+The study printed on one printer with one spool; another printer's joints differ by a factor (the
+filament's modulus and the machine's extrusion) and, near any one design, by what the study's
+response surface gets wrong there. Per response, in log space:
+
+    log y_user(x) = mu0(x) + b + g(x) + e
+
+- ``mu0(x)``: the study surrogate's prediction (its log), the prior mean;
+- ``b ~ N(0, tau^2)``: the printer/material factor exp(b), shared by every design (tau = 0.3: a
+  factor between 0.55 and 1.8 at 95 %);
+- ``g ~ GP(0, s_g(x) s_g(x') rho(x, x'))``: the study model's local error, a squared-exponential
+  correlation over the coded factors whose length scale is the longest the study's own nested
+  leave-one-out residuals do not reject (`fit_length`), and whose size is the study's predictive spread
+  ``s_g(x)^2 = s0(x)^2 - sigma_n^2``;
+- ``e ~ N(0, sigma_n^2)``: print-to-print scatter, from the study's replicated runs (pure error),
+  never below 2.5 %.
+
+Far from the user's runs the prediction is the study's, times the estimated printer factor, with the
+study's interval widened by the factor's uncertainty; at a measured design it converges to the
+measurements. With no run, calibration returns the study surrogate itself.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from . import space
+from .errors import DesignerError
+from .surrogate import Prediction, ResponseSurface, Surrogate
+
+#: prior standard deviation of log(printer factor): filaments of one grade and printers differ
+PRINTER_SD = 0.3
+#: the smallest print-to-print scatter assumed (relative, log space)
+MIN_NOISE = 0.025
+#: length scales tried for the local correction (coded factor units, each factor spans [-1, 1])
+LENGTHS = (0.25, 0.35, 0.5, 0.7, 1.0, 1.4, 2.0, 3.0)
+#: log-likelihood drop that still counts as "not rejected" (about a 95 % profile interval)
+LIKELIHOOD_DROP = 2.0
+
+
+def coded(X: Mapping[str, Any]) -> np.ndarray:
+    """(n, 6) coordinates of the local correction: every factor coded to [-1, 1] over its range.
+
+    Where the walls fill the section the infill has no effect, so such designs are coded at 100 %.
+    """
+    cols = {n: np.atleast_1d(np.asarray(X[n], dtype=float)) for n in space.FACTOR_NAMES}
+    core = np.minimum(cols["width"], cols["height"]) - 2 * space.WALL_MM
+    cols["density"] = np.where(core > space.NOZZLE_MM + 1e-9, cols["density"], 100.0)
+    return np.column_stack(
+        [(cols[f.name] - (f.low + f.high) / 2) / ((f.high - f.low) / 2) for f in space.FACTORS]
+    )
+
+
+def _coded_symbolic(x: Any) -> list[Any]:
+    """`coded` for one design as CasADi expressions (factor order)."""
+    out = []
+    for i, f in enumerate(space.FACTORS):
+        xi = x[i]
+        if f.name == "density":
+            core = ca.fmin(x[space.FACTOR_NAMES.index("width")], x[space.FACTOR_NAMES.index("height")])
+            xi = ca.if_else(core - 2 * space.WALL_MM > space.NOZZLE_MM + 1e-9, xi, 100.0)
+        out.append((xi - (f.low + f.high) / 2) / ((f.high - f.low) / 2))
+    return out
+
+
+def _log_moments(base: ResponseSurface, X: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The study surface's predictive mean and scale in log space at designs X.
+
+    For a raw-space form the log-normal with the same median and upper 95 % bound stands in.
+    """
+    p = base.predict(X)
+    mu = np.log(np.asarray(p.value, dtype=float))
+    s = (np.log(np.asarray(p.high, dtype=float)) - mu) / base.t95
+    return mu, s
+
+
+def noise_of(base: ResponseSurface) -> float:
+    """Print-to-print scatter (log space) from the study's replicated runs, at least MIN_NOISE."""
+    lof = base.lack_of_fit or {}
+    if lof.get("df_pure_error"):
+        sd = np.sqrt(lof["ss_pure_error"] / lof["df_pure_error"])
+        mean = np.mean(base.observed_range)
+        return float(max(sd / mean, MIN_NOISE))
+    return MIN_NOISE
+
+
+def _correlation(A: np.ndarray, B: np.ndarray, length: float) -> np.ndarray:
+    d2 = np.sum((A[:, None, :] - B[None, :, :]) ** 2, axis=2)
+    return np.exp(-0.5 * d2 / length**2)
+
+
+def fit_length(base: ResponseSurface, X: Mapping[str, Any], y: np.ndarray, noise: float) -> float:
+    """Length scale of the model's local error, from the study's own residuals.
+
+    The residuals are the nested leave-one-out ones where the surrogate carries them (each run
+    predicted by a model that never saw it), else the selected form's own leave-one-out ones. The
+    study's runs lie at least one coded unit apart, so its likelihood cannot tell length scales below
+    that spacing apart: the longest length scale the residuals do not reject (log-likelihood within
+    LIKELIHOOD_DROP of the best) is taken, the smoothest correction the data allows.
+    """
+    held = base.nested_predictions or base.loo_predictions
+    if held is None:
+        return LENGTHS[0]
+    r = np.log(y) - np.log(np.asarray(held.value, dtype=float))
+    _, s0 = _log_moments(base, X)
+    sg = np.sqrt(np.maximum(s0**2 - noise**2, 0.25 * s0**2))
+    Z = coded(X)
+    ll = []
+    for length in LENGTHS:
+        K = np.outer(sg, sg) * _correlation(Z, Z, length) + noise**2 * np.eye(len(r))
+        L = np.linalg.cholesky(K)
+        a = np.linalg.solve(L, r)
+        ll.append(-0.5 * a @ a - np.sum(np.log(np.diag(L))))
+    return max(length for length, v in zip(LENGTHS, ll, strict=True) if v >= max(ll) - LIKELIHOOD_DROP)
+
+
+def _length_of(base: ResponseSurface, X: Mapping[str, Any], y: np.ndarray, noise: float) -> float:
+    """`fit_length`, computed once per study surface (the design loop recalibrates many times)."""
+    if "_calibration_length" not in base.__dict__:
+        base.__dict__["_calibration_length"] = fit_length(base, X, y, noise)
+    return base.__dict__["_calibration_length"]
+
+
+@dataclass
+class CalibratedSurface(ResponseSurface):
+    """A study response surface updated by a user's runs (see the module docstring).
+
+    Carries the study surface's fields (form, accuracy, ...) for reporting; predictions and the
+    CasADi function are the calibrated ones, log-normal (Student t in log space, the study's dof).
+    """
+
+    runs: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))  # (n, 6) designs, factor order
+    observed: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (n,) measured values
+    length: float = 1.0
+    noise: float = MIN_NOISE
+    printer_sd: float = PRINTER_SD
+
+    @classmethod
+    def from_base(
+        cls,
+        base: ResponseSurface,
+        runs: np.ndarray,
+        observed: np.ndarray,
+        length: float,
+        noise: float,
+        printer_sd: float = PRINTER_SD,
+    ) -> CalibratedSurface:
+        shared = {f.name: getattr(base, f.name) for f in fields(ResponseSurface)}
+        surf = cls(**shared, runs=runs, observed=observed, length=length, noise=noise, printer_sd=printer_sd)
+        surf._prepare(base)
+        return surf
+
+    def _prepare(self, base: ResponseSurface) -> None:
+        self._base = base
+        X = dict(zip(space.FACTOR_NAMES, self.runs.T, strict=True))
+        mu0, s0 = _log_moments(base, X)
+        self._Zu = coded(X)
+        self._sgu = np.sqrt(np.maximum(s0**2 - self.noise**2, 0.25 * s0**2))
+        K = self._prior_cov(self._Zu, self._sgu, self._Zu, self._sgu) + self.noise**2 * np.eye(len(mu0))
+        self._Kinv = np.linalg.inv(K)
+        self._alpha = self._Kinv @ (np.log(self.observed) - mu0)
+
+    def _prior_cov(self, Za: np.ndarray, sa: np.ndarray, Zb: np.ndarray, sb: np.ndarray) -> np.ndarray:
+        return self.printer_sd**2 + np.outer(sa, sb) * _correlation(Za, Zb, self.length)
+
+    @property
+    def transform(self) -> str:
+        return "log"
+
+    def log_moments(self, X: Any) -> tuple[np.ndarray, np.ndarray]:
+        """Calibrated predictive mean and scale of log y at designs X, arrays of shape (n,)."""
+        mu0, s0 = _log_moments(self._base, X)
+        Z = coded(X)
+        sg = np.sqrt(np.maximum(s0**2 - self.noise**2, 0.25 * s0**2))
+        C = self._prior_cov(Z, sg, self._Zu, self._sgu)
+        var = s0**2 + self.printer_sd**2 - np.einsum("ij,jk,ik->i", C, self._Kinv, C)
+        return mu0 + C @ self._alpha, np.sqrt(np.maximum(var, self.noise**2))
+
+    def predict(self, X: Any) -> Prediction:
+        mu, s = self.log_moments(X)
+        half = self.t95 * s
+        return Prediction(np.exp(mu), np.exp(mu - half), np.exp(mu + half))
+
+    def casadi_function(self) -> ca.Function:
+        x = ca.SX.sym("x", len(space.FACTOR_NAMES))
+        value0, _, hi0 = self._base.casadi_function()(x)
+        mu0 = ca.log(value0)
+        s0 = (ca.log(hi0) - mu0) / self.t95
+        sg = ca.sqrt(ca.fmax(s0**2 - self.noise**2, 0.25 * s0**2))
+        z = ca.vertcat(*_coded_symbolic(x))
+        d2 = ca.sum1((ca.repmat(z, 1, len(self._Zu)) - ca.DM(self._Zu.T)) ** 2).T
+        c = self.printer_sd**2 + sg * ca.DM(self._sgu) * ca.exp(-0.5 * d2 / self.length**2)
+        var = s0**2 + self.printer_sd**2 - ca.bilin(ca.DM(self._Kinv), c, c)
+        mu = mu0 + ca.dot(c, ca.DM(self._alpha))
+        half = self.t95 * ca.sqrt(ca.fmax(var, self.noise**2))
+        out = [ca.exp(mu), ca.exp(mu - half), ca.exp(mu + half)]
+        return ca.Function(self.response, [x], out, ["x"], ["value", "lo", "hi"])
+
+    def printer_factor(self) -> Prediction:
+        """The estimated printer/material factor exp(b) with its 95 % interval."""
+        b = self.printer_sd**2 * float(np.sum(self._alpha))
+        var = self.printer_sd**2 - self.printer_sd**4 * float(np.sum(self._Kinv))
+        half = 1.96 * np.sqrt(max(var, 0.0))
+        return Prediction(float(np.exp(b)), float(np.exp(b - half)), float(np.exp(b + half)))
+
+    def settings(self) -> dict[str, Any]:
+        return {"length": self.length, "noise": self.noise, "printer_sd": self.printer_sd}
+
+
+def _runs_table(runs: Any, surrogate: Surrogate) -> Any:
+    """The user's runs through `load_table` (factors checked, printable), restricted to responses
+    the surrogate has; raise for a table that shares no response or no factor with it."""
+    import pandas as pd
+
+    from .data import load_table
+
+    if runs is None:
+        return pd.DataFrame()
+    if isinstance(runs, pd.DataFrame) and runs.empty:
+        return runs
+    table = load_table(runs)
+    responses = [r for r in surrogate.responses if r in table.columns]
+    if not responses:
+        raise DesignerError(
+            f"runs has none of the surrogate's responses ({', '.join(surrogate.responses)})",
+            "give measured coefficients of the same axis, e.g. the columns k_x and c_x "
+            "(designer identify writes them)",
+        )
+    for name in space.FACTOR_NAMES:
+        for v in table[name]:
+            space.check_value(name, float(v), allow_extrapolation=True)
+    return table
+
+
+def calibrate(surrogate: Surrogate, runs: Any, *, printer_sd: float = PRINTER_SD) -> Surrogate:
+    """The study surrogate updated by a user's measured runs: a printer factor and a local correction.
+
+    Args:
+        surrogate: the prior, usually the shipped study surrogate (`Surrogate.load()`); a surrogate
+            that is already calibrated is recalibrated from its own prior with all runs.
+        runs: the user's runs, a coefficient table (path or DataFrame: the six factors and any of
+            the surrogate's responses, e.g. k_x and c_x; designer identify's output) with 0 or more
+            rows. Responses missing from the table stay as in the prior.
+        printer_sd: prior standard deviation of log(printer factor).
+
+    Returns:
+        A new `Surrogate` whose responses are `CalibratedSurface`s; with no run, `surrogate` itself.
+
+    Raises:
+        DesignerError: a malformed table, a factor outside what can be printed, no response of the
+            surrogate's axis in the table, a non-positive coefficient, or printer_sd <= 0.
+    """
+    if not isinstance(surrogate, Surrogate) or not surrogate.models:
+        raise DesignerError(
+            f"surrogate={type(surrogate).__name__} is not a fitted Surrogate",
+            "give Surrogate.load() or a fitted Surrogate",
+        )
+    if not printer_sd > 0:
+        raise DesignerError(f"printer_sd={printer_sd} must be positive", "give e.g. printer_sd=0.3")
+    prior = surrogate.prior if surrogate.calibration else surrogate
+    table = _runs_table(runs, prior)
+    if prior is not surrogate:
+        import pandas as pd
+
+        table = pd.concat([surrogate.calibration["table"], table], ignore_index=True)
+    if table.empty:
+        return prior
+    X_study = {n: np.asarray(prior.training[n], dtype=float) for n in space.FACTOR_NAMES}
+    models: dict[str, ResponseSurface] = {}
+    for r, base in prior.models.items():
+        rows = table[r].notna().to_numpy() if r in table.columns else np.zeros(len(table), bool)
+        if not rows.any():
+            models[r] = base
+            continue
+        noise = noise_of(base)
+        length = _length_of(base, X_study, np.asarray(prior.training[r], dtype=float), noise)
+        designs = table.loc[rows, list(space.FACTOR_NAMES)].to_numpy(dtype=float)
+        observed = table.loc[rows, r].to_numpy(dtype=float)
+        models[r] = CalibratedSurface.from_base(base, designs, observed, length, noise, printer_sd)
+    keep = list(space.FACTOR_NAMES) + [r for r in prior.responses if r in table.columns]
+    return Surrogate(
+        models=models,
+        table_hash=prior.table_hash,
+        training=prior.training,
+        prior=prior,
+        calibration={"table": table.loc[:, keep].reset_index(drop=True), "printer_sd": printer_sd},
+    )
+
+
+def _user_loo(surrogate: Surrogate, response: str) -> dict[str, float] | None:
+    """Each of the user's runs predicted by the surrogate calibrated on the others (the prior and
+    its settings come from the study, so nothing is refitted on the user's runs)."""
+    table = surrogate.calibration["table"]
+    rows = np.flatnonzero(table[response].notna().to_numpy()) if response in table.columns else []
+    if len(rows) < 2:
+        return None
+    errors, inside = [], []
+    for i in rows:
+        others = calibrate(
+            surrogate.prior, table.drop(index=i), printer_sd=surrogate.calibration["printer_sd"]
+        )
+        p = others.model(response).predict(table.loc[[i], list(space.FACTOR_NAMES)]).at(0)
+        y = float(table.loc[i, response])
+        errors.append(abs(p.value - y) / y)
+        inside.append(p.low <= y <= p.high)
+    return {"n": len(rows), "mape": 100 * float(np.median(errors)), "coverage95": float(np.mean(inside))}
+
+
+def _statement(m: ResponseSurface, calibrated: ResponseSurface) -> str:
+    if not isinstance(calibrated, CalibratedSurface):
+        return "no measured value: the study's prediction"
+    if m.predictable:
+        return (
+            f"{m.response}: the study's {m.form} form times your printer's factor, corrected near the "
+            f"designs you printed (correlation length {calibrated.length:g} of a factor's half-range); "
+            "far from them the interval stays as wide as the study's plus the factor's uncertainty"
+        )
+    return (
+        f"{m.response} is not predictable from the six factors (the study's nested Q2 "
+        f"{m.accuracy.get('q2', float('nan')):.2f}): your runs set its level for your printer and pin it "
+        "down at the designs you printed; elsewhere its interval stays wide"
+    )
+
+
+def report(surrogate: Surrogate) -> dict[str, Any]:
+    """What a calibration found, as plain data: per response the user's run count, the printer
+    factor with its 95 % interval, and the nested leave-one-out over the user's runs.
+
+    Raises:
+        DesignerError: `surrogate` is not calibrated.
+    """
+    if surrogate.calibration is None:
+        raise DesignerError("surrogate is not calibrated", "give the result of designer.calibrate(...)")
+    table = surrogate.calibration["table"]
+    out: dict[str, Any] = {
+        "surrogate_id": surrogate.id,
+        "prior_id": surrogate.prior.id,
+        "n_runs": len(table),
+        "n_study_runs": len(surrogate.prior.training["run"]),
+        "printer_sd": surrogate.calibration["printer_sd"],
+        "responses": {},
+    }
+    for r, m in surrogate.models.items():
+        base = surrogate.prior.model(r)
+        cal = isinstance(m, CalibratedSurface)
+        out["responses"][r] = {
+            "unit": m.unit,
+            "n_runs": len(m.runs) if cal else 0,
+            "printer_factor": m.printer_factor().to_dict() if cal else None,
+            "settings": m.settings() if cal else None,
+            "loo_user": _user_loo(surrogate, r) if cal else None,
+            "predictable": base.predictable,
+            "statement": _statement(base, m),
+        }
+    return out

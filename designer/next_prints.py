@@ -1,0 +1,263 @@
+"""The next prints: which designs to print and measure now so the recommendation lands on target.
+
+Criterion (a knowledge gradient on the product's answer): for a candidate print x, the value of
+measuring it is the expected probability that the best recommendation *after* the measurement lands
+within the tolerance of every predictable target,
+
+    KG(x) = E_y[ max_r P(r within tolerance | runs + (x, y)) ],
+
+with y drawn from the calibrated surrogate's predictive distribution at x (Gauss-Hermite quadrature
+in log space) and r over the current search's candidate designs. Several prints are chosen greedily:
+each next one is valued with the ones before it assumed measured at their predicted values, and
+must be distinct from them. The expected P after the batch is a Monte Carlo over joint draws of
+the batch's measurements. When the current recommendation already lands with probability >= `stop`,
+nothing more is worth printing before it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from . import space
+from .calibration import calibrate
+from .errors import DesignerError
+from .suggestions import DISTINCT, TOLERANCE, Candidate, _distance, probability_within, suggest
+from .surrogate import Prediction, Surrogate
+
+#: quadrature nodes of the fantasised measurement
+NODES = 5
+#: candidate designs searched for the prints and for the recommendation after them
+POOL = 8
+#: joint draws of the batch's measurements for the expected P after it
+DRAWS = 48
+#: the probability of landing at which printing the recommendation is the best next step
+STOP = 0.9
+
+
+@dataclass(frozen=True)
+class NextPrint:
+    """One design to print and measure now, what the model expects of it, and why it was chosen."""
+
+    params: dict[str, float]
+    predicted: dict[str, Prediction]
+    expected_p: float  # expected best P after measuring this print (and the ones before it)
+    recommended: bool  # the current recommendation itself
+    reason: str
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "params": self.params,
+            "predicted": {q: p.to_dict() for q, p in self.predicted.items()},
+            "expected_p": self.expected_p,
+            "recommended": self.recommended,
+            "reason": self.reason,
+        }
+
+
+@dataclass(frozen=True)
+class NextPrints:
+    """The result of `next_prints`: the current recommendation, its P, and the prints to make now."""
+
+    axis: str
+    targets: dict[str, float | str]
+    tolerance: float
+    recommendation: Candidate
+    p_now: float
+    stop: bool
+    prints: list[NextPrint]
+    p_after: float  # expected P of the best recommendation once `prints` are measured
+    statements: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "axis": self.axis,
+            "targets": self.targets,
+            "tolerance": self.tolerance,
+            "recommendation": self.recommendation.to_dict(),
+            "p_now": self.p_now,
+            "stop": self.stop,
+            "p_after": self.p_after,
+            "prints": [p.to_dict() for p in self.prints],
+            "statements": self.statements,
+        }
+
+
+class _Scorer:
+    """P(within tolerance of every predictable target) of fixed designs under updated surrogates."""
+
+    def __init__(self, surrogate: Surrogate, axis: str, targets: Mapping[str, float], tolerance: float):
+        self.axis, self.targets, self.tolerance = axis, dict(targets), tolerance
+        self.responses = [f"{q}_{axis}" for q in targets]
+        #: what a print measures: both coefficients of the axis
+        self.measured = [f"{q}_{axis}" for q in ("k", "c")]
+
+    def best(self, surrogate: Surrogate, designs: Mapping[str, np.ndarray]) -> float:
+        preds = surrogate.predict(designs, responses=self.responses, allow_extrapolation=True)
+        n = len(next(iter(designs.values())))
+        p = np.ones(n)
+        for q, target in self.targets.items():
+            r = f"{q}_{self.axis}"
+            m = surrogate.model(r)
+            log = m.transform == "log"
+            p *= [
+                probability_within(preds[r].at(i), target, self.tolerance, m.dof, log=log) for i in range(n)
+            ]
+        return float(p.max())
+
+
+def _log_predictive(surrogate: Surrogate, response: str, design: Mapping[str, float]) -> tuple[float, float]:
+    """Mean and scale of log y at one design (Student t in log space, read back from the PI)."""
+    m = surrogate.model(response)
+    p = surrogate.predict({n: [v] for n, v in design.items()}, responses=[response], allow_extrapolation=True)
+    value, high = float(p[response].value[0]), float(p[response].high[0])
+    mu = float(np.log(value))
+    return mu, (float(np.log(high)) - mu) / m.t95
+
+
+def _run(design: Mapping[str, float], values: Mapping[str, float]) -> dict[str, float]:
+    return {**{n: float(design[n]) for n in space.FACTOR_NAMES}, **values}
+
+
+def _with_runs(surrogate: Surrogate, runs: list[dict[str, float]]) -> Surrogate:
+    import pandas as pd
+
+    return calibrate(surrogate, pd.DataFrame(runs)) if runs else surrogate
+
+
+def _expected_best(
+    surrogate: Surrogate, scorer: _Scorer, design: dict[str, float], known: list[dict[str, float]], pool: Any
+) -> float:
+    """KG of printing `design` after the `known` (fantasised) runs: quadrature over its measurement."""
+    base = _with_runs(surrogate, known)
+    nodes, weights = np.polynomial.hermite_e.hermegauss(NODES)
+    weights = weights / weights.sum()
+    moments = {r: _log_predictive(base, r, design) for r in scorer.measured}
+    total = 0.0
+    for z, w in zip(nodes, weights, strict=True):
+        # the targeted responses at the quadrature node, the others at their median
+        values = {
+            r: float(np.exp(mu + (z * s if r in scorer.responses else 0.0))) for r, (mu, s) in moments.items()
+        }
+        total += w * scorer.best(_with_runs(surrogate, known + [_run(design, values)]), pool)
+    return total
+
+
+def _batch_p(surrogate: Surrogate, scorer: _Scorer, designs: list[dict[str, float]], pool: Any) -> float:
+    """Expected best P once every design of the batch is measured: joint draws, each conditioned on
+    the draws before it (seeded, so the answer is repeatable)."""
+    rng = np.random.default_rng(20261125)
+    total = 0.0
+    for _ in range(DRAWS):
+        runs: list[dict[str, float]] = []
+        for d in designs:
+            current = _with_runs(surrogate, runs)
+            values = {}
+            for r in scorer.measured:
+                mu, s = _log_predictive(current, r, d)
+                values[r] = float(np.exp(mu + s * rng.standard_normal()))
+            runs.append(_run(d, values))
+        total += scorer.best(_with_runs(surrogate, runs), pool)
+    return total / DRAWS
+
+
+def _predictable_targets(sug: Any) -> dict[str, float]:
+    return {
+        q: t.value
+        for q, t in sug.targets.items()
+        if t.kind == "target" and sug.predictability[q]["predictable"]
+    }
+
+
+def next_prints(
+    surrogate: Surrogate,
+    *,
+    k: float | str | None = None,
+    c: float | str | None = None,
+    axis: str = "x",
+    fixed: Mapping[str, float] | None = None,
+    n: int = 3,
+    tolerance: float = TOLERANCE,
+    stop: float = STOP,
+) -> NextPrints:
+    """The `n` designs to print and measure now that most raise the chance the final recommendation
+    lands within `tolerance` of every predictable target.
+
+    Args:
+        surrogate: the study surrogate or one calibrated to the user's printer (`designer.calibrate`).
+        k, c: goals as in `designer.suggest` (a target value in rig units, "min" or "max"); at least
+            one predictable target value is needed: the criterion is the probability of landing on it.
+        axis, fixed, tolerance: as in `designer.suggest`.
+        n: how many designs to print now (1 to 10).
+        stop: when the current recommendation lands with at least this probability, propose no
+            print but the recommendation itself.
+
+    Returns:
+        A `NextPrints`: the current recommendation and its P, `prints` (empty when `stop`), the
+        expected P after them, and plain statements.
+
+    Raises:
+        DesignerError: the goals of `designer.suggest` are invalid, no predictable target value is
+            given, n is not in 1..10, or stop is not in (0, 1].
+    """
+    if not 1 <= int(n) <= 10 or int(n) != n:
+        raise DesignerError(f"n={n} is not a whole number from 1 to 10", "give e.g. n=3")
+    if not 0 < stop <= 1:
+        raise DesignerError(f"stop={stop} is not in (0, 1]", "give e.g. stop=0.9")
+    sug = suggest(surrogate, k=k, c=c, axis=axis, fixed=fixed, top=POOL, tolerance=tolerance)
+    targets = _predictable_targets(sug)
+    if not targets:
+        raise DesignerError(
+            "no predictable target value is given, so no print can raise the chance of landing on it",
+            f"give k= a target value (k_{axis} is predictable); min or max goals have no landing chance",
+        )
+    scorer = _Scorer(surrogate, axis, targets, tolerance)
+    best = sug.candidates[0]
+    p_now = float(best.p_within or 0.0)
+    goals = {q: (t.value if t.kind == "target" else t.kind) for q, t in sug.targets.items()}
+    if p_now >= stop:
+        text = (
+            f"print design #1: it lands within +-{100 * tolerance:g} % with probability {p_now:.2f} "
+            f"(>= {stop:g}); no other print is expected to do better first"
+        )
+        return NextPrints(axis, goals, tolerance, best, p_now, True, [], p_now, [text])
+    pool_designs = [c.params for c in sug.candidates]
+    pool = {name: np.array([d[name] for d in pool_designs]) for name in space.FACTOR_NAMES}
+    spans = {f.name: f.high - f.low for f in space.CONTINUOUS}
+    chosen: list[NextPrint] = []
+    known: list[dict[str, float]] = []
+    for _ in range(int(n)):
+        free = [
+            c for c in sug.candidates if all(_distance(c.params, p.params, spans) > DISTINCT for p in chosen)
+        ]
+        if not free:
+            break
+        scores = [_expected_best(surrogate, scorer, c.params, known, pool) for c in free]
+        i = int(np.argmax(scores))
+        pick = free[i]
+        recommended = pick is best
+        reason = (
+            "the current recommendation: measuring it tests the answer where it matters"
+            if recommended
+            else "tests the model where another near-target design may do better than the current one"
+        )
+        chosen.append(NextPrint(pick.params, pick.predicted, float(scores[i]), recommended, reason))
+        base = _with_runs(surrogate, known)
+        known.append(
+            _run(
+                pick.params,
+                {r: float(np.exp(_log_predictive(base, r, pick.params)[0])) for r in scorer.measured},
+            )
+        )
+    p_after = _batch_p(surrogate, scorer, [p.params for p in chosen], pool)
+    statements = [
+        f"the best design now lands within +-{100 * tolerance:g} % with probability {p_now:.2f}; "
+        f"after printing and measuring these {len(chosen)}, the best is expected to land with {p_after:.2f}",
+        "then: add the measured coefficients to your runs table, designer calibrate, designer next again",
+    ]
+    if len(chosen) < n:
+        statements.append(f"{len(chosen)} distinct design(s) instead of {n}: the search found no more")
+    return NextPrints(axis, goals, tolerance, best, p_now, False, chosen, p_after, statements)

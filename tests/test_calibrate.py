@@ -1,0 +1,193 @@
+"""Calibration to a user's printer and the next prints: tiny exact cases, invariants, bad input,
+and simulated printers from tests/printers.py (written independently of designer)."""
+
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from clitools import assert_clean_failure, run_inprocess
+
+import designer
+from designer.calibration import CalibratedSurface, noise_of
+from designer.space import check_design
+from designer.surrogate import Surrogate
+
+sys.path.insert(0, str(Path(__file__).parent))
+import printers  # noqa: E402
+
+FACTORS = ["density", "length", "width", "height", "layer", "raster"]
+
+
+@pytest.fixture(scope="module")
+def study():
+    return Surrogate.load()
+
+
+@pytest.fixture(scope="module")
+def table():
+    return designer.load_table()
+
+
+def _rows(table, idx, scale=1.0):
+    runs = table.iloc[idx][FACTORS + ["k_x", "c_x"]].reset_index(drop=True)
+    return runs.assign(k_x=runs["k_x"] * scale)
+
+
+def test_zero_runs_return_the_study_surrogate(study, table):
+    same = designer.calibrate(study, pd.DataFrame())
+    assert same is study
+    X = table[FACTORS]
+    for r in study.responses:
+        a, b = same.predict(X)[r], study.predict(X)[r]
+        np.testing.assert_allclose(a.value, b.value, rtol=1e-12)
+
+
+def test_one_run_at_a_study_design_moves_the_prediction_by_the_models_amount(study, table):
+    # the model (calibration.py's docstring): log y = mu0 + b + g + e, with b ~ N(0, tau^2), g of
+    # variance s0^2 - sigma_n^2 at the run, e ~ N(0, sigma_n^2): one run's residual d moves the
+    # prediction there by (tau^2 + sg^2) / (tau^2 + sg^2 + sigma_n^2) * d, in log space
+    run = _rows(table, [10], scale=0.7)
+    base = study.model("k_x")
+    p0 = base.predict(run[FACTORS]).at(0)
+    s0 = (math.log(p0.high) - math.log(p0.value)) / base.t95
+    noise = noise_of(base)
+    sg2 = max(s0**2 - noise**2, 0.25 * s0**2)
+    d = math.log(run["k_x"][0]) - math.log(p0.value)
+    shrink = (0.3**2 + sg2) / (0.3**2 + sg2 + noise**2)
+    p1 = designer.calibrate(study, run).predict(run[FACTORS])["k_x"].at(0)
+    assert math.log(p1.value) - math.log(p0.value) == pytest.approx(shrink * d, rel=1e-9)
+    # and the interval there shrinks to about the print scatter
+    assert (math.log(p1.high) - math.log(p1.value)) / base.t95 == pytest.approx(
+        math.sqrt(s0**2 + 0.3**2 - (0.3**2 + sg2) ** 2 / (0.3**2 + sg2 + noise**2)), rel=1e-9
+    )
+
+
+def test_printer_factor_of_one_half_is_recovered_within_its_interval(study, table):
+    runs = _rows(table, list(range(0, 40, 4)), scale=0.5)  # ten study designs, measured at half
+    factor = designer.calibrate(study, runs).model("k_x").printer_factor()
+    assert factor.low <= 0.5 <= factor.high
+    assert factor.high / factor.low < 2.0  # ten runs say something
+
+
+def test_interval_narrows_near_measured_designs_and_stays_wide_elsewhere(study, table):
+    runs = _rows(table, [3, 10, 20, 30])
+    cal = designer.calibrate(study, runs)
+    near, far = table.iloc[[3]][FACTORS], table.iloc[[12]][FACTORS]
+    width = {
+        n: {
+            s: float(np.log(p.high / p.low)[0])
+            for s, p in (("study", study.predict(X)["k_x"]), ("cal", cal.predict(X)["k_x"]))
+        }
+        for n, X in (("near", near), ("far", far))
+    }
+    assert width["near"]["cal"] < 0.5 * width["near"]["study"]
+    assert width["far"]["cal"] > 0.9 * width["far"]["study"]
+
+
+def test_save_load_and_recalibration_are_the_same_surrogate(study, table, tmp_path):
+    runs = _rows(table, [1, 2, 3, 4])
+    cal = designer.calibrate(study, runs)
+    cal.save(tmp_path / "mine.json")
+    back = Surrogate.load(tmp_path / "mine.json")
+    assert back.id == cal.id and isinstance(back.model("k_x"), CalibratedSurface)
+    twice = designer.calibrate(designer.calibrate(study, runs.iloc[:2]), runs.iloc[2:])
+    X = table[FACTORS]
+    for r in ("k_x", "c_x"):
+        np.testing.assert_allclose(back.predict(X)[r].high, cal.predict(X)[r].high, rtol=1e-12)
+        np.testing.assert_allclose(twice.predict(X)[r].value, cal.predict(X)[r].value, rtol=1e-12)
+
+
+def test_casadi_function_equals_predict(study, table):
+    cal = designer.calibrate(study, _rows(table, [5, 6], scale=1.3))
+    f = cal.model("k_x").casadi_function()
+    for i in (0, 5, 17):
+        p = cal.predict(table.iloc[[i]][FACTORS])["k_x"].at(0)
+        v, lo, hi = (float(x) for x in f(table.iloc[i][FACTORS].to_numpy(dtype=float)))
+        assert (v, lo, hi) == pytest.approx((p.value, p.low, p.high), rel=1e-12)
+
+
+def test_simulated_printer_three_prints_pin_the_neighbourhood(study):
+    printer = printers.Printer(3)
+    rng = np.random.default_rng(0)
+    sug = designer.suggest(study, k=0.8, top=3)
+    designs = pd.DataFrame([c.params for c in sug.candidates])
+    runs = printer.prints(designs, rng)
+    cal = designer.calibrate(study, runs)
+    truth = printer.k(designs)
+    pred = cal.predict(designs[FACTORS])["k_x"]
+    assert np.all(np.abs(pred.value / truth - 1) < 0.08)
+    assert np.all((pred.low <= truth) & (truth <= pred.high))
+    factor = cal.model("k_x").printer_factor()
+    assert factor.low <= printer.factor_k <= factor.high
+
+
+def test_next_prints_proposes_distinct_printable_designs_and_stops_when_sure(study, table):
+    nxt = designer.next_prints(study, k=0.8, n=3)
+    assert not nxt.stop and len(nxt.prints) == 3 and nxt.p_after > nxt.p_now
+    for p in nxt.prints:
+        check_design(p.params)
+        assert p.params["width"] >= 2.0 and p.params["layer"] in (0.12, 0.16, 0.2)
+    keys = {tuple(round(p.params[f], 2) for f in FACTORS) for p in nxt.prints}
+    assert len(keys) == 3
+    # four prints at one design that measures 0.8: the recommendation there is sure enough
+    rec = nxt.recommendation.params
+    runs = pd.DataFrame([rec] * 4).assign(k_x=0.8, c_x=2e-3)
+    sure = designer.next_prints(designer.calibrate(study, runs), k=0.8, n=3)
+    assert sure.stop and sure.prints == [] and sure.p_now >= 0.9
+
+
+def test_cli_calibrate_and_next(tmp_path, capsys, table):
+    runs = tmp_path / "mine.csv"
+    _rows(table, [3, 10, 20], scale=0.8).to_csv(runs, index=False)
+    out = tmp_path / "mine.json"
+    code, stdout, err = run_inprocess(["calibrate", runs, "-o", out, "--json"], capsys)
+    assert code == 0, err
+    rep = json.loads(stdout)
+    assert rep["n_runs"] == 3 and rep["responses"]["k_x"]["loo_user"]["n"] == 3
+    code, stdout, err = run_inprocess(
+        ["next", "--k", "0.8", "--n", "2", "--surrogate", out, "--json"], capsys
+    )
+    assert code == 0, err
+    data = json.loads(stdout)
+    assert data["stop"] or len(data["prints"]) == 2
+    for cmd in (
+        ["suggest", "--k", "0.8"],
+        [
+            "predict",
+            "--density",
+            "60",
+            "--length",
+            "24",
+            "--width",
+            "4.5",
+            "--height",
+            "9",
+            "--layer",
+            "0.16",
+            "--raster",
+            "0",
+        ],
+    ):
+        code, _, err = run_inprocess([*cmd, "--surrogate", out], capsys)
+        assert code == 0, err
+
+
+@pytest.mark.parametrize(
+    "content, words",
+    [
+        ("a,b\n1,2\n", "density"),  # none of the study's factors
+        ("density,length,width,height,layer,raster,k_x,c_x\n60,24,1.5,9,0.16,0,0.8,0.002\n", "width"),
+        ("density,length,width,height,layer,raster,k_theta,c_theta\n60,24,4.5,9,0.16,0,8,0.2\n", "k_x"),
+    ],
+)
+def test_cli_calibrate_bad_input(tmp_path, capsys, content, words):
+    bad = tmp_path / "bad.csv"
+    bad.write_text(content)
+    code, _, err = run_inprocess(["calibrate", bad, "-o", tmp_path / "o.json"], capsys)
+    assert_clean_failure(code, err, allowed=(2,))
+    assert words in err
+    assert not (tmp_path / "o.json").exists()
