@@ -629,8 +629,13 @@ class Surrogate:
 
     @property
     def id(self) -> str:
-        """Content hash of the fitted surrogate (form, coefficients and training table)."""
-        return hashlib.sha256(self._payload_json(include_id=False).encode()).hexdigest()[:16]
+        """Content hash of the fitted surrogate (form, coefficients and training table).
+
+        Numbers enter the hash at 10 significant digits, so a refit on another machine (another
+        BLAS, last-bit differences) gets the same id as the file it reproduces.
+        """
+        payload = _rounded(json.loads(self._payload_json(include_id=False)))
+        return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
 
     @property
     def table(self):  # -> pandas.DataFrame; pandas imported lazily to keep `suggest` fast
@@ -820,6 +825,17 @@ def _recalibrate(prior: Surrogate, d: Any, path: Path) -> Surrogate:
             f"the calibration block of {path} is incomplete ({exc})",
             "recalibrate it with designer calibrate",
         ) from None
+
+
+def _rounded(obj: Any) -> Any:
+    """`obj` (parsed JSON) with every float rounded to 10 significant digits."""
+    if isinstance(obj, float):
+        return float(f"{obj:.10g}")
+    if isinstance(obj, dict):
+        return {k: _rounded(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_rounded(v) for v in obj]
+    return obj
 
 
 def _check_varied(X: Mapping[str, np.ndarray]) -> None:
