@@ -209,6 +209,22 @@ class CalibratedSurface(ResponseSurface):
         half = 1.96 * np.sqrt(max(var, 0.0))
         return Prediction(float(np.exp(b)), float(np.exp(b - half)), float(np.exp(b + half)))
 
+    def page_data(self) -> dict[str, Any]:
+        """What the profiler page needs to evaluate this calibration itself (profile.html's
+        `calibrated`): the coded runs and the solved system, plain lists."""
+        return {
+            "factors": [[f.name, (f.low + f.high) / 2, (f.high - f.low) / 2] for f in space.FACTORS],
+            "wall": space.WALL_MM,
+            "line": space.NOZZLE_MM,
+            "runs": self._Zu.tolist(),
+            "sgu": self._sgu.tolist(),
+            "kinv": self._Kinv.tolist(),
+            "alpha": self._alpha.tolist(),
+            "tau2": self.printer_sd**2,
+            "noise": self.noise,
+            "length": self.length,
+        }
+
     def settings(self) -> dict[str, Any]:
         return {"length": self.length, "noise": self.noise, "printer_sd": self.printer_sd}
 

@@ -154,6 +154,8 @@ def _response(surrogate: Surrogate, name: str, statement: str, target: float | N
         "unit": model.unit,
         "form": model.form,
         "transform": model.transform,
+        "base_transform": "log" if model.form == "powerlaw" else "none",
+        "calibration": model.page_data() if hasattr(model, "page_data") else None,
         "features": feature_program(model.form),
         "coef": [float(v) for v in model.coef],
         "vcov": np.asarray(model.vcov, float).tolist(),

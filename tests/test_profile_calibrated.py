@@ -1,0 +1,52 @@
+"""The profiler page of a calibrated surrogate (designer calibrate) in a real browser: the page
+evaluates the calibration itself and must print what the library predicts, to 1e-9."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from test_profile_browser import _check
+
+import designer
+from designer import space
+from designer.surrogate import Surrogate
+
+pytest.importorskip("websocket", reason="the browser tests speak to Chromium with websocket-client")
+import cdp  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def calibrated(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("calibrated")
+    table = designer.load_table()
+    runs = table.iloc[[3, 10, 27, 30]][list(space.FACTOR_NAMES) + ["k_x", "c_x"]]
+    runs.assign(k_x=runs["k_x"] * 0.7, c_x=runs["c_x"] * 1.4).to_csv(folder / "mine.csv", index=False)
+    exe = Path(sys.executable).with_name("designer")
+    for cmd in (
+        ["calibrate", "mine.csv", "-o", "mine.json"],
+        ["profile", "--surrogate", "mine.json", "--target", "k=0.8", "--target", "c=2e-3", "-o", "p.html"],
+    ):
+        run = subprocess.run([str(exe), *cmd], capture_output=True, text=True, cwd=folder)
+        assert run.returncode == 0, run.stderr
+    return folder
+
+
+def test_page_of_a_calibrated_surrogate_matches_the_library(calibrated):
+    exe = cdp.find_browser()
+    if exe is None:
+        pytest.skip("no headless Chromium on this machine")
+    sur = Surrogate.load(calibrated / "mine.json")
+    assert sur.calibration is not None
+    with cdp.Browser(exe) as browser:
+        page = browser.new_page()
+        page.goto((calibrated / "p.html").resolve().as_uri())
+        _check(page, sur)
+        for f in space.CONTINUOUS:
+            page.click(f"#s-{f.name}", 0.2)
+            _check(page, sur)
+        for level in (0.12, 0.2):
+            page.click(f'button[data-factor="layer"][data-level="{level:g}"]')
+            _check(page, sur)
