@@ -36,6 +36,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import printers as truth  # noqa: E402
 
 import designer  # noqa: E402
+from designer.calibration import new_printer  # noqa: E402
 from designer.doe import plan_next  # noqa: E402
 from designer.suggestions import DISTINCT, _distance  # noqa: E402
 
@@ -60,18 +61,23 @@ def _predictable(sug) -> dict:
     return {q: t.value for q, t in sug.targets.items() if sug.predictability[q]["predictable"]}
 
 
-def loop(study, printer, goals, fixed, rng, max_prints, stated):
+def loop(study, printer, goals, fixed, rng, max_prints, stated, policy="next"):
     runs = pd.DataFrame()
     for count in range(1, max_prints + 1):
         surrogate = designer.calibrate(study, runs)
-        nxt = designer.next_prints(surrogate, **goals, fixed=fixed, n=1, tolerance=TOLERANCE)
-        rec = nxt.recommendation
-        design = rec.params if nxt.stop else nxt.prints[0].params
-        is_rec = nxt.stop or _distance(design, rec.params, SPANS) <= DISTINCT
+        if policy == "recommend":  # print the recommendation every round
+            surrogate = new_printer(surrogate)
+            rec = designer.suggest(surrogate, **goals, fixed=fixed, top=1, tolerance=TOLERANCE).candidates[0]
+            design, is_rec, p_now = rec.params, True, rec.p_within
+        else:
+            nxt = designer.next_prints(surrogate, **goals, fixed=fixed, n=1, tolerance=TOLERANCE)
+            rec, p_now = nxt.recommendation, nxt.p_now
+            design = rec.params if nxt.stop else nxt.prints[0].params
+            is_rec = nxt.stop or _distance(design, rec.params, SPANS) <= DISTINCT
         targets = {q: v for q, v in goals.items() if q == "k"}
         hit, run = _lands(printer, design, rng, targets)
         if is_rec:
-            stated.append((nxt.p_now, hit))
+            stated.append((p_now, hit))
         if hit and is_rec:
             return count
         runs = pd.concat([runs, run], ignore_index=True)
@@ -142,6 +148,13 @@ def main() -> None:
     parser.add_argument("--augment", type=int, default=5, help="printers run through the augment baseline")
     parser.add_argument("--quick", action="store_true", help="3 printers x 3 targets (a smoke run)")
     parser.add_argument("--json", action="store_true")
+    parser.add_argument(
+        "--policy",
+        choices=("next", "recommend"),
+        default="next",
+        help="next: print what designer next proposes; recommend: print suggest's #1 each round",
+    )
+    parser.add_argument("--seed", type=int, default=1000, help="seed of the first printer")
     args = parser.parse_args()
     if args.quick:
         args.printers, args.targets, args.augment = 3, 3, 1
@@ -154,14 +167,16 @@ def main() -> None:
     unreachable = 0
     t0 = time.perf_counter()
     for p in range(args.printers):
-        printer = truth.Printer(1000 + p)
+        printer = truth.Printer(args.seed + p)
         for i, k in enumerate(targets):
             goals, fixed = _goals(i, float(k))
             if not printer.best(k=k, fixed=fixed, tolerance=TOLERANCE)[1]:
                 unreachable += 1
                 continue
             rng = np.random.default_rng(10_000 * p + i)
-            results["loop"].append(loop(study, printer, goals, fixed, rng, args.max_prints, stated_loop))
+            results["loop"].append(
+                loop(study, printer, goals, fixed, rng, args.max_prints, stated_loop, args.policy)
+            )
             results["one_shot"].append(one_shot(study, printer, goals, fixed, rng, cache, stated_one))
             if p < args.augment:
                 results["augment"].append(augment(study, table, printer, goals, fixed, rng, args.max_prints))

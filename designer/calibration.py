@@ -32,7 +32,7 @@ import numpy as np
 
 from . import space
 from .errors import DesignerError
-from .surrogate import Prediction, ResponseSurface, Surrogate
+from .surrogate import Prediction, ResponseSurface, Surrogate, _as_printed
 
 #: prior standard deviation of log(printer factor): filaments of one grade and printers differ
 PRINTER_SD = 0.3
@@ -163,7 +163,7 @@ class CalibratedSurface(ResponseSurface):
         self._Zu = coded(X)
         self._sgu = np.sqrt(np.maximum(s0**2 - self.noise**2, 0.25 * s0**2))
         K = self._prior_cov(self._Zu, self._sgu, self._Zu, self._sgu) + self.noise**2 * np.eye(len(mu0))
-        self._Kinv = np.linalg.inv(K)
+        self._Kinv = np.linalg.inv(K) if len(mu0) else np.zeros((0, 0))
         self._alpha = self._Kinv @ (np.log(self.observed) - mu0)
 
     def _prior_cov(self, Za: np.ndarray, sa: np.ndarray, Zb: np.ndarray, sb: np.ndarray) -> np.ndarray:
@@ -193,11 +193,12 @@ class CalibratedSurface(ResponseSurface):
         mu0 = ca.log(value0)
         s0 = (ca.log(hi0) - mu0) / self.t95
         sg = ca.sqrt(ca.fmax(s0**2 - self.noise**2, 0.25 * s0**2))
-        z = ca.vertcat(*_coded_symbolic(x))
-        d2 = ca.sum1((ca.repmat(z, 1, len(self._Zu)) - ca.DM(self._Zu.T)) ** 2).T
-        c = self.printer_sd**2 + sg * ca.DM(self._sgu) * ca.exp(-0.5 * d2 / self.length**2)
-        var = s0**2 + self.printer_sd**2 - ca.bilin(ca.DM(self._Kinv), c, c)
-        mu = mu0 + ca.dot(c, ca.DM(self._alpha))
+        var, mu = s0**2 + self.printer_sd**2, mu0
+        if len(self._Zu):
+            z = ca.vertcat(*_coded_symbolic(x))
+            d2 = ca.sum1((ca.repmat(z, 1, len(self._Zu)) - ca.DM(self._Zu.T)) ** 2).T
+            c = self.printer_sd**2 + sg * ca.DM(self._sgu) * ca.exp(-0.5 * d2 / self.length**2)
+            var, mu = var - ca.bilin(ca.DM(self._Kinv), c, c), mu + ca.dot(c, ca.DM(self._alpha))
         half = self.t95 * ca.sqrt(ca.fmax(var, self.noise**2))
         out = [ca.exp(mu), ca.exp(mu - half), ca.exp(mu + half)]
         return ca.Function(self.response, [x], out, ["x"], ["value", "lo", "hi"])
@@ -254,6 +255,28 @@ def _runs_table(runs: Any, surrogate: Surrogate) -> Any:
     return table
 
 
+def new_printer(surrogate: Surrogate, *, printer_sd: float = PRINTER_SD) -> Surrogate:
+    """The study surrogate as a prior for a printer not measured yet: every response carries the
+    printer factor's uncertainty (no run, so no correction). What a user's first print should expect;
+    `calibrate` with runs continues from it."""
+    if surrogate.calibration is not None:
+        return surrogate
+    import pandas as pd
+
+    models = {
+        r: CalibratedSurface.from_base(base, np.zeros((0, 6)), np.zeros(0), 1.0, noise_of(base), printer_sd)
+        for r, base in surrogate.models.items()
+    }
+    empty = pd.DataFrame(columns=list(space.FACTOR_NAMES) + surrogate.responses, dtype=float)
+    return Surrogate(
+        models=models,
+        table_hash=surrogate.table_hash,
+        training=surrogate.training,
+        prior=surrogate,
+        calibration={"table": empty, "printer_sd": printer_sd},
+    )
+
+
 def calibrate(surrogate: Surrogate, runs: Any, *, printer_sd: float = PRINTER_SD) -> Surrogate:
     """The study surrogate updated by a user's measured runs: a printer factor and a local correction.
 
@@ -281,7 +304,7 @@ def calibrate(surrogate: Surrogate, runs: Any, *, printer_sd: float = PRINTER_SD
         raise DesignerError(f"printer_sd={printer_sd} must be positive", "give e.g. printer_sd=0.3")
     prior = surrogate.prior if surrogate.calibration else surrogate
     table = _runs_table(runs, prior)
-    if prior is not surrogate:
+    if prior is not surrogate and len(surrogate.calibration["table"]):
         import pandas as pd
 
         table = pd.concat([surrogate.calibration["table"], table], ignore_index=True)
@@ -296,7 +319,8 @@ def calibrate(surrogate: Surrogate, runs: Any, *, printer_sd: float = PRINTER_SD
             continue
         noise = noise_of(base)
         length = _length_of(base, X_study, np.asarray(prior.training[r], dtype=float), noise)
-        designs = table.loc[rows, list(space.FACTOR_NAMES)].to_numpy(dtype=float)
+        printed = _as_printed({n: table.loc[rows, n].to_numpy(dtype=float) for n in space.FACTOR_NAMES})
+        designs = np.column_stack([printed[n] for n in space.FACTOR_NAMES])
         observed = table.loc[rows, r].to_numpy(dtype=float)
         models[r] = CalibratedSurface.from_base(base, designs, observed, length, noise, printer_sd)
     keep = list(space.FACTOR_NAMES) + [r for r in prior.responses if r in table.columns]

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from . import space
-from .calibration import calibrate
+from .calibration import calibrate, new_printer
 from .errors import DesignerError
 from .suggestions import DISTINCT, TOLERANCE, Candidate, _distance, probability_within, suggest
 from .surrogate import Prediction, Surrogate
@@ -207,6 +207,13 @@ def next_prints(
         raise DesignerError(f"n={n} is not a whole number from 1 to 10", "give e.g. n=3")
     if not 0 < stop <= 1:
         raise DesignerError(f"stop={stop} is not in (0, 1]", "give e.g. stop=0.9")
+    statements = []
+    if surrogate.calibration is None:
+        surrogate = new_printer(surrogate)
+        statements.append(
+            "not calibrated to your printer yet: P includes its unknown printer/material factor "
+            "(suggest states P for the study's own printer)"
+        )
     sug = suggest(surrogate, k=k, c=c, axis=axis, fixed=fixed, top=POOL, tolerance=tolerance)
     targets = _predictable_targets(sug)
     if not targets:
@@ -223,7 +230,7 @@ def next_prints(
             f"print design #1: it lands within +-{100 * tolerance:g} % with probability {p_now:.2f} "
             f"(>= {stop:g}); no other print is expected to do better first"
         )
-        return NextPrints(axis, goals, tolerance, best, p_now, True, [], p_now, [text])
+        return NextPrints(axis, goals, tolerance, best, p_now, True, [], p_now, statements + [text])
     pool_designs = [c.params for c in sug.candidates]
     pool = {name: np.array([d[name] for d in pool_designs]) for name in space.FACTOR_NAMES}
     spans = {f.name: f.high - f.low for f in space.CONTINUOUS}
@@ -253,7 +260,7 @@ def next_prints(
             )
         )
     p_after = _batch_p(surrogate, scorer, [p.params for p in chosen], pool)
-    statements = [
+    statements += [
         f"the best design now lands within +-{100 * tolerance:g} % with probability {p_now:.2f}; "
         f"after printing and measuring these {len(chosen)}, the best is expected to land with {p_after:.2f}",
         "then: add the measured coefficients to your runs table, designer calibrate, designer next again",

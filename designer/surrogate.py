@@ -712,7 +712,7 @@ class Surrogate:
         """
         if not self.models:
             raise DesignerError("the surrogate is not fitted", "call fit(table) or Surrogate.load() first")
-        X = _check_designs(designs, allow_extrapolation)
+        X = _as_printed(_check_designs(designs, allow_extrapolation))
         return {r: self.model(r).predict(X) for r in (responses or self.responses)}
 
     def _payload_json(self, include_id: bool = True) -> str:
@@ -848,6 +848,13 @@ def _check_varied(X: Mapping[str, np.ndarray]) -> None:
                 "cannot be estimated",
                 f"add runs at other {f.name} values ({f.describe_range()}), or fit a table that varies it",
             )
+
+
+def _as_printed(X: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Designs as printed: where the walls fill the section (width or height <= 2.0 mm) the infill
+    has no effect and the part is solid, so it is predicted at 100 % whatever the nominal infill."""
+    core = np.minimum(X["width"], X["height"]) - 2 * space.WALL_MM
+    return X | {"density": np.where(core > space.NOZZLE_MM + 1e-9, X["density"], 100.0)}
 
 
 def _check_designs(designs: Any, allow_extrapolation: bool) -> dict[str, np.ndarray]:

@@ -50,7 +50,8 @@ def test_one_run_at_a_study_design_moves_the_prediction_by_the_models_amount(stu
     # the model (calibration.py's docstring): log y = mu0 + b + g + e, with b ~ N(0, tau^2), g of
     # variance s0^2 - sigma_n^2 at the run, e ~ N(0, sigma_n^2): one run's residual d moves the
     # prediction there by (tau^2 + sg^2) / (tau^2 + sg^2 + sigma_n^2) * d, in log space
-    run = _rows(table, [10], scale=0.7)
+    run = _rows(table, [12], scale=0.7)
+    assert run["width"][0] > 2  # a hollow section: the design is predicted as given
     base = study.model("k_x")
     p0 = base.predict(run[FACTORS]).at(0)
     s0 = (math.log(p0.high) - math.log(p0.value)) / base.t95
@@ -104,7 +105,8 @@ def test_save_load_and_recalibration_are_the_same_surrogate(study, table, tmp_pa
 def test_casadi_function_equals_predict(study, table):
     cal = designer.calibrate(study, _rows(table, [5, 6], scale=1.3))
     f = cal.model("k_x").casadi_function()
-    for i in (0, 5, 17):
+    hollow = np.flatnonzero(table["width"].to_numpy() > 2)  # predicted as given (thin: as solid)
+    for i in hollow[[0, 7, 20]]:
         p = cal.predict(table.iloc[[i]][FACTORS])["k_x"].at(0)
         v, lo, hi = (float(x) for x in f(table.iloc[i][FACTORS].to_numpy(dtype=float)))
         assert (v, lo, hi) == pytest.approx((p.value, p.low, p.high), rel=1e-12)
@@ -191,3 +193,22 @@ def test_cli_calibrate_bad_input(tmp_path, capsys, content, words):
     assert_clean_failure(code, err, allowed=(2,))
     assert words in err
     assert not (tmp_path / "o.json").exists()
+
+
+def test_a_new_printer_widens_every_interval_by_the_printer_factor(study, table):
+    from designer.calibration import PRINTER_SD, new_printer
+
+    fresh = new_printer(study)
+    X = table[FACTORS].iloc[:5]
+    a, b = study.predict(X)["k_x"], fresh.predict(X)["k_x"]
+    np.testing.assert_allclose(a.value, b.value, rtol=1e-12)
+    s_study = np.log(a.high / a.value) / study.model("k_x").t95
+    s_fresh = np.log(b.high / b.value) / study.model("k_x").t95
+    np.testing.assert_allclose(s_fresh**2, s_study**2 + PRINTER_SD**2, rtol=1e-9)
+    # and calibrating it continues from the study, as calibrating the study does
+    runs = _rows(table, [1, 2])
+    np.testing.assert_allclose(
+        designer.calibrate(fresh, runs).predict(X)["k_x"].value,
+        designer.calibrate(study, runs).predict(X)["k_x"].value,
+        rtol=1e-12,
+    )
