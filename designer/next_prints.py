@@ -1,10 +1,10 @@
 """The next prints: which designs to print and measure now so the recommendation lands on target.
 
-Criterion (a knowledge gradient on the product's answer): for a candidate print x, the value of
-measuring it is the expected probability that the best recommendation *after* the measurement lands
-within the tolerance of every predictable target,
+Criterion (a knowledge gradient on the product's answer): for a candidate print x (one of the
+search's near-target designs), the value of printing it is the chance of holding a joint within the
+tolerance of every predictable target after it and the recommendation that follows:
 
-    KG(x) = E_y[ max_r P(r within tolerance | runs + (x, y)) ],
+    V(x) = P(x lands) + P(x misses) E_y[ max_r P(r within tolerance | runs + (x, y)) | x missed ],
 
 with y drawn from the calibrated surrogate's predictive distribution at x (Gauss-Hermite quadrature
 in log space) and r over the current search's candidate designs. Several prints are chosen greedily:
@@ -29,7 +29,7 @@ from .suggestions import DISTINCT, TOLERANCE, Candidate, _distance, probability_
 from .surrogate import Prediction, Surrogate
 
 #: quadrature nodes of the fantasised measurement
-NODES = 5
+NODES = 9
 #: candidate designs searched for the prints and for the recommendation after them
 POOL = 8
 #: joint draws of the batch's measurements for the expected P after it
@@ -95,6 +95,12 @@ class _Scorer:
         #: what a print measures: both coefficients of the axis
         self.measured = [f"{q}_{axis}" for q in ("k", "c")]
 
+    def lands(self, values: Mapping[str, float]) -> bool:
+        """Whether measured values (by response name) are within the tolerance of every target."""
+        return all(
+            abs(values[f"{q}_{self.axis}"] / t - 1.0) <= self.tolerance for q, t in self.targets.items()
+        )
+
     def best(self, surrogate: Surrogate, designs: Mapping[str, np.ndarray]) -> float:
         preds = surrogate.predict(designs, responses=self.responses, allow_extrapolation=True)
         n = len(next(iter(designs.values())))
@@ -131,19 +137,28 @@ def _with_runs(surrogate: Surrogate, runs: list[dict[str, float]]) -> Surrogate:
 def _expected_best(
     surrogate: Surrogate, scorer: _Scorer, design: dict[str, float], known: list[dict[str, float]], pool: Any
 ) -> float:
-    """KG of printing `design` after the `known` (fantasised) runs: quadrature over its measurement."""
+    """Chance of holding a joint that lands after printing `design` and then the best recommendation
+    (after the `known`, fantasised, runs): P(design lands) + P(it misses) E[best P | it missed].
+
+    The measurement is integrated by Gauss-Hermite quadrature in log space; the nodes where the
+    print lands are left out of the second term's average (renormalised over the missing nodes).
+    """
     base = _with_runs(surrogate, known)
+    p_lands = scorer.best(base, {n: np.array([design[n]]) for n in space.FACTOR_NAMES})
     nodes, weights = np.polynomial.hermite_e.hermegauss(NODES)
     weights = weights / weights.sum()
     moments = {r: _log_predictive(base, r, design) for r in scorer.measured}
-    total = 0.0
-    for z, w in zip(nodes, weights, strict=True):
+    best, missed = [], []
+    for z in nodes:
         # the targeted responses at the quadrature node, the others at their median
         values = {
             r: float(np.exp(mu + (z * s if r in scorer.responses else 0.0))) for r, (mu, s) in moments.items()
         }
-        total += w * scorer.best(_with_runs(surrogate, known + [_run(design, values)]), pool)
-    return total
+        best.append(scorer.best(_with_runs(surrogate, known + [_run(design, values)]), pool))
+        missed.append(not scorer.lands(values))
+    miss = weights * np.array(missed, dtype=float)
+    after_miss = float(miss @ best / miss.sum()) if miss.sum() > 0 else float(weights @ best)
+    return p_lands + (1.0 - p_lands) * after_miss
 
 
 def _batch_p(surrogate: Surrogate, scorer: _Scorer, designs: list[dict[str, float]], pool: Any) -> float:
