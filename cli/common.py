@@ -145,6 +145,9 @@ FLAGS: tuple[tuple[str, str], ...] = (
     (r"\ballow_extrapolation=True\b", "--allow-extrapolation"),
     (r"\btop=", "--top "),
     (r"\bk= and/or c=", "--k and/or --c"),
+    (r"\bgive k= a target value", "give --k a target value"),
+    (r"\bn=(?=\S+ is not a whole number)", "--n "),
+    (r"\bstop=(?=\S+ is not in)", "--stop "),
     (r"\btargets=\{'k': 0\.8\}", "--target k=0.8"),
     # export mjcf/urdf/sdf/modelica/ssp
     (r"\binto=", "--into "),

@@ -97,7 +97,8 @@ def next_(
     Each proposed print is chosen for how much measuring it raises the chance that the best design
     afterwards lands within --tolerance of the targets (a knowledge gradient), among printable
     designs near the target. When the current best already lands with probability --stop or more,
-    it says to print design #1 and proposes nothing else.
+    it says to print design #1 and proposes nothing else. Exit 1 when the target is out of reach
+    (the reason is printed, no print is proposed), 2 on bad input.
 
     Example: designer next --k 0.8 --n 3 --surrogate mine.json
     """
@@ -116,8 +117,10 @@ def next_(
     data = result.to_dict()
     if as_json:
         print_json(data)
-        return
-    _print_next(data)
+    else:
+        _print_next(data)
+    if not data["reachable"]:
+        raise typer.Exit(1)
 
 
 def _design(params: dict) -> str:

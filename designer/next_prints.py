@@ -71,6 +71,8 @@ class NextPrints:
     prints: list[NextPrint]
     p_after: float  # expected P of the best recommendation once `prints` are measured
     statements: list[str] = field(default_factory=list)
+    #: False when no design's prediction reaches a target within the tolerance (then no print)
+    reachable: bool = True
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -83,6 +85,7 @@ class NextPrints:
             "p_after": self.p_after,
             "prints": [p.to_dict() for p in self.prints],
             "statements": self.statements,
+            "reachable": self.reachable,
         }
 
 
@@ -216,12 +219,13 @@ def next_prints(
 
     Raises:
         DesignerError: the goals of `designer.suggest` are invalid, no predictable target value is
-            given, n is not in 1..10, or stop is not in (0, 1].
+            given, n is not in 1..10, or stop is not in (0, 1]. An unreachable target is not an
+            error: the result has `reachable` False, the reason in `statements`, and no print.
     """
     if not 1 <= int(n) <= 10 or int(n) != n:
-        raise DesignerError(f"n={n} is not a whole number from 1 to 10", "give e.g. n=3")
+        raise DesignerError(f"n={n} is not a whole number from 1 to 10", "give a whole number such as 3")
     if not 0 < stop <= 1:
-        raise DesignerError(f"stop={stop} is not in (0, 1]", "give e.g. stop=0.9")
+        raise DesignerError(f"stop={stop} is not in (0, 1]", "give a probability such as 0.9")
     statements = []
     if surrogate.calibration is None:
         surrogate = new_printer(surrogate)
@@ -240,6 +244,11 @@ def next_prints(
     best = sug.candidates[0]
     p_now = float(best.p_within or 0.0)
     goals = {q: (t.value if t.kind == "target" else t.kind) for q, t in sug.targets.items()}
+    if not sug.reachable:
+        statements += [st for st in sug.statements if "distinct design" not in st] + [
+            "no print is proposed: the target lies outside what the data supports (see above)"
+        ]
+        return NextPrints(axis, goals, tolerance, best, p_now, False, [], p_now, statements, False)
     if p_now >= stop:
         text = (
             f"print design #1: it lands within +-{100 * tolerance:g} % with probability {p_now:.2f} "

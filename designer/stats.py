@@ -51,7 +51,28 @@ def _responses(table: pd.DataFrame, responses: list[str] | None, *, fit: bool = 
     dof = len(table) - len(space.FACTOR_NAMES) - 1
     if fit and dof < 1:
         raise DesignerError(f"{len(table)} runs leave no error degrees of freedom", "give at least 8 runs")
+    if fit:
+        _check_estimable(table)
     return cols
+
+
+def _check_estimable(table: pd.DataFrame) -> None:
+    """Raise when the first-order model of the six factors cannot be estimated from the table's runs:
+    a factor that never changes, or factors that change together (the covariance is singular)."""
+    for f in space.FACTORS:
+        values = np.unique(table[f.name].to_numpy(dtype=float))
+        if len(values) == 1:
+            raise DesignerError(
+                f"factor {f.name} is {values[0]:g} {f.unit} in every run, so its effect cannot be estimated",
+                f"add runs at other {f.name} values ({f.describe_range()})",
+            )
+    X = np.column_stack([np.ones(len(table))] + [table[n].to_numpy(dtype=float) for n in space.FACTOR_NAMES])
+    X = X / np.maximum(np.abs(X).max(axis=0), 1e-300)
+    if np.linalg.matrix_rank(X) < X.shape[1]:
+        raise DesignerError(
+            "the factors of the table change together, so their effects cannot be told apart",
+            "add runs that vary the factors independently (designer doe plans such runs)",
+        )
 
 
 def anova(table: pd.DataFrame, response: str) -> pd.DataFrame:
@@ -74,7 +95,14 @@ def manova(table: pd.DataFrame, responses: list[str] | None = None) -> list[dict
     cols = _responses(table, responses)
     if len(cols) < 2:
         return []
-    result = MANOVA.from_formula(f"{' + '.join(cols)} ~ {_RHS}", data=table).mv_test()
+    try:
+        result = MANOVA.from_formula(f"{' + '.join(cols)} ~ {_RHS}", data=table).mv_test()
+    except (ValueError, np.linalg.LinAlgError) as exc:
+        raise DesignerError(
+            f"the MANOVA of {', '.join(cols)} cannot be computed: their residuals are linearly dependent "
+            f"({exc})",
+            "check the table for a response column copied from, or proportional to, another",
+        ) from None
     rows = []
     for source, res in result.results.items():
         for name, row in res["stat"].iterrows():

@@ -142,14 +142,19 @@ def test_next_prints_proposes_distinct_printable_designs_and_stops_when_sure(stu
     assert sure.stop and sure.prints == [] and sure.p_now >= 0.9
 
 
-def test_cli_calibrate_and_next(tmp_path, capsys, table):
+@pytest.mark.parametrize("rows", [[12], [3, 10, 20], list(range(1, 41, 4))])
+def test_cli_calibrate_and_next(tmp_path, capsys, table, rows):
     runs = tmp_path / "mine.csv"
-    _rows(table, [3, 10, 20], scale=0.8).to_csv(runs, index=False)
+    _rows(table, rows, scale=0.8).to_csv(runs, index=False)
     out = tmp_path / "mine.json"
     code, stdout, err = run_inprocess(["calibrate", runs, "-o", out, "--json"], capsys)
     assert code == 0, err
     rep = json.loads(stdout)
-    assert rep["n_runs"] == 3 and rep["responses"]["k_x"]["loo_user"]["n"] == 3
+    assert rep["n_runs"] == len(rows)
+    loo = rep["responses"]["k_x"]["loo_user"]
+    assert (loo is None) if len(rows) == 1 else loo["n"] == len(rows)
+    factor = rep["responses"]["k_x"]["printer_factor"]
+    assert factor["low"] < factor["value"] < factor["high"]
     code, stdout, err = run_inprocess(
         ["next", "--k", "0.8", "--n", "2", "--surrogate", out, "--json"], capsys
     )
