@@ -94,7 +94,15 @@ def parse_fix(
 
 
 # piped output is not cut at rich's 80-column default: numbers must never be truncated
-console = Console(highlight=False, width=None if sys.stdout.isatty() else 120)
+class _Console(Console):
+    """rich's console, except that a closed stdout raises BrokenPipeError (rich exits 1 there): the
+    one error path (`main.run`) ends such a command quietly with exit 0, as SIGPIPE would."""
+
+    def on_broken_pipe(self) -> None:
+        raise BrokenPipeError
+
+
+console = _Console(highlight=False, width=None if sys.stdout.isatty() else 120)
 err_console = Console(stderr=True, highlight=False)
 
 

@@ -163,6 +163,8 @@ def _run(args: list[str], debug: bool) -> int:
         return _fail(exc.format_message(), f"see {where}", 2)
     except DesignerError as exc:
         return _fail(flag_message(exc.problem), exc.fix and flag_message(exc.fix), 2)
+    except BrokenPipeError:
+        return _closed_stdout()
     except MemoryError:
         return _fail("out of memory", "ask for a smaller run (shorter, coarser, fewer cases)", 2)
     except OSError as exc:
@@ -171,6 +173,15 @@ def _run(args: list[str], debug: bool) -> int:
         return _fail(*_os_message(exc), 2)
     except Exception as exc:  # noqa: BLE001 - the one place that turns any bug into exit 3
         return _internal(exc, debug)
+
+
+def _closed_stdout() -> int:
+    """The reader of our output has gone (`designer ... | head`): a normal end for a command line, as
+    with SIGPIPE's default action. Later writes and the exit flush go to /dev/null; exit 0."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
+    os.close(devnull)
+    return 0
 
 
 def _internal(exc: BaseException, debug: bool) -> int:
@@ -185,7 +196,10 @@ def main() -> None:
     for s in _signals():
         signal.signal(s, _stop)
     code = run()
-    sys.stdout.flush()
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        code = _closed_stdout()
     sys.exit(code)
 
 

@@ -173,3 +173,17 @@ def test_validate_exit_1_when_a_check_fails_3_when_it_crashes(tmp_path, monkeypa
     code, out, err = run_inprocess(["validate", "-o", "rep"], capsys)
     assert code == 3 and "internal error: RuntimeError: the report itself broke" in err
     assert snapshot(tmp_path) == before, "the old report stays whole, no staging folder left"
+
+
+def test_a_closed_stdout_ends_quietly_with_exit_0(tmp_path):
+    """`designer ... | head -1`: the reader goes away before the output is written (SIGPIPE's default)."""
+    import subprocess
+
+    from clitools import CLI
+
+    for args in (["suggest", "--k", "0.8"], ["suggest", "--k", "0.8", "--json"]):
+        proc = subprocess.Popen([*CLI, *args], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        proc.stdout.close()  # closed before the command writes anything
+        err = proc.stderr.read().decode()
+        assert proc.wait(timeout=120) == 0, err
+        assert err == "", err
