@@ -21,8 +21,26 @@ export_app = typer.Typer(
     help="Export a joint: FMU (FMI 2/3), Modelica, MJCF, URDF, SDF or SSP.", no_args_is_help=True
 )
 
-Floats = Annotated[list[float] | None, typer.Option(show_default=False)]  # noqa: UP007 (typer needs Optional)
-Number = Annotated[float | None, typer.Option(show_default=False)]  # noqa: UP007
+
+def _floats(text: str) -> Any:
+    """A repeatable coefficient option (one value per --axis), rig units, with its help."""
+    return Annotated[list[float] | None, typer.Option(show_default=False, help=text)]  # noqa: UP007
+
+
+def _number(text: str) -> Any:
+    """A print-setting option with its help (the study's units and tested range)."""
+    return Annotated[float | None, typer.Option(show_default=False, help=text)]  # noqa: UP007
+
+
+K = _floats("stiffness k per --axis: N/mm (N.mm/rad rotational)")
+C = _floats("damping c per --axis: N.s/mm (N.mm.s/rad rotational)")
+M = _floats("moving mass m per --axis: kg (kg.m^2 rotational)")
+DENSITY = _number("infill density, % (20-100): predict k and c from the print settings")
+LENGTH = _number("length l, mm (18-30)")
+WIDTH = _number("width b, mm (2-7)")
+HEIGHT = _number("height h, mm (4-14)")
+LAYER = _number("layer thickness, mm (0.12, 0.16 or 0.2)")
+RASTER = _number("raster angle, deg (0 or 45)")
 
 
 def _joint(
@@ -109,15 +127,15 @@ def _snippet(
         axis: Annotated[
             list[str] | None, typer.Option(help="x y z theta phi psi; repeat for several")
         ] = None,  # noqa: UP007
-        k: Floats = None,
-        c: Floats = None,
-        m: Floats = None,
-        density: Number = None,
-        length: Number = None,
-        width: Number = None,
-        height: Number = None,
-        layer: Number = None,
-        raster: Number = None,
+        k: K = None,
+        c: C = None,
+        m: M = None,
+        density: DENSITY = None,
+        length: LENGTH = None,
+        width: WIDTH = None,
+        height: HEIGHT = None,
+        layer: LAYER = None,
+        raster: RASTER = None,
         from_: Annotated[
             Path | None, typer.Option("--from", help="output of designer suggest --json")
         ] = None,  # noqa: UP007

@@ -43,3 +43,24 @@ def test_every_command_prints_json_and_shows_an_example():
         flags = {opt for p in cmd.params for opt in getattr(p, "opts", [])}
         assert "--json" in flags, f"{path} has no --json"
         assert "Example: designer" in (cmd.help or ""), f"{path} --help has no example"
+
+
+def test_every_option_and_argument_has_help():
+    """A newcomer reads `--help`: no option or argument of any command may be left without text."""
+    import typer.main
+    from designer_cli.main import app
+
+    def commands(cmd, path):
+        if hasattr(cmd, "commands"):
+            for name, sub in cmd.commands.items():
+                yield from commands(sub, [*path, name])
+        else:
+            yield " ".join(path), cmd
+
+    bare = [
+        (path, param.name)
+        for path, cmd in commands(typer.main.get_command(app), ["designer"])
+        for param in cmd.params
+        if not (getattr(param, "help", None) or "").strip() and "--help" not in getattr(param, "opts", [])
+    ]
+    assert not bare, f"without help: {bare}"
