@@ -97,7 +97,10 @@ def one_shot(study, printer, goals, fixed, rng, cache, stated):
 def augment(study, table, printer, goals, fixed, rng, max_prints):
     runs, count, surrogate = pd.DataFrame(), 0, study
     while count < max_prints:
-        plan, _ = plan_next(surrogate, n=3, targets={"k": goals["k"]})
+        try:
+            plan, _ = plan_next(surrogate, n=3, targets={"k": goals["k"]})
+        except designer.DesignerError:  # the refitted model no longer reaches the target
+            return max_prints + 1
         designs = plan[list(truth.FACTORS)].to_dict("records")
         printed = printer.prints(pd.DataFrame(designs), rng)
         runs = pd.concat([runs, printed], ignore_index=True)

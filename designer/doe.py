@@ -94,6 +94,10 @@ def printable_grid() -> pd.DataFrame:
     )
 
 
+#: a target this far (relative) beyond the predicted range of printable designs is out of reach
+REACH = 0.10
+
+
 def near_target(
     predict: Callable[[pd.DataFrame], Mapping[str, np.ndarray]],
     target: Mapping[str, float],
@@ -106,6 +110,15 @@ def near_target(
     for resp, value in target.items():
         if value <= 0:
             raise DesignerError(f"target {resp} = {value:g}", "give a positive target")
+    for resp, value in target.items():
+        lo, hi = float(np.min(pred[resp])), float(np.max(pred[resp]))
+        # a response the model cannot predict (the same value everywhere) has no reach to test
+        if hi > lo * (1 + 1e-9) and not lo * (1 - REACH) <= value <= hi * (1 + REACH):
+            raise DesignerError(
+                f"target {resp} = {value:g} is outside what printable designs are predicted to reach "
+                f"({lo:.3g} to {hi:.3g})",
+                "give a target inside that range, or augment without a target to narrow the model everywhere",
+            )
     dist = sum(np.log(np.maximum(pred[r], 1e-300) / v) ** 2 for r, v in target.items())
     count = max(5, int(round(fraction * len(cand))))
     return cand.iloc[np.argsort(dist)[:count]].reset_index(drop=True)

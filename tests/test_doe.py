@@ -134,3 +134,15 @@ def test_cli_augment_with_the_shipped_surrogate(tmp_path):
     assert set(doc["pi_narrowing"]) == set(Surrogate.load().responses)
     k = doc["pi_narrowing"]["k_x"]
     assert k["half_width_after"] < k["half_width_before"]
+
+
+def test_augment_toward_an_unreachable_target_is_refused(tmp_path):
+    """`doe --augment 3 --k 50`: no printable design is predicted near 50 N/mm; say so, write nothing."""
+    import subprocess
+
+    out = tmp_path / "next.csv"
+    run = subprocess.run(
+        [*CLI, "doe", "--augment", "3", "--k", "50", "-o", out], capture_output=True, text=True
+    )
+    assert run.returncode == 2 and "outside what printable designs are predicted to reach" in run.stderr
+    assert len(run.stderr.strip().splitlines()) == 1 and not out.exists()
