@@ -15,6 +15,9 @@ HUB_AMPLITUDE = 1.0
 F0 = 0.2
 F1 = 1.85
 SWEEP = 2200.0
+#: samples per period of the highest frequency a log or a co-simulation must carry (identification
+#: needs the same: below it the chirp's top is aliased or too coarse to differentiate)
+SAMPLES_PER_PERIOD = 10
 
 
 @dataclass(frozen=True)
@@ -34,6 +37,24 @@ class Chirp:
         s, c = np.sin(phase), np.cos(phase)
         a = self.amplitude
         return a * s, a * omega * c, a * (2 * np.pi * rate * c - omega**2 * s)
+
+    def check_sampling(self, rate: float, *, what: str = "rate") -> None:
+        """Raise DesignerError unless sampling at `rate` (Hz) carries the whole chirp.
+
+        The sampling theorem allows frequencies up to rate / 2; differentiating and identifying the
+        motion needs SAMPLES_PER_PERIOD samples per period of the highest one.
+        """
+        from .errors import DesignerError
+
+        top = max(self.f0, self.f1)
+        if rate < SAMPLES_PER_PERIOD * top:
+            aliased = "is aliased" if top >= rate / 2 else "is sampled too coarsely"
+            raise DesignerError(
+                f"the chirp's {top:g} Hz {aliased} at {what} = {rate:g} Hz (the sampling theorem allows "
+                f"up to {rate / 2:g} Hz; identification needs {SAMPLES_PER_PERIOD} samples per period)",
+                f"lower f0/f1 below {rate / SAMPLES_PER_PERIOD:g} Hz or sample at {SAMPLES_PER_PERIOD * top:g} Hz "
+                "or more",
+            )
 
     def __call__(self, t: float) -> tuple[float, float]:
         """The angle and its rate at time `t`, as a motor reference (rad, rad/s)."""

@@ -173,3 +173,25 @@ def test_clean_drops_sensor_failures_and_dbscan_noise_with_reasons():
     # looser clustering keeps every valid run but the far one
     loose = clean(raw, eps=3.0, min_samples=3)
     assert list(loose.dropped["row"]) == [3, 6, 8]
+
+
+@pytest.mark.parametrize("f1, rate", [(900.0, 1000.0), (60.0, 500.0)])
+def test_a_chirp_the_sampling_cannot_carry_is_refused(f1, rate):
+    """Aliased (f1 above rate / 2) or too coarse to differentiate (under 10 samples per period)."""
+    from designer.rig.simulate import simulate
+
+    with pytest.raises(DesignerError, match="sampling theorem"):
+        simulate({"x": {"m": 0.001, "c": 2e-3, "k": 0.8}}, duration=10.0, rate=rate, f1=f1)
+    Chirp(f1=f1).check_sampling(10 * f1)  # 10 samples per period is enough
+
+
+def test_a_rig_scenario_whose_step_aliases_the_chirp_is_refused(tmp_path):
+    from pathlib import Path
+
+    from designer import cosim
+
+    text = (Path(__file__).parents[1] / "examples" / "rig.toml").read_text()
+    bad = tmp_path / "rig.toml"
+    bad.write_text(text.replace("f1 = 1.85", "f1 = 1e6", 1))
+    with pytest.raises(DesignerError, match="aliased at 1 / step = 1000 Hz"):
+        cosim.load(bad)

@@ -172,6 +172,7 @@ class Scenario:
             )
         if self.hub is None:
             object.__setattr__(self, "hub", Chirp())
+        self.hub.check_sampling(1.0 / self.step, what="1 / step")
         if self.factors is not None:
             from .. import space
 

@@ -73,6 +73,7 @@ def simulate(
         _check("dropouts", dropouts, False),
     )
     _check("f0", f0), _check("f1", f1)
+    Chirp(1.0, f0, f1, duration).check_sampling(rate)
     if dropouts >= 0.5:
         raise DesignerError(f"dropouts = {dropouts:g} is too large", "give a fraction below 0.5, e.g. 0.001")
     if not coefficients:
