@@ -52,8 +52,8 @@ class Chirp:
             raise DesignerError(
                 f"the chirp's {top:g} Hz {aliased} at {what} = {rate:g} Hz (the sampling theorem allows "
                 f"up to {rate / 2:g} Hz; identification needs {SAMPLES_PER_PERIOD} samples per period)",
-                f"lower f0/f1 below {rate / SAMPLES_PER_PERIOD:g} Hz or sample at {SAMPLES_PER_PERIOD * top:g} Hz "
-                "or more",
+                f"lower f0/f1 below {rate / SAMPLES_PER_PERIOD:g} Hz "
+                f"or sample at {SAMPLES_PER_PERIOD * top:g} Hz or more",
             )
 
     def __call__(self, t: float) -> tuple[float, float]:
