@@ -322,3 +322,42 @@ def test_joint_parameters_from_an_ssv_file(tmp_path):
     sc = load(write(tmp_path, text))
     assert sc.joints["j1"].parameters["theta.k"] == pytest.approx(0.66)  # N.mm/rad in the SSV's units -> SI
     assert run(sc).laws["j1"]["k"] == pytest.approx(0.66)
+
+
+def test_a_refused_parameter_names_the_joint_and_leaves_no_temporary_folder(tmp_path, monkeypatch):
+    """A negative k override: the FMU refuses it; one DesignerError naming joint and parameter, and
+    neither the exported FMUs nor their unpacked archives stay in the temporary folder."""
+    import tempfile
+
+    from designer import cosim
+    from designer.errors import DesignerError
+
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    monkeypatch.setenv("TMPDIR", str(scratch))
+    monkeypatch.setattr(tempfile, "tempdir", None)  # re-read TMPDIR
+    spec = tmp_path / "neg.toml"
+    spec.write_text(
+        textwrap.dedent(
+            """
+            [simulation]
+            duration = 0.1
+            step = 1e-3
+            [robot]
+            model = "arm"
+            lengths = [0.08, 0.06]
+            masses = [0.03, 0.02]
+            [joints.j1]
+            axis = "theta"
+            coefficients = { k = 330, c = 0.83 }
+            parameters = { "theta.k" = -5.0 }
+            [joints.j2]
+            axis = "theta"
+            coefficients = { k = 330, c = 0.83 }
+            """
+        )
+    )
+    with pytest.raises(DesignerError) as err:
+        cosim.run(cosim.load(spec))
+    assert "joint j1" in err.value.problem and "theta.k = -5" in err.value.problem
+    assert list(scratch.iterdir()) == []

@@ -155,14 +155,41 @@ class FmuSystem:
         self._needs_cis = me and md.modelExchange.needsCompletedIntegratorStep
         self._dir = extract(str(path))
         self.log: deque[str] = deque(maxlen=LOG_LINES)
-        self.fmu = self._instantiate(md, name, me)
-        refs = {v.name: v.valueReference for v in md.modelVariables}
-        for key, value in (parameters or {}).items():
-            if key not in refs:
-                raise DesignerError(f"FMU {path} has no parameter '{key}'", "use names such as theta.k")
-            self._set_scalar(refs[key], float(value))
-        self._initialize(me)
-        self._bind(refs)
+        try:
+            self.fmu = self._instantiate(md, name, me)
+            refs = {v.name: v.valueReference for v in md.modelVariables}
+            for key, value in (parameters or {}).items():
+                if key not in refs:
+                    raise DesignerError(f"FMU {path} has no parameter '{key}'", "use names such as theta.k")
+                self._set_scalar(refs[key], float(value))
+            self._initialize(me)
+            self._bind(refs)
+        except BaseException as exc:  # a half-built instance frees what it holds, then reports
+            self._abandon()
+            self._refused(exc, name, parameters or {})
+            raise
+
+    def _refused(self, exc: BaseException, name: str, parameters: Mapping[str, float]) -> None:
+        """Raise a DesignerError naming the joint and its parameters when the FMU refused to start
+        (fmpy's exception for a status above Warning, with the FMU's own log)."""
+        from fmpy.fmi1 import FMICallException
+
+        if isinstance(exc, FMICallException):
+            given = ", ".join(f"{k} = {v:g}" for k, v in parameters.items()) or "its exported values"
+            log = "; ".join(self.log) or "the FMU logged nothing"
+            raise DesignerError(
+                f"joint {name}: the FMU refused to start with {given} ({exc.function}: {log})",
+                "give physical values (k > 0, c >= 0, m >= 0, in SI) in the joint's parameters",
+            ) from None
+
+    def _abandon(self) -> None:
+        """Free a partly built instance and remove its unpacked archive (construction failed)."""
+        fmu = getattr(self, "fmu", None)
+        if fmu is not None:
+            with contextlib.suppress(Exception):
+                fmu.freeInstance()
+        _LOGS.pop(getattr(self, "_token", None), None)
+        shutil.rmtree(self._dir, ignore_errors=True)
 
     def _instantiate(self, md, name: str, me: bool):
         """An fmpy FMU2/FMU3 Model (me) or Slave, instantiated."""
