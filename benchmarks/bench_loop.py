@@ -72,8 +72,10 @@ def loop(study, printer, goals, fixed, rng, max_prints, stated, policy="next"):
         else:
             nxt = designer.next_prints(surrogate, **goals, fixed=fixed, n=1, tolerance=TOLERANCE)
             rec, p_now = nxt.recommendation, nxt.p_now
-            design = rec.params if nxt.stop else nxt.prints[0].params
-            is_rec = nxt.stop or _distance(design, rec.params, SPANS) <= DISTINCT
+            # no print proposed (stop, or the calibrated model finds the target out of reach): the
+            # recommendation itself, the nearest design
+            design = nxt.prints[0].params if nxt.prints else rec.params
+            is_rec = not nxt.prints or _distance(design, rec.params, SPANS) <= DISTINCT
         targets = {q: v for q, v in goals.items() if q == "k"}
         hit, run = _lands(printer, design, rng, targets)
         if is_rec:

@@ -183,3 +183,18 @@ def test_library_errors_name_python_arguments():
         identify(df, load_delay_s=float("nan"))
     with pytest.raises(DesignerError, match=r"axes=\['y'\]"):
         identify(df, axes=["y"])
+
+
+@pytest.mark.parametrize("column, scale", [("Fx", 1e200), ("x", 1e300)])
+def test_a_log_beyond_any_rigs_range_is_refused(column, scale):
+    """Loads of 1e200 N once identified as k = 8e199 N/mm with R2 = 1: a unit or logger error."""
+    import pandas as pd
+
+    from designer.errors import DesignerError
+    from designer.rig.logs import validate_frame
+
+    t = np.arange(2000) / 1000.0
+    frame = pd.DataFrame({"t": t, "x": np.sin(2 * np.pi * t), "Fx": 0.8 * np.sin(2 * np.pi * t)})
+    frame[column] *= scale
+    with pytest.raises(DesignerError, match=f"column '{column}' row 2 .* beyond any printed joint's rig"):
+        validate_frame(frame, "bad.csv")

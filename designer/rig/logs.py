@@ -41,6 +41,9 @@ UNITS: dict[str, str] = {
     **{a: units.rig_unit("r", a) for a in units.AXES},
     **{LOAD[a]: units.rig_unit("F", a) for a in units.AXES},
 }
+#: the largest magnitude a printed joint's rig can log per unit (far beyond any bench rig: a value
+#: above it is a unit or logger error, and identification would return an impossible coefficient)
+PLAUSIBLE: dict[str, float] = {"mm": 1e4, "rad": 1e3, "N": 1e6, "N.mm": 1e9}
 #: spellings of each unit accepted in a column suffix
 _UNIT_SPELLINGS: dict[str, tuple[str, ...]] = {
     "s": ("s",),
@@ -190,6 +193,7 @@ def validate_frame(
     gap_rows = np.zeros(len(t), dtype=bool)
     gap_rows[1:] |= gaps
     gap_rows[:-1] |= gaps
+    _check_magnitudes(cols, axes, source)
     dropouts, fractions = {}, {}
     for a in axes:
         dropouts[a] = _dropouts(cols, a, gap_rows, fractions, source)
@@ -204,6 +208,22 @@ def validate_frame(
         dropouts=dropouts,
         missing_fraction=fractions,
     )
+
+
+def _check_magnitudes(cols: dict[str, np.ndarray], axes: list[str], source: str) -> None:
+    """Raise for a position or load beyond what a printed joint's rig can see (PLAUSIBLE)."""
+    for col in [c for a in axes for c in (a, LOAD[a])]:
+        unit = UNITS[col]
+        with np.errstate(invalid="ignore"):
+            big = np.abs(cols[col]) > PLAUSIBLE[unit]
+        big &= np.isfinite(cols[col])
+        if big.any():
+            row = _first_bad_row(big)
+            raise DesignerError(
+                f"{source}: column '{col}' row {row} is {cols[col][row - 1]:.3g} {unit}, beyond any "
+                f"printed joint's rig (at most {PLAUSIBLE[unit]:g} {unit})",
+                f"check the logger's scale and units (the log's are {unit}) or remove the corrupt rows",
+            )
 
 
 def _columns(raw: pd.DataFrame, source: str) -> tuple[pd.DataFrame, list[str]]:
