@@ -79,7 +79,7 @@ def loop(study, printer, goals, fixed, rng, max_prints, stated, policy="next"):
         targets = {q: v for q, v in goals.items() if q == "k"}
         hit, run = _lands(printer, design, rng, targets)
         if is_rec:
-            stated.append((p_now, hit))
+            stated.append((p_now, hit, count))
         if hit and is_rec:
             return count
         runs = pd.concat([runs, run], ignore_index=True)
@@ -92,7 +92,7 @@ def one_shot(study, printer, goals, fixed, rng, cache, stated):
         cache[key] = designer.suggest(study, **goals, fixed=fixed, top=1, tolerance=TOLERANCE).candidates[0]
     rec = cache[key]
     hit, _ = _lands(printer, rec.params, rng, {"k": goals["k"]})
-    stated.append((rec.p_within, hit))
+    stated.append((rec.p_within, hit, 1))
     return hit
 
 
@@ -120,16 +120,18 @@ def augment(study, table, printer, goals, fixed, rng, max_prints):
 
 
 def calibration_table(stated) -> list[dict]:
+    """Recommendations grouped by stated P (bins of 0.2): count, mean stated P, realised hit rate."""
     rows = []
     for lo in np.arange(0.0, 1.0, 0.2):
-        inside = [hit for p, hit in stated if p is not None and lo <= p < lo + 0.2 + (lo >= 0.8) * 1e-9]
+        top = lo + 0.2 + (1e-9 if lo >= 0.8 else 0.0)
+        inside = [(p, hit) for p, hit, _ in stated if p is not None and lo <= p < top]
         if inside:
             rows.append(
                 {
                     "stated": f"{lo:.1f}-{lo + 0.2:.1f}",
                     "n": len(inside),
-                    "realised": float(np.mean(inside)),
-                    "mean_stated": float(np.mean([p for p, _ in stated if lo <= p < lo + 0.2 + 1e-9])),
+                    "mean_stated": float(np.mean([p for p, _ in inside])),
+                    "realised": float(np.mean([hit for _, hit in inside])),
                 }
             )
     return rows
@@ -193,6 +195,8 @@ def main() -> None:
         "augment": summary(results["augment"], args.max_prints) if results["augment"] else None,
         "one_shot_hit_share": float(np.mean(results["one_shot"])),
         "stated_p_loop": calibration_table(stated_loop),
+        "stated_p_loop_first_print": calibration_table([s for s in stated_loop if s[2] == 1]),
+        "stated_p_loop_later_prints": calibration_table([s for s in stated_loop if s[2] > 1]),
         "stated_p_one_shot": calibration_table(stated_one),
         "seconds": round(time.perf_counter() - t0, 1),
     }
@@ -208,12 +212,17 @@ def main() -> None:
                 f"(never within {args.max_prints}: {s['never']} of {s['runs']})"
             )
     print(f"one-shot  hits in {100 * out['one_shot_hit_share']:.0f} % of runs")
-    for name in ("stated_p_loop", "stated_p_one_shot"):
-        print(
-            name
-            + ": "
-            + "; ".join(f"P {r['stated']}: {r['realised']:.2f} realised (n={r['n']})" for r in out[name])
-        )
+    for name in (
+        "stated_p_loop",
+        "stated_p_loop_first_print",
+        "stated_p_loop_later_prints",
+        "stated_p_one_shot",
+    ):
+        rows = [
+            f"P {r['stated']} (mean {r['mean_stated']:.2f}): {r['realised']:.2f} (n={r['n']})"
+            for r in out[name]
+        ]
+        print(f"{name}: " + "; ".join(rows))
 
 
 if __name__ == "__main__":

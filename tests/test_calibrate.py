@@ -217,3 +217,21 @@ def test_a_new_printer_widens_every_interval_by_the_printer_factor(study, table)
         designer.calibrate(study, runs).predict(X)["k_x"].value,
         rtol=1e-12,
     )
+
+
+@pytest.mark.parametrize("seed, k", [(11, 0.6), (12, 0.9), (13, 1.1)])
+def test_the_loop_lands_on_a_simulated_printer_within_four_prints(study, seed, k):
+    """calibrate -> next (n=1) -> print and measure, against a printer of tests/printers.py."""
+    printer = printers.Printer(seed)
+    assert printer.best(k=k)[1], "the test's target must be reachable on this printer"
+    rng = np.random.default_rng(seed)
+    runs = pd.DataFrame()
+    for count in range(1, 5):
+        nxt = designer.next_prints(designer.calibrate(study, runs), k=k, n=1)
+        design = nxt.prints[0].params if nxt.prints else nxt.recommendation.params
+        run = printer.prints(pd.DataFrame([design]), rng)
+        if abs(run["k_x_N_per_mm"][0] / k - 1) <= 0.1:
+            break
+        runs = pd.concat([runs, run], ignore_index=True)
+    else:
+        pytest.fail(f"printer {seed} (factor {printer.factor_k:.2f}) missed k = {k} four times")
