@@ -226,7 +226,7 @@ def test_the_loop_lands_on_a_simulated_printer_within_four_prints(study, seed, k
     assert printer.best(k=k)[1], "the test's target must be reachable on this printer"
     rng = np.random.default_rng(seed)
     runs = pd.DataFrame()
-    for count in range(1, 5):
+    for _ in range(4):
         nxt = designer.next_prints(designer.calibrate(study, runs), k=k, n=1)
         design = nxt.prints[0].params if nxt.prints else nxt.recommendation.params
         run = printer.prints(pd.DataFrame([design]), rng)
