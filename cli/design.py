@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated
 
@@ -239,11 +240,16 @@ def suggest(
         tolerance=_tolerance(tolerance),
         allow_extrapolation=allow_extrapolation,
     )
-    data = result.to_dict()
+    answer(result.to_dict(), as_json, _print_suggestion)
+
+
+def answer(data: dict, as_json: bool, show: Callable[[dict], None]) -> None:
+    """Print a design answer (JSON, or `show`'s table and sentences); exit 1 when it is negative
+    (`data["reachable"]` False: the output still says why and what comes nearest)."""
     if as_json:
         print_json(data)
     else:
-        _print_suggestion(data)
+        show(data)
     if not data["reachable"]:
         raise typer.Exit(1)
 

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from .common import FixOpt, JsonOpt, SurrogateOpt, console, output_option, parse_fix, print_json
-from .design import AxisOpt, _load, _parse_goal, _pi, _tolerance
+from .design import AxisOpt, _load, _parse_goal, _pi, _tolerance, answer
 
 #: the calibrate report's significant digits for a factor and its interval
 _FACTOR = "{:.2f}"
@@ -114,13 +114,7 @@ def next_(
         tolerance=_tolerance(tolerance),
         stop=stop,
     )
-    data = result.to_dict()
-    if as_json:
-        print_json(data)
-    else:
-        _print_next(data)
-    if not data["reachable"]:
-        raise typer.Exit(1)
+    answer(result.to_dict(), as_json, _print_next)
 
 
 def _design(params: dict) -> str:

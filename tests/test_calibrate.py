@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from clitools import assert_clean_failure, run_inprocess
+from test_cli_campaign import SIX
 
 import designer
 from designer.calibration import CalibratedSurface, noise_of
@@ -163,21 +164,7 @@ def test_cli_calibrate_and_next(tmp_path, capsys, table, rows):
     assert data["stop"] or len(data["prints"]) == 2
     for cmd in (
         ["suggest", "--k", "0.8"],
-        [
-            "predict",
-            "--density",
-            "60",
-            "--length",
-            "24",
-            "--width",
-            "4.5",
-            "--height",
-            "9",
-            "--layer",
-            "0.16",
-            "--raster",
-            "0",
-        ],
+        ["predict", *SIX],
     ):
         code, _, err = run_inprocess([*cmd, "--surrogate", out], capsys)
         assert code == 0, err
