@@ -13,6 +13,9 @@ from designer.errors import DesignerError
 from .common import DataOpt, FixOpt, JsonOpt, SurrogateOpt, console, output_option, parse_fix, print_json
 
 AxisOpt = Annotated[str, typer.Option("--axis", help="Axis: x y z theta phi psi.")]
+ToleranceOpt = Annotated[
+    float, typer.Option("--tolerance", help="Band around a target that counts as met, % (+-).")
+]
 
 
 def _load(path: Path | None):
@@ -187,9 +190,7 @@ def suggest(
     axis: AxisOpt = "x",
     fix: FixOpt = None,
     top: Annotated[int, typer.Option("--top", help="How many distinct candidates.")] = 5,
-    tolerance: Annotated[
-        float, typer.Option("--tolerance", help="Band around a target that counts as met, % (+-).")
-    ] = 10.0,
+    tolerance: ToleranceOpt = 10.0,
     importance_k: Annotated[float, typer.Option("--importance-k", help="Importance of the k goal.")] = 1.0,
     importance_c: Annotated[float, typer.Option("--importance-c", help="Importance of the c goal.")] = 1.0,
     weight_k: Annotated[float, typer.Option("--weight-k", help="Desirability shape exponent of k.")] = 1.0,

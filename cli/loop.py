@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from .common import FixOpt, JsonOpt, SurrogateOpt, console, output_option, parse_fix, print_json
-from .design import AxisOpt, _load, _parse_goal, _pi, _tolerance, answer
+from .design import AxisOpt, ToleranceOpt, _load, _parse_goal, _pi, _tolerance, answer
 
 #: the calibrate report's significant digits for a factor and its interval
 _FACTOR = "{:.2f}"
@@ -82,9 +82,7 @@ def next_(
     axis: AxisOpt = "x",
     fix: FixOpt = None,
     n: Annotated[int, typer.Option("--n", help="How many designs to print now (1-10).")] = 3,
-    tolerance: Annotated[
-        float, typer.Option("--tolerance", help="Band around a target that counts as met, % (+-).")
-    ] = 10.0,
+    tolerance: ToleranceOpt = 10.0,
     stop: Annotated[
         float,
         typer.Option("--stop", help="Print the recommendation once it lands with this probability (0-1)."),
