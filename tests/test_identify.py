@@ -198,3 +198,25 @@ def test_a_log_beyond_any_rigs_range_is_refused(column, scale):
     frame[column] *= scale
     with pytest.raises(DesignerError, match=f"column '{column}' row 2 .* beyond any printed joint's rig"):
         validate_frame(frame, "bad.csv")
+
+
+@pytest.mark.parametrize("fraction", [0.001, 0.01])
+@pytest.mark.parametrize("glitch", [np.nan, 0.0])
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_scattered_single_sample_glitches_cost_only_their_samples(fraction, glitch, seed):
+    """One load sample in a thousand (or a hundred) NaN or exactly zero: the study's "sensor errors
+    result in zeroes or NaN". Each glitch loses its own sample, not the cycles around it."""
+    from designer.rig.identify import identify
+    from designer.rig.logs import validate_frame
+
+    log = make_log(
+        {"x": {"k": 0.8, "c": 2e-3, "m": 0.001, "amplitude": 1.0}}, duration=300, rate=1000, seed=seed
+    )
+    rng = np.random.default_rng(seed)
+    rows = rng.choice(np.arange(1, len(log) - 1), size=int(fraction * len(log)), replace=False)
+    log.loc[rows, "Fx"] = glitch
+    fit = identify([validate_frame(log, "glitch.csv")])[0]
+    assert not fit.failures, fit.failures
+    assert fit.axes["x"].k == pytest.approx(0.8, rel=0.01) and fit.axes["x"].c == pytest.approx(
+        2e-3, rel=0.01
+    )

@@ -115,17 +115,23 @@ class Channels:
 def block_means(values: np.ndarray, bad: np.ndarray, factor: int) -> tuple[np.ndarray, np.ndarray]:
     """Means over consecutive blocks of `factor` samples (a trailing partial block is dropped).
 
-    Returns the means and which blocks hold a bad sample; those means are meaningless until filled.
+    A block's mean is over its good samples: a scattered glitch costs its own sample, not the
+    block (the block's time centre moves by under half a sample). Returns the means and which blocks
+    have fewer than half their samples good; those means are meaningless until filled.
     (A matrix-vector product and the sparse bad rows: one pass over the samples each.)
     """
     blocks = values.size // factor
     if factor == 1:
         return values.astype(np.float64, copy=True), bad.copy()
-    means = values[: blocks * factor].reshape(blocks, factor) @ np.full(factor, 1.0 / factor)
-    bad_blocks = np.zeros(blocks, dtype=bool)
     rows = np.flatnonzero(bad[: blocks * factor])
-    bad_blocks[rows // factor] = True
-    return means, bad_blocks
+    if rows.size:
+        values = values[: blocks * factor].copy()
+        values[rows] = 0.0
+    means = values[: blocks * factor].reshape(blocks, factor) @ np.full(factor, 1.0 / factor)
+    lost = np.bincount(rows // factor, minlength=blocks)
+    if rows.size:
+        means *= factor / np.maximum(factor - lost, 1)
+    return means, lost > factor // 2
 
 
 def fill(values: np.ndarray, bad: np.ndarray) -> None:

@@ -145,8 +145,21 @@ def _runs(mask: np.ndarray, min_len: int) -> np.ndarray:
 
 
 def missing(values: np.ndarray) -> np.ndarray:
-    """Samples a sensor did not deliver: NaN or infinite, or inside a run stuck at exactly zero."""
-    return ~np.isfinite(values) | _runs(values == 0.0, STUCK_SAMPLES)
+    """Samples a sensor did not deliver: NaN or infinite, inside a run stuck at exactly zero, or an
+    exact zero in a channel that is not quantized (a noisy analogue reading is never exactly 0.0, so
+    a single zero is a glitch; on an ADC's integer counts a zero is a reading like any other)."""
+    zero = values == 0.0
+    out = ~np.isfinite(values) | _runs(zero, STUCK_SAMPLES)
+    if zero.any() and not _quantized(values):
+        out |= zero
+    return out
+
+
+def _quantized(values: np.ndarray, probe: int = 2000) -> bool:
+    """Whether the channel takes few distinct values (an ADC's steps): judged on an even sample."""
+    sample = values[:: max(values.size // probe, 1)]
+    sample = sample[np.isfinite(sample)]
+    return np.unique(sample).size < 0.5 * sample.size
 
 
 def _check_factors(factors: dict | None, source: str) -> dict[str, float] | None:
