@@ -115,6 +115,8 @@ def _print_identification(res) -> None:
         console.print(f"  warning: {w}")
     for a, why in res.failures.items():
         console.print(f"  FAILED {a}: {why}")
+    for a, why in res.still.items():
+        console.print(f"  still {a}: {why}; not identified (the moving axes are)")
 
 
 TABLE_SUFFIXES = (".csv", ".parquet", ".pq")

@@ -220,3 +220,24 @@ def test_scattered_single_sample_glitches_cost_only_their_samples(fraction, glit
     assert fit.axes["x"].k == pytest.approx(0.8, rel=0.01) and fit.axes["x"].c == pytest.approx(
         2e-3, rel=0.01
     )
+
+
+def test_a_logged_but_still_axis_is_reported_as_still_and_the_moving_one_identified(tmp_path):
+    """A six-axis logger with one axis not moving: x is identified, y is named as still (it used to
+    fail the whole log as 'aliased', and -o wrote nothing)."""
+    log = make_log(
+        {"x": {"k": 0.8, "c": 2e-3, "m": 0.001, "amplitude": 1.0}}, duration=120, rate=1000, seed=4
+    )
+    rng = np.random.default_rng(4)
+    log["y"] = 0.002 * rng.standard_normal(len(log))
+    log["Fy"] = 0.01 * rng.standard_normal(len(log))
+    res = identify(log)[0]
+    assert res.ok and set(res.axes) == {"x"} and "no motion" in res.still["y"]
+    assert res.axes["x"].k == pytest.approx(0.8, rel=0.01)
+    path = tmp_path / "still.csv"
+    log.to_csv(path, index=False)
+    factors = {"density": 60, "length": 24, "width": 4.5, "height": 9, "layer": 0.16, "raster": 0}
+    path.with_suffix(".json").write_text(json.dumps({"factors": factors}))
+    out = _cli("identify", path, "-o", tmp_path / "table.csv")
+    assert out.returncode == 0, out.stderr
+    assert "k_x" in (tmp_path / "table.csv").read_text()

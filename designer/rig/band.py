@@ -23,6 +23,8 @@ import numpy as np
 PRE_RATE = 100.0
 #: the block-mean stage is used only when its rate is at least this multiple of the band's top
 PRE_MARGIN = 10.0
+#: spectral flatness above which a position is only noise (white noise 0.56, a chirp under 0.02)
+STILL_FLATNESS = 0.3
 #: fraction of the record tapered (half at each end) in the periodogram that finds the band
 TAPER = 0.04
 #: stop edge over pass edge of the low-pass
@@ -204,6 +206,15 @@ def _noise_floor(power: np.ndarray, rate: float, n: int, top: float) -> float:
     return float(np.median(region) / np.log(2.0))
 
 
+def _flatness(power: np.ndarray) -> float:
+    """Spectral flatness, geometric over arithmetic mean of a periodogram: about 0.56 for white
+    noise (exponentially distributed bins), near 0 for any excitation, even an aliased one."""
+    positive = power[power > 0]
+    if positive.size < 2:
+        return 0.0
+    return float(np.exp(np.mean(np.log(positive))) / np.mean(positive))
+
+
 def _band_and_noise(r: np.ndarray, rate: float) -> tuple[Band | None, float]:
     """Excitation band and white-noise variance per sample, from a tapered periodogram.
 
@@ -220,6 +231,8 @@ def _band_and_noise(r: np.ndarray, rate: float) -> tuple[Band | None, float]:
     n = fast_len(r.size)
     spectrum = np.fft.rfft((r - r.mean()) * window, n=n)
     power = spectrum.real**2 + spectrum.imag**2
+    if _flatness(power[1:]) > STILL_FLATNESS:  # only noise: a logged axis that does not move
+        return None, 0.0
     rough = estimate_band(power, rate, n, 0.0)
     if rough is None:
         return None, 0.0

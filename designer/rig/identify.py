@@ -65,6 +65,15 @@ class AxisFailed(Exception):
     """An axis whose log cannot give, or gave, a physically possible fit; the message is the reason."""
 
 
+class StillAxis(AxisFailed):
+    """An axis that is logged but does not move: reported as still, not as a failed log."""
+
+
+@dataclass(frozen=True)
+class _Still:
+    reason: str
+
+
 @dataclass(frozen=True)
 class AxisFit:
     """One axis: m, c, k in rig units (m in kg or kg.m^2) with HAC standard errors and fit quality."""
@@ -134,11 +143,14 @@ class Identification:
     rate: float
     axes: dict[str, AxisFit]
     failures: dict[str, str] = field(default_factory=dict)
+    #: axes logged but not moving (only noise): not identified, and no reason to fail the log
+    still: dict[str, str] = field(default_factory=dict)
 
     @property
     def ok(self) -> bool:
-        """Whether every axis gave a possible fit (only then is the log a row of the table)."""
-        return not self.failures
+        """Whether every moving axis gave a possible fit and one did move (only then is the log a row
+        of the table, with the moving axes)."""
+        return not self.failures and bool(self.axes)
 
     @property
     def warnings(self) -> list[str]:
@@ -149,6 +161,7 @@ class Identification:
             "path": None if self.path is None else str(self.path),
             "ok": self.ok,
             "failures": self.failures,
+            "still": self.still,
             "warnings": self.warnings,
             "factors": self.factors,
             "rate_hz": self.rate,
@@ -178,10 +191,12 @@ def _spectra(log: RigLog, axis: str) -> bandlib.Spectra:
         raise AxisFailed(f"only {100 * usable:.3g} % of the samples are valid")
     factor = max(1, int(log.rate // bandlib.PRE_RATE))
     spec = bandlib.spectra(r, f, log.dropouts[axis], log.rate, factor)
-    if spec.band is not None and factor > 1 and spec.band.high * bandlib.PRE_MARGIN > spec.rate:
+    # the full rate when the band is too high for the block means, or when they show no band (a
+    # motion above their rate averages out to noise there)
+    if factor > 1 and (spec.band is None or spec.band.high * bandlib.PRE_MARGIN > spec.rate):
         spec = bandlib.spectra(r, f, log.dropouts[axis], log.rate, 1)
     if spec.band is None or not np.isfinite([spec.scale_r, spec.scale_f]).all():
-        raise AxisFailed(f"no motion on {axis}: the position is constant or not finite")
+        raise StillAxis(f"no motion on {axis}: the position is constant, only noise, or not finite")
     return spec
 
 
@@ -362,22 +377,25 @@ def identify_log(
     if not np.isfinite(delay):
         raise DesignerError(f"load_delay_s={load_delay_s} is not finite", "give the delay in seconds")
 
-    def one(axis: str) -> AxisFit | str:
+    def one(axis: str) -> AxisFit | _Still | str:
         try:
             _check_time(log)
             return fit_axis(log, axis, load_delay_s=float(delay))
+        except StillAxis as exc:
+            return _Still(str(exc))
         except (AxisFailed, np.linalg.LinAlgError) as exc:
             return str(exc) if isinstance(exc, AxisFailed) else "the fit is degenerate (singular equations)"
 
     # one thread per axis: the FFTs and array arithmetic release the GIL
     with ThreadPoolExecutor(max_workers=min(len(chosen), os.cpu_count() or 1)) as pool:
         outcomes = dict(zip(chosen, pool.map(one, chosen), strict=True))
+    fits = {a: o for a, o in outcomes.items() if isinstance(o, AxisFit)}
+    still = {a: o.reason for a, o in outcomes.items() if isinstance(o, _Still)}
+    failures = {a: o for a, o in outcomes.items() if isinstance(o, str)}
+    if not fits:  # nothing moved: the still axes are why the log fails
+        failures, still = failures | still, {}
     return Identification(
-        path=log.path,
-        factors=log.factors,
-        rate=log.rate,
-        axes={a: o for a, o in outcomes.items() if isinstance(o, AxisFit)},
-        failures={a: o for a, o in outcomes.items() if isinstance(o, str)},
+        path=log.path, factors=log.factors, rate=log.rate, axes=fits, failures=failures, still=still
     )
 
 
