@@ -57,8 +57,9 @@ MIN_VALID = 0.5
 MIN_R2 = 0.5
 PLAUSIBLE_RATE_HZ = (10.0, 1e6)
 PLAUSIBLE_DURATION_S = 1e5
-#: warn when one sample of channel skew moves c by more than this fraction
-SKEW_WARN = 0.1
+#: warn when one sample of channel skew moves c by more than this fraction: c is then dominated
+#: by the channels' timing (below it, the sensitivity is reported with every fit, not warned about)
+SKEW_WARN = 1.0
 
 
 class AxisFailed(Exception):
@@ -317,9 +318,10 @@ def _warnings(fit: AxisFit, stable: bool, k_varies: bool, c_varies: bool, rate: 
     cu, ku = units.rig_unit("c", fit.axis), units.rig_unit("k", fit.axis)
     if fit.c_skew_relative > SKEW_WARN:
         out.append(
-            f"one sample ({1e3 / rate:.3g} ms) of skew between the load and position channels changes c by "
-            f"{fit.c_per_sample_skew:+.3g} {cu} ({100 * fit.c_skew_relative:.3g} % of c): give the known "
-            "channel delay (load_delay_s) or c is uncertain by that much"
+            f"c is dominated by the channels' timing: one sample ({1e3 / rate:.3g} ms) of skew between the "
+            f"load and position channels changes c by {fit.c_per_sample_skew:+.3g} {cu}, "
+            f"{fit.c_skew_relative:.2g} times c: give the known channel delay (load_delay_s) or sample "
+            "faster, or c is uncertain by that much"
         )
     if k_varies:
         rows = fit.k_amplitude["rows"]
