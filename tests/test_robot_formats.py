@@ -465,3 +465,42 @@ def test_urdf_into_a_ros_robot_with_transmissions(tmp_path, robot, joint):
     for j_before, j_after in zip(before.iter("joint"), after.iter("joint"), strict=True):
         if not (j_after.get("name") == joint and j_after.getparent() is after):
             assert etree.tostring(j_before) == etree.tostring(j_after)
+
+
+TENDON_HOST = """<mujoco model="knees">
+  <worldbody>
+    <body name="thigh">
+      <joint name="hip" type="hinge" axis="0 1 0"/>
+      <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03"/>
+      <body name="shin" pos="0 0 -0.3">
+        <joint name="knee" type="hinge" axis="0 1 0" springref="0"/>
+        <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03"/>
+      </body>
+    </body>
+  </worldbody>
+  <tendon>
+    <fixed name="coupling" stiffness="1">
+      <joint joint="hip" coef="1"/>
+      <joint joint="knee" coef="-1"/>
+    </fixed>
+  </tendon>
+</mujoco>
+"""
+
+
+def test_into_a_joint_of_a_fixed_tendon_with_a_new_rest(tmp_path):
+    """A new springref moves MuJoCo's derived tendon_lengthspring: the edit's own consequence, not a
+    forbidden change (gymnasium's humanoid knees and mujoco's hipy_0 ended as exit 3 'a bug')."""
+    host_path = tmp_path / "knees.xml"
+    host_path.write_text(TENDON_HOST)
+    out = export_mjcf(
+        Joint.from_coefficients(THETA),
+        tmp_path / "knees_flex.xml",
+        into=host_path,
+        joint_name="knee",
+        rest=0.3,
+    )
+    flex, host = mujoco.MjModel.from_xml_path(str(out.path)), mujoco.MjModel.from_xml_path(str(host_path))
+    assert flex.qpos_spring[flex.joint("knee").qposadr[0]] == pytest.approx(0.3)
+    assert np.array_equal(flex.tendon_stiffness, host.tendon_stiffness)
+    assert not np.array_equal(flex.tendon_lengthspring, host.tendon_lengthspring)  # derived from the rest
