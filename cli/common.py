@@ -157,6 +157,7 @@ FLAGS: tuple[tuple[str, str], ...] = (
     (r"\bn=(?=\S+ is not a whole number)", "--n "),
     (r"\bstop=(?=\S+ is not in)", "--stop "),
     (r"\bload_filter=", "--load-filter "),
+    (r"\ballow_outside_range=True\b", "--allow-outside-range"),
     (r"\btargets=\{'k': 0\.8\}", "--target k=0.8"),
     # export mjcf/urdf/sdf/modelica/ssp
     (r"\binto=", "--into "),

@@ -212,7 +212,14 @@ INTO = _option(
     None,
 )
 ROBOT_JOINT = _option("joint_name", Annotated[str | None, typer.Option("--joint", help="robot joint")], None)
-REST = _option("rest", Annotated[float, typer.Option(help="spring rest position, rad or m")], 0.0)
+REST = _option(
+    "rest",
+    Annotated[
+        float | None,  # noqa: UP007
+        typer.Option(help="spring rest position, rad or m (the joint's qpos; --into: default the host's)"),
+    ],
+    None,
+)
 AXIS_PICK = _option(
     "axis_pick", Annotated[str | None, typer.Option("--use-axis", help="joint axis to use")], None
 )
@@ -350,6 +357,11 @@ def _formats(snippet: Callable[..., None]) -> None:
             ),
             _option("motor_inertia", Annotated[float | None, typer.Option(help="series: SI")], None),  # noqa: UP007
             _option("motor_bandwidth", Annotated[float | None, typer.Option(help="series: servo Hz")], None),  # noqa: UP007
+            _option(
+                "allow_outside_range",
+                Annotated[bool, typer.Option(help="accept a --rest outside the robot joint's range")],
+                False,
+            ),
         ),
     )
     snippet(

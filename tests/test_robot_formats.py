@@ -549,3 +549,35 @@ def test_series_into_keeps_every_keyframe_pose(tmp_path, rest):
             joint_name="elbow",
             form="series",
         )
+
+
+def test_parallel_into_keeps_the_hosts_springref_and_armature_and_says_what_changed(tmp_path):
+    """reacher-like host: armature 1 and springref 30 deg stay unless asked; a rest outside the range
+    is refused; every changed host value is listed old -> new."""
+    host = HOST.replace(
+        '<joint name="elbow" type="hinge" axis="0 1 0" range="-120 120"/>',
+        '<joint name="elbow" type="hinge" axis="0 1 0" range="-120 120" armature="1" springref="30"/>',
+    )
+    host_path = tmp_path / "robot.xml"
+    host_path.write_text(host)
+    joint = Joint.from_coefficients(THETA)
+    out = export_mjcf(joint, tmp_path / "flex.xml", into=host_path, joint_name="elbow")
+    flex = mujoco.MjModel.from_xml_path(str(out.path))
+    j = flex.joint("elbow")
+    assert flex.dof_armature[j.dofadr[0]] == 1.0 and flex.qpos_spring[j.qposadr[0]] == pytest.approx(
+        math.radians(30)
+    )
+    assert j.stiffness[0] == 0.05
+    text = "\n".join(out.notes)
+    assert "springref kept" in text and "armature kept" in text and "stiffness: 0 -> 0.05" in text
+    with pytest.raises(DesignerError, match="outside the range"):
+        export_mjcf(joint, tmp_path / "far.xml", into=host_path, joint_name="elbow", rest=math.radians(150))
+    far = export_mjcf(
+        joint,
+        tmp_path / "far.xml",
+        into=host_path,
+        joint_name="elbow",
+        rest=math.radians(150),
+        allow_outside_range=True,
+    )
+    assert "springref: 0.5236 -> 2.618 (SI)" in "\n".join(far.notes)

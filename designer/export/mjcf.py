@@ -121,17 +121,19 @@ def export_mjcf(
     joint_name: str | None = None,
     axis: str | None = None,
     form: str = "parallel",
-    rest: float = 0.0,
+    rest: float | None = None,
     motor_inertia: float | None = None,
     motor_bandwidth: float | None = None,
+    allow_outside_range: bool = False,
 ) -> robot.RobotExport:
     """Write `joint` for MuJoCo at `path` (.xml) and return the path and the stated step advice.
 
     Standalone (`into` None): form "parallel" is a chain of links, one per axis, each on a spring-damper
     joint; form "series" is motor -> flexure -> link on one axis (see `series_text`). With `into` (an
     MJCF file) and `joint_name`, a copy of that robot with the joint made flexible, in parallel or in
-    series (see `mjcf_into.into_parallel`, `mjcf_into.into_series`).
-    Masses come from the joint, or from the design's geometry.
+    series (see `mjcf_into.into_parallel`, `mjcf_into.into_series`). `rest` (rad or m, the joint's
+    qpos): in parallel None keeps the host's springref; a rest outside a limited joint's range is
+    refused unless `allow_outside_range`. Masses come from the joint, or from the design's geometry.
 
     Raises:
         DesignerError: a wrong suffix, unknown form, missing mass, or an `into` problem.
@@ -149,14 +151,22 @@ def export_mjcf(
                 path,
                 joint_name=joint_name,
                 axis=axis,
-                rest=rest,
+                rest=0.0 if rest is None else rest,
                 motor_inertia=motor_inertia,
                 motor_bandwidth=motor_bandwidth,
             )
-        else:
-            advice = into_parallel(joint, into, path, joint_name=joint_name, axis=axis, rest=rest)
-        return robot.RobotExport(path, advice)
-    if rest != 0.0:
+            return robot.RobotExport(path, advice)
+        advice, notes = into_parallel(
+            joint,
+            into,
+            path,
+            joint_name=joint_name,
+            axis=axis,
+            rest=rest,
+            allow_outside_range=allow_outside_range,
+        )
+        return robot.RobotExport(path, advice, notes)
+    if rest not in (None, 0.0):
         raise DesignerError(
             f"rest={rest:g} is for exports into a robot (into=...): a standalone snippet cannot know its "
             "host's angle unit",

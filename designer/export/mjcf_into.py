@@ -185,28 +185,85 @@ def _retag(text: str, joint_name: str, values: dict[str, str]) -> str:
 
 
 def into_parallel(
-    joint: Joint, host: str | Path, path: Path, *, joint_name: str, axis: str | None = None, rest: float = 0.0
-) -> dict[str, StepAdvice]:
+    joint: Joint,
+    host: str | Path,
+    path: Path,
+    *,
+    joint_name: str,
+    axis: str | None = None,
+    rest: float | None = None,
+    allow_outside_range: bool = False,
+) -> tuple[dict[str, StepAdvice], tuple[str, ...]]:
     """Write a copy of MJCF `host` to `path` with robot joint `joint_name` made this flexible joint.
 
-    Sets stiffness, damping, armature (the axis' moving mass, when known) and springref (`rest`, SI,
-    written in the host's angle unit). Returns the step advice for the joint, with its inertia from
-    the compiled model's mass matrix (other joints held, at the reference pose).
+    Sets stiffness and damping; springref to `rest` (SI, the joint's qpos, written in the host's
+    angle unit; None keeps the host's); armature to the axis' moving mass only where the host has
+    none (a host armature, the motor's reflected inertia, is kept). Returns the step advice for the
+    joint (inertia from the compiled model's mass matrix, other joints held, at the reference pose)
+    and one note per host value changed or kept (old -> new, SI).
 
     Raises:
-        DesignerError: no such host file or joint, a ball or free joint, an axis of the wrong kind.
+        DesignerError: no such host file or joint, a ball or free joint, an axis of the wrong kind, a
+            rest outside a limited joint's range (unless `allow_outside_range`).
     """
     h = _open(host, joint_name)
     a = _axis(joint, axis, h, joint_name)
+    values, notes = _parallel_values(h, joint, a, joint_name, rest, allow_outside_range)
+    for attr, v in values.items():
+        h.element.set(attr, v)
     raw = h.path.read_bytes()
     encoding = h.tree.docinfo.encoding or "utf-8"
-    text = _retag(raw.decode(encoding), joint_name, _flexure(h, joint, a, rest))
+    text = _retag(raw.decode(encoding), joint_name, values)
     check = partial(_compare_parallel, h.model, joint_name=joint_name)
     after = _write_checked(h, path, check, text.encode(encoding))
     si = joint.axes[a].si()
-    return {
-        joint_name: step_advice(si["k"], si["c"], _mass_diagonal(after)[after.joint(joint_name).dofadr[0]])
+    dof = after.joint(joint_name).dofadr[0]
+    return {joint_name: step_advice(si["k"], si["c"], _mass_diagonal(after)[dof])}, notes
+
+
+def _parallel_values(
+    h: _Host, joint: Joint, a: str, joint_name: str, rest: float | None, allow_outside_range: bool
+) -> tuple[dict[str, str], tuple[str, ...]]:
+    """The joint element's new attributes (host units) and the notes on every host value (SI)."""
+    si = joint.axes[a].si()
+    j = h.model.joint(joint_name)
+    dof, adr = j.dofadr[0], j.qposadr[0]
+    unit = "rad" if h.hinge else "m"
+    old = {
+        "stiffness": float(j.stiffness[0]),
+        "damping": float(h.model.dof_damping[dof]),
+        "springref": float(h.model.qpos_spring[adr]),
+        "armature": float(h.model.dof_armature[dof]),
     }
+    new = {"stiffness": si["k"], "damping": si["c"]}
+    notes = []
+    if rest is None:
+        notes.append(f"springref kept at the host's {old['springref']:.4g} {unit} (give rest to set it)")
+    else:
+        lo, hi = (float(v) for v in h.model.jnt_range[j.id])
+        if h.model.jnt_limited[j.id] and not lo <= rest <= hi and not allow_outside_range:
+            raise DesignerError(
+                f"rest={rest:g} {unit} is outside the range [{lo:.4g}, {hi:.4g}] {unit} of robot joint "
+                f"'{joint_name}'",
+                "give a rest inside the range, or allow_outside_range=True if the spring should preload "
+                "the joint against its limit",
+            )
+        new["springref"] = rest
+    if old["armature"] > 0:
+        notes.append(
+            f"armature kept at the host's {old['armature']:.4g} (the motor's; the flexure's own moving "
+            f"inertia {si['m'] if si['m'] is not None else 0:.3g} not added)"
+        )
+    elif si["m"] is not None:
+        new["armature"] = si["m"]
+    if float(h.model.qpos0[adr]) != 0.0:
+        notes.append(
+            f"rest is the joint's qpos, which this joint's ref puts at {float(h.model.qpos0[adr]):.4g} "
+            f"{unit} in its reference pose"
+        )
+    notes += [f"{attr}: {old[attr]:.4g} -> {v:.4g} (SI)" for attr, v in new.items() if v != old[attr]]
+    values = {attr: robot.num(h.angle(v) if attr == "springref" else v) for attr, v in new.items()}
+    return values, tuple(notes)
 
 
 def _insert_motor(host: _Host, joint_name: str, motor: robot.Sphere, servo: robot.Servo) -> int:

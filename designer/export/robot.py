@@ -53,13 +53,19 @@ class RobotExport:
 
     path: Path
     advice: dict[str, StepAdvice]
+    #: what the export did to a host's own values, one sentence each (old -> new, SI)
+    notes: tuple[str, ...] = ()
 
     def __fspath__(self) -> str:
         return str(self.path)
 
     def to_dict(self) -> dict[str, object]:
-        """Plain data for JSON: the path and each joint's step advice."""
-        return {"path": str(self.path), "advice": {n: a.to_dict() for n, a in self.advice.items()}}
+        """Plain data for JSON: the path, each joint's step advice and the notes."""
+        return {
+            "path": str(self.path),
+            "advice": {n: a.to_dict() for n, a in self.advice.items()},
+            "notes": list(self.notes),
+        }
 
 
 def pick_axis(joint: Joint, axis: str | None, rotational: bool | None = None) -> str:

@@ -205,7 +205,7 @@ def export_urdf(
     into: str | Path | None = None,
     joint_name: str | None = None,
     axis: str | None = None,
-    rest: float = 0.0,
+    rest: float | None = None,
 ) -> robot.RobotExport:
     """Write `joint` as URDF at `path` (.urdf) and return the path and the stated step advice.
 
@@ -223,11 +223,11 @@ def export_urdf(
     if into is not None:
         if joint_name is None:
             raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
-        data, advice = _into_urdf(joint, Path(into), joint_name=joint_name, axis=axis, rest=rest)
+        data, advice = _into_urdf(joint, Path(into), joint_name=joint_name, axis=axis, rest=rest or 0.0)
         with atomic_path(path) as tmp:
             tmp.write_bytes(data)
         return robot.RobotExport(path, advice)
-    text, advice = urdf_text(robot.with_masses(joint), rest=rest)
+    text, advice = urdf_text(robot.with_masses(joint), rest=rest or 0.0)
     with atomic_write(path) as fh:
         fh.write(text)
     return robot.RobotExport(path, advice)
