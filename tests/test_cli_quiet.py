@@ -29,3 +29,11 @@ def test_quiet_is_accepted_in_any_position(monkeypatch, capsys):
     assert main.run(["suggest", "--k", "0.8", "--json", "--quiet"]) == 0
     assert common.QUIET
     assert capsys.readouterr().err == ""
+
+
+def test_fit_reports_progress_per_response():
+    from designer.surrogate import Surrogate
+
+    seen: list[float] = []
+    Surrogate().fit(None, responses=["k_x", "c_x"], nested=False, progress=seen.append)
+    assert seen == [0.5, 1.0]
