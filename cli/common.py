@@ -161,6 +161,7 @@ FLAGS: tuple[tuple[str, str], ...] = (
     (r"\bgive k= a target value", "give --k a target value"),
     (r"\bn=(?=\S+ is not a whole number)", "--n "),
     (r"\bstop=(?=\S+ is not in)", "--stop "),
+    (r"\bload_filter=", "--load-filter "),
     (r"\btargets=\{'k': 0\.8\}", "--target k=0.8"),
     # export mjcf/urdf/sdf/modelica/ssp
     (r"\binto=", "--into "),

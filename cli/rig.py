@@ -30,9 +30,19 @@ def identify(
             help="s by which the load channel lags the position (default: sidecar load_delay_s, else 0)"
         ),
     ] = None,
+    load_filter: Annotated[
+        str | None,
+        typer.Option(
+            help="the load sensor's low-pass, e.g. butter2:200Hz, undone exactly (default: sidecar "
+            "load_filter, else none)"
+        ),
+    ] = None,
     json_out: JsonOpt = False,
 ) -> None:
     """Identify m, c, k per axis from rig logs (F = m r'' + c r' + k r); exit 1 if any log fails.
+
+    A force sensor's own low-pass lags the load like a delay and biases c (a 2nd-order Butterworth
+    at 200 Hz: about -45 % of c at 0.8 N/mm); give it with --load-filter.
 
     Example: designer identify run1.csv run2.parquet --load-delay 0.002 -o table.csv
     """
@@ -45,7 +55,7 @@ def identify(
     if load_delay is not None and load_delay != load_delay:
         raise DesignerError("--load-delay is NaN", "give the delay in seconds, e.g. --load-delay 0.002")
     with progress("identifying") as bar:
-        results = run(logs, load_delay_s=load_delay, progress=bar)
+        results = run(logs, load_delay_s=load_delay, load_filter=load_filter, progress=bar)
     passed = [r for r in results if r.ok]
     wrote = output is not None and bool(passed)
     if wrote:
@@ -98,7 +108,9 @@ def _print_identification(res) -> None:
         ru, ku, cu = units.rig_unit("r", f.axis), units.rig_unit("k", f.axis), units.rig_unit("c", f.axis)
         console.print(f"  {f.axis}: {f.statement()}")
         console.print(
-            f"  {f.axis}: load delay corrected {1e3 * f.load_delay_s:.3g} ms; one more sample of skew "
+            f"  {f.axis}: load delay corrected {1e3 * f.load_delay_s:.3g} ms"
+            + (f", load filter {f.load_filter} undone" if f.load_filter else "")
+            + "; one more sample of skew "
             f"changes c by {f.c_per_sample_skew:+.3g} {cu}"
         )
         amp = ", ".join(

@@ -241,3 +241,40 @@ def test_a_logged_but_still_axis_is_reported_as_still_and_the_moving_one_identif
     out = _cli("identify", path, "-o", tmp_path / "table.csv")
     assert out.returncode == 0, out.stderr
     assert "k_x" in (tmp_path / "table.csv").read_text()
+
+
+def _filtered_load_log(cutoff_hz: float, seed: int = 5):
+    """A log whose load went through the sensor's 2nd-order analogue Butterworth (scipy's lsim)."""
+    from scipy import signal
+
+    log = make_log(
+        {"x": {"k": 0.8, "c": 2e-3, "m": 0.001, "amplitude": 1.0}}, duration=300, rate=1000, seed=seed
+    )
+    b, a = signal.butter(2, 2 * np.pi * cutoff_hz, analog=True)
+    log["Fx"] = signal.lsim((b, a), log["Fx"].to_numpy(), log["t"].to_numpy())[1]
+    return log
+
+
+@pytest.mark.parametrize("cutoff", [200.0, 100.0, 50.0])
+def test_the_load_sensors_filter_given_is_undone_exactly(cutoff):
+    """Unknown, a 200 Hz filter moves c by -45 % and a 50 Hz one makes it negative; given, c holds."""
+    log = _filtered_load_log(cutoff)
+    fit = identify(log, load_filter=f"butter2:{cutoff:g}Hz")[0]
+    assert fit.ok, fit.failures
+    assert fit.axes["x"].c == pytest.approx(2e-3, rel=0.01) and fit.axes["x"].k == pytest.approx(
+        0.8, rel=0.01
+    )
+    assert fit.axes["x"].load_filter == f"butter2:{cutoff:g}Hz"
+    if cutoff == 200.0:
+        assert identify(log)[0].axes["x"].c < 0.7 * 2e-3  # the bias the filter causes when not given
+
+
+def test_load_filter_from_the_sidecar_and_the_flag(tmp_path):
+    path = tmp_path / "run.csv"
+    _filtered_load_log(100.0).to_csv(path, index=False)
+    path.with_suffix(".json").write_text(json.dumps({"load_filter": "butter2:100Hz"}))
+    out = _cli("identify", path, "--json")
+    assert out.returncode == 0, out.stderr
+    assert json.loads(out.stdout)["logs"][0]["axes"]["x"]["c"] == pytest.approx(2e-3, rel=0.01)
+    bad = _cli("identify", path, "--load-filter", "cheby2:100")
+    assert bad.returncode == 2 and "--load-filter 'cheby2:100' is not a filter" in bad.stderr

@@ -418,3 +418,89 @@ def test_cli_mjcf_into_urdf_and_sdf(tmp_path, monkeypatch, capsys):
     assert run("urdf", *joint, "-o", "j.urdf")[0] == 0 and run("sdf", *joint, "-o", "j.sdf")[0] == 0
     code, _, err = run("mjcf", *joint, "--into", "robot.xml", "--joint", "wrist", "-o", "x.xml")
     assert code == 2 and "elbow" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    "robot, joint", [("xarm/xarm6_robot.urdf", "joint3"), ("a1/a1.urdf", "FR_lower_joint")]
+)
+def test_urdf_into_a_ros_robot_with_transmissions(tmp_path, robot, joint):
+    """pybullet_data's xArm6 and Unitree A1 name every joint again in a <transmission>: the robot-level
+    <joint> is the one edited (it used to be refused as '2 found'), and nothing else changes."""
+    import subprocess
+    from pathlib import Path
+
+    from clitools import CLI
+    from lxml import etree
+
+    pybullet_data = pytest.importorskip("pybullet_data")
+    host = Path(pybullet_data.getDataPath()) / robot
+    out = tmp_path / "flex.urdf"
+    code = subprocess.run(
+        [
+            *CLI,
+            "export",
+            "urdf",
+            "--axis",
+            "theta",
+            "--k",
+            "330",
+            "--c",
+            "0.83",
+            "--into",
+            str(host),
+            "--joint",
+            joint,
+            "-o",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+    )
+    assert code.returncode == 0, code.stderr
+    before, after = etree.parse(str(host)).getroot(), etree.parse(str(out)).getroot()
+    edited = after.xpath("/robot/joint[@name=$n]/dynamics", n=joint)[0]
+    assert float(edited.get("damping")) == pytest.approx(0.83e-3)
+    gazebo = after.xpath("/robot/gazebo[@reference=$n]/springStiffness", n=joint)[0]
+    assert float(gazebo.text) == pytest.approx(0.33)
+    for j_before, j_after in zip(before.iter("joint"), after.iter("joint"), strict=True):
+        if not (j_after.get("name") == joint and j_after.getparent() is after):
+            assert etree.tostring(j_before) == etree.tostring(j_after)
+
+
+TENDON_HOST = """<mujoco model="knees">
+  <worldbody>
+    <body name="thigh">
+      <joint name="hip" type="hinge" axis="0 1 0"/>
+      <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03"/>
+      <body name="shin" pos="0 0 -0.3">
+        <joint name="knee" type="hinge" axis="0 1 0" springref="0"/>
+        <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03"/>
+      </body>
+    </body>
+  </worldbody>
+  <tendon>
+    <fixed name="coupling" stiffness="1">
+      <joint joint="hip" coef="1"/>
+      <joint joint="knee" coef="-1"/>
+    </fixed>
+  </tendon>
+</mujoco>
+"""
+
+
+def test_into_a_joint_of_a_fixed_tendon_with_a_new_rest(tmp_path):
+    """A new springref moves MuJoCo's derived tendon_lengthspring: the edit's own consequence, not a
+    forbidden change (gymnasium's humanoid knees and mujoco's hipy_0 ended as exit 3 'a bug')."""
+    host_path = tmp_path / "knees.xml"
+    host_path.write_text(TENDON_HOST)
+    out = export_mjcf(
+        Joint.from_coefficients(THETA),
+        tmp_path / "knees_flex.xml",
+        into=host_path,
+        joint_name="knee",
+        rest=0.3,
+    )
+    flex, host = mujoco.MjModel.from_xml_path(str(out.path)), mujoco.MjModel.from_xml_path(str(host_path))
+    assert flex.qpos_spring[flex.joint("knee").qposadr[0]] == pytest.approx(0.3)
+    assert np.array_equal(flex.tendon_stiffness, host.tendon_stiffness)
+    assert not np.array_equal(flex.tendon_lengthspring, host.tendon_lengthspring)  # derived from the rest

@@ -28,7 +28,16 @@ from . import robot, xmltext
 from .stability import StepAdvice, step_advice
 
 #: compiled-model arrays that follow from the mass matrix, so they change with a joint's armature
-_DERIVED = {"actuator_acc0", "body_invweight0", "dof_M0", "dof_invweight0", "tendon_invweight0"}
+#: (tendon_lengthspring follows the springref of the joints a fixed tendon couples, unless the host
+#: gives the tendon's springlength, which the edit does not touch)
+_DERIVED = {
+    "actuator_acc0",
+    "body_invweight0",
+    "dof_M0",
+    "dof_invweight0",
+    "tendon_invweight0",
+    "tendon_lengthspring",
+}
 #: compiled-model arrays the parallel edit sets, per joint, degree of freedom or qpos entry
 _EDITED = {"jnt_stiffness": "jnt", "dof_damping": "dof", "dof_armature": "dof", "qpos_spring": "qpos"}
 #: body attributes that place a body in its parent's frame

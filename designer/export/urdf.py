@@ -149,15 +149,18 @@ def _into_urdf(
         )
     si = joint.axes[a].si()
     encoding = tree.docinfo.encoding or "utf-8"
-    text = _set_damping(host.read_bytes().decode(encoding), joint_name, robot.num(si["c"]))
+    # the robot-level <joint> among every element <joint name=...> (a <transmission> names its joint too)
+    nth = [j.getparent() is root for j in root.iter("joint") if j.get("name") == joint_name].index(True)
+    text = _set_damping(host.read_bytes().decode(encoding), joint_name, robot.num(si["c"]), nth)
     moved = moved_inertia(root, joint_name)
     advice = {joint_name: step_advice(si["k"], si["c"], moved)} if moved > 0 else {}
     return _set_spring(text, joint_name, si["k"], rest).encode(encoding), advice
 
 
-def _set_damping(text: str, joint_name: str, damping: str) -> str:
-    """The joint element's `<dynamics damping>` set (a `<dynamics>` line added when it has none)."""
-    element = xmltext.find_one(text, "joint", "name", joint_name, whole=True)
+def _set_damping(text: str, joint_name: str, damping: str, nth: int) -> str:
+    """The joint element's `<dynamics damping>` set (a `<dynamics>` line added when it has none);
+    the element is the `nth` <joint name=joint_name> of the text (the robot-level one)."""
+    element = xmltext.find_one(text, "joint", "name", joint_name, whole=True, nth=nth)
     body = element.group(0)
     dynamics = re.search(r"<dynamics\b[^>]*>", body)
     if dynamics:

@@ -16,21 +16,29 @@ def _outside_comments(text: str, matches: list[re.Match]) -> list[re.Match]:
     return [m for m in matches if not any(a <= m.start() < b for a, b in spans)]
 
 
-def find_one(text: str, tag: str, attr: str, value: str, *, whole: bool = False) -> re.Match:
+def find_one(
+    text: str, tag: str, attr: str, value: str, *, whole: bool = False, nth: int | None = None
+) -> re.Match:
     """The one `<tag ... attr="value" ...>` start tag (or, `whole`, element up to `</tag>`) in `text`.
 
+    `nth`: of several such tags outside comments, the one at this index in document order (the
+    caller located the element with a parser, e.g. a URDF's robot-level <joint> among the <joint>s
+    that <transmission> blocks also name).
+
     Raises:
-        DesignerError: none or several outside comments.
+        DesignerError: none or several outside comments (without `nth`), or fewer than nth + 1.
     """
     start = rf"<{tag}\b[^>]*?\s{attr}\s*=\s*(['\"]){re.escape(value)}\1[^>]*>"
-    pattern = re.compile(start + (rf".*?</{tag}\s*>" if whole else ""), re.S)
-    found = _outside_comments(text, list(pattern.finditer(text)))
-    if len(found) != 1:
+    found = _outside_comments(text, list(re.finditer(start, text, re.S)))
+    if nth is None and len(found) != 1 or nth is not None and len(found) <= nth:
         raise DesignerError(
             f"cannot find <{tag} {attr}={value!r}> once in the file's text ({len(found)} found)",
             f"write it as one <{tag}> element outside comments",
         )
-    return found[0]
+    m = found[0 if nth is None else nth]
+    if not whole or m.group(0).endswith("/>"):
+        return m
+    return re.compile(start + rf".*?</{tag}\s*>", re.S).match(text, m.start())
 
 
 def set_attributes(start_tag: str, values: dict[str, str]) -> str:

@@ -15,6 +15,7 @@ tens of seconds at each end and around every dropout.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -290,10 +291,16 @@ def _guard(filled: np.ndarray, n: int, nd: int, samples: int, reach: int) -> np.
     return near
 
 
-def filtered(spec: Spectra, pass_edge: float, delay_s: float = 0.0, skew_s: float | None = None) -> Channels:
-    """r'', r', r and the load through the low-pass at `pass_edge` Hz, the load advanced by `delay_s`.
+def filtered(
+    spec: Spectra,
+    pass_edge: float,
+    correct: Callable[[np.ndarray], np.ndarray] | None = None,
+    skew_s: float | None = None,
+) -> Channels:
+    """r'', r', r and the load through the low-pass at `pass_edge` Hz, the load's spectrum times
+    `correct(w)` (w in rad/s: the channel's known delay and filter undone; None: as logged).
 
-    With `skew_s`, `y_skew` is the load advanced by `delay_s + skew_s` as well.
+    With `skew_s`, `y_skew` is that load advanced by `skew_s` as well.
     """
     stop = STOP_RATIO * pass_edge
     bins = min(int(np.ceil(stop * spec.n / spec.rate)) + 1, spec.position.size)
@@ -303,7 +310,7 @@ def filtered(spec: Spectra, pass_edge: float, delay_s: float = 0.0, skew_s: floa
     w = 2 * np.pi * freqs
     gain = lowpass(freqs, pass_edge)
     pos = spec.position[:bins] * gain
-    load = spec.load[:bins] * gain * np.exp(1j * w * delay_s)
+    load = spec.load[:bins] * gain * (1.0 if correct is None else correct(w))
     rows = [-(w**2) * pos, 1j * w * pos, pos, load]
     if skew_s is not None:
         rows.append(load * np.exp(1j * w * skew_s))

@@ -34,6 +34,7 @@ from .. import space, units
 from ..errors import DesignerError
 from ..mass import specimen_mass
 from . import band as bandlib
+from . import channel
 from .logs import LOAD, RigLog, missing, read_log, validate_frame
 from .nonlinear import amplitude_table, frequency_table
 from .regress import solve
@@ -98,6 +99,8 @@ class AxisFit:
     inertia_ratio: float
     band: dict
     load_delay_s: float
+    #: the load sensor's low-pass undone in the fit (e.g. "butter2:200Hz"), or None
+    load_filter: str | None
     #: change of c when the load is shifted by one more sample (rig units), and that over |c|
     c_per_sample_skew: float
     c_skew_relative: float
@@ -222,12 +225,12 @@ def _cycles(ch: bandlib.Channels) -> float:
     return float(np.count_nonzero(s[1:] != s[:-1]) / 2)
 
 
-def _fit(spec: bandlib.Spectra, pass_edge: float, delay: float, *, skew_s: float | None = None):
+def _fit(spec: bandlib.Spectra, pass_edge: float, correct, *, skew_s: float | None = None):
     """Filter at `pass_edge` and fit; fail a log with too few cycles or usable rows.
 
     With `skew_s`, the solution's `also_beta` is the fit with the load advanced by that much more.
     """
-    ch = bandlib.filtered(spec, pass_edge, delay, skew_s)
+    ch = bandlib.filtered(spec, pass_edge, correct, skew_s)
     cycles = _cycles(ch)
     if cycles < MIN_CYCLES:
         raise AxisFailed(f"only {cycles:.3g} cycles of excitation (at least {MIN_CYCLES:g} needed)")
@@ -239,12 +242,18 @@ def _fit(spec: bandlib.Spectra, pass_edge: float, delay: float, *, skew_s: float
     return ch, solve(x, ch.y, ch.keep, noise, _lags(ch), also=ch.y_skew)
 
 
-def fit_axis(log: RigLog, axis: str, *, load_delay_s: float = 0.0) -> AxisFit:
-    """Fit one axis of a validated log; raise AxisFailed with the reason when it cannot or should not."""
+def fit_axis(
+    log: RigLog, axis: str, *, load_delay_s: float = 0.0, load_filter: channel.LoadFilter | None = None
+) -> AxisFit:
+    """Fit one axis of a validated log; raise AxisFailed with the reason when it cannot or should not.
+
+    `load_delay_s` and `load_filter`: the load channel's known delay and low-pass, undone exactly.
+    """
     spec = _spectra(log, axis)
     top = spec.band.high
     scale = spec.scale_f / spec.scale_r
-    ch, main = _fit(spec, PASS_EDGES[0] * top, load_delay_s, skew_s=1.0 / log.rate)
+    correct = channel.correction(load_delay_s, load_filter)
+    ch, main = _fit(spec, PASS_EDGES[0] * top, correct, skew_s=1.0 / log.rate)
     if log.rate < MIN_RATE_OVER_BAND * top:
         raise AxisFailed(
             f"sampling rate {log.rate:.4g} Hz is under {MIN_RATE_OVER_BAND:g} x the highest excitation "
@@ -261,7 +270,7 @@ def fit_axis(log: RigLog, axis: str, *, load_delay_s: float = 0.0) -> AxisFit:
             f"(needs k > 0, c >= 0, R2 >= {MIN_R2:g})"
         )
     c_skew = float(main.also_beta[1]) * scale - c
-    wide = [(ch, main)] + [_fit(spec, p * top, load_delay_s) for p in PASS_EDGES[1:]]
+    wide = [(ch, main)] + [_fit(spec, p * top, correct) for p in PASS_EDGES[1:]]
     m_rows = [
         {
             "pass_hz": w_ch.pass_edge,
@@ -296,6 +305,7 @@ def fit_axis(log: RigLog, axis: str, *, load_delay_s: float = 0.0) -> AxisFit:
         band=spec.band.to_dict()
         | {"filter_pass_hz": ch.pass_edge, "filter_stop_hz": bandlib.STOP_RATIO * ch.pass_edge},
         load_delay_s=load_delay_s,
+        load_filter=None if load_filter is None else str(load_filter),
         c_per_sample_skew=c_skew,
         c_skew_relative=abs(c_skew) / c if c > 0 else float("inf"),
         m_bandwidths=m_rows,
@@ -362,7 +372,11 @@ def _as_log(source: LogSource) -> RigLog:
 
 
 def identify_log(
-    source: LogSource, *, axes: list[str] | None = None, load_delay_s: float | None = None
+    source: LogSource,
+    *,
+    axes: list[str] | None = None,
+    load_delay_s: float | None = None,
+    load_filter: str | None = None,
 ) -> Identification:
     """Identify one log (path, DataFrame or RigLog); see `identify`.
 
@@ -378,11 +392,12 @@ def identify_log(
     delay = load_delay_s if load_delay_s is not None else (log.load_delay_s or 0.0)
     if not np.isfinite(delay):
         raise DesignerError(f"load_delay_s={load_delay_s} is not finite", "give the delay in seconds")
+    lowpass = channel.parse(load_filter if load_filter is not None else log.load_filter)
 
     def one(axis: str) -> AxisFit | _Still | str:
         try:
             _check_time(log)
-            return fit_axis(log, axis, load_delay_s=float(delay))
+            return fit_axis(log, axis, load_delay_s=float(delay), load_filter=lowpass)
         except StillAxis as exc:
             return _Still(str(exc))
         except (AxisFailed, np.linalg.LinAlgError) as exc:
@@ -406,6 +421,7 @@ def identify(
     *,
     axes: list[str] | None = None,
     load_delay_s: float | None = None,
+    load_filter: str | None = None,
     progress: Callable[[float], None] | None = None,
 ) -> list[Identification]:
     """Identify m, c, k per axis of each log: a list of `Identification`, one per log, in order.
@@ -413,7 +429,9 @@ def identify(
     logs: a path (CSV or Parquet, with its JSON sidecar), a pandas DataFrame in the log schema, a
     RigLog, or an iterable of these. axes: the axes to fit (default every axis in the log).
     load_delay_s: seconds by which the load channel lags the position (default: the sidecar's
-    `load_delay_s`, else 0); it is corrected exactly. progress: called with the fraction done.
+    `load_delay_s`, else 0); it is corrected exactly. load_filter: the load sensor's low-pass,
+    e.g. "butter2:200Hz" (default: the sidecar's `load_filter`, else none), undone exactly in the
+    frequency domain. progress: called with the fraction done.
     A log that cannot support a fit, or whose fit is physically impossible, is returned with
     `ok` False and the reason in `failures`; doubtful fits carry `warnings`.
 
@@ -424,7 +442,7 @@ def identify(
     sources = [logs] if isinstance(logs, (str, Path, pd.DataFrame, RigLog)) else list(logs)
     out = []
     for i, source in enumerate(sources):
-        out.append(identify_log(source, axes=axes, load_delay_s=load_delay_s))
+        out.append(identify_log(source, axes=axes, load_delay_s=load_delay_s, load_filter=load_filter))
         if progress is not None:
             progress((i + 1) / len(sources))
     return out

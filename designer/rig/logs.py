@@ -24,6 +24,7 @@ from ..data import is_parquet
 from ..errors import DesignerError
 from ..files import atomic_path, atomic_write
 from ..keys import check_keys
+from . import channel
 
 #: the load column of each axis
 LOAD: dict[str, str] = {
@@ -74,6 +75,8 @@ class RigLog:
     dropouts: dict[str, np.ndarray] = field(default_factory=dict)
     #: seconds by which the load channels lag the position channels (from the sidecar), if known
     load_delay_s: float | None = None
+    #: the load sensor's low-pass from the sidecar, e.g. "butter2:200Hz" (checked when identified)
+    load_filter: str | None = None
     #: per axis column, the fraction of samples the sensor did not deliver (NaN or stuck at zero)
     missing_fraction: dict[str, float] = field(default_factory=dict)
 
@@ -103,7 +106,7 @@ class RigLog:
 
 
 #: keys a sidecar may hold: the six factors, and the load channel's lag behind the positions (s)
-SIDECAR_KEYS = ("factors", "load_delay_s")
+SIDECAR_KEYS = ("factors", "load_delay_s", "load_filter")
 
 
 def sidecar_path(path: str | Path) -> Path:
@@ -171,11 +174,11 @@ def _check_factors(factors: dict | None, source: str) -> dict[str, float] | None
         raise DesignerError(f"{source}: {exc.problem}", exc.fix) from None
 
 
-def _read_sidecar(path: Path) -> tuple[dict[str, float] | None, float | None]:
-    """The sidecar's factors and load delay (s), each None when not given."""
+def _read_sidecar(path: Path) -> tuple[dict[str, float] | None, float | None, str | None]:
+    """The sidecar's factors, load delay (s) and load filter, each None when not given."""
     side = sidecar_path(path)
     if not side.exists():
-        return None, None
+        return None, None, None
     try:
         doc = json.loads(side.read_text())
     except (OSError, ValueError) as exc:
@@ -183,8 +186,8 @@ def _read_sidecar(path: Path) -> tuple[dict[str, float] | None, float | None]:
     form = 'write it as {"factors": {"density": 60, ...}, "load_delay_s": 0.002}'
     if isinstance(doc, dict):
         check_keys(doc, SIDECAR_KEYS, where=side.name)
-    if not isinstance(doc, dict) or not ("factors" in doc or "load_delay_s" in doc):
-        raise DesignerError(f"{side}: neither a 'factors' object nor 'load_delay_s'", form)
+    if not isinstance(doc, dict) or not any(key in doc for key in SIDECAR_KEYS):
+        raise DesignerError(f"{side}: none of 'factors', 'load_delay_s', 'load_filter'", form)
     if "factors" in doc and not isinstance(doc["factors"], dict):
         raise DesignerError(f"{side}: 'factors' is not an object", form)
     delay = doc.get("load_delay_s")
@@ -192,7 +195,13 @@ def _read_sidecar(path: Path) -> tuple[dict[str, float] | None, float | None]:
         isinstance(delay, bool) or not isinstance(delay, (int, float)) or not np.isfinite(delay)
     ):
         raise DesignerError(f"{side}: load_delay_s = {delay!r} is not a number of seconds", form)
-    return _check_factors(doc.get("factors"), side.name), None if delay is None else float(delay)
+    lowpass = doc.get("load_filter")
+    if lowpass is not None:
+        try:
+            lowpass = str(channel.parse(lowpass, where="load_filter"))
+        except DesignerError as exc:
+            raise DesignerError(f"{side}: {exc.problem}", exc.fix) from None
+    return _check_factors(doc.get("factors"), side.name), None if delay is None else float(delay), lowpass
 
 
 def validate_frame(
@@ -367,9 +376,9 @@ def read_log(path: str | Path) -> RigLog:
     except (ValueError, OSError, pd.errors.ParserError, UnicodeDecodeError) as exc:
         first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise DesignerError(f"cannot read {p}: {first}", "give a CSV or Parquet rig log") from None
-    factors, delay = _read_sidecar(p)
+    factors, delay, lowpass = _read_sidecar(p)
     log = validate_frame(raw, source=p.name, factors=factors, path=p)
-    log.load_delay_s = delay
+    log.load_delay_s, log.load_filter = delay, lowpass
     return log
 
 
