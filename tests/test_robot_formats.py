@@ -504,3 +504,48 @@ def test_into_a_joint_of_a_fixed_tendon_with_a_new_rest(tmp_path):
     assert flex.qpos_spring[flex.joint("knee").qposadr[0]] == pytest.approx(0.3)
     assert np.array_equal(flex.tendon_stiffness, host.tendon_stiffness)
     assert not np.array_equal(flex.tendon_lengthspring, host.tendon_lengthspring)  # derived from the rest
+
+
+@pytest.mark.parametrize("rest", [0.0, 0.2])
+def test_series_into_keeps_every_keyframe_pose(tmp_path, rest):
+    """The inserted motor joint would shift every later qpos entry of a <key> (MuJoCo pads a short key
+    silently): each key gets the motor at the host's angle less the rest, the flexure at its rest."""
+    keyed = HOST.replace(
+        "</mujoco>",
+        '<keyframe><key name="bent" qpos="0.3 -0.7" qvel="0.1 0.2" ctrl="0.25"/>'
+        '<key name="still" qpos="-0.2 0.5"/></keyframe>\n</mujoco>',
+    )
+    host_path = tmp_path / "keyed.xml"
+    host_path.write_text(keyed)
+    out = export_mjcf(
+        Joint.from_coefficients(THETA),
+        tmp_path / "sea.xml",
+        into=host_path,
+        joint_name="elbow",
+        form="series",
+        rest=rest,
+    )
+    host, sea = (mujoco.MjModel.from_xml_path(str(p)) for p in (host_path, out.path))
+    assert sea.nkey == host.nkey == 2 and sea.nq == host.nq + 1
+    for k in range(host.nkey):
+        poses = []
+        for m in (host, sea):
+            d = mujoco.MjData(m)
+            mujoco.mj_resetDataKeyframe(m, d, k)
+            mujoco.mj_kinematics(m, d)
+            poses.append({b: (d.body(b).xpos.copy(), d.body(b).xquat.copy()) for b in ("upper", "lower")})
+        for b in ("upper", "lower"):
+            np.testing.assert_allclose(poses[1][b][0], poses[0][b][0], atol=1e-12)
+            np.testing.assert_allclose(poses[1][b][1], poses[0][b][1], atol=1e-12)
+        assert sea.key_qpos[k][sea.joint("elbow").qposadr[0]] == pytest.approx(rest)
+    assert sea.key_ctrl[0][-1] == pytest.approx(-0.7 - rest)  # the added servo holds the motor there
+    short = HOST.replace("</mujoco>", '<keyframe><key name="short" qpos="0.3"/></keyframe>\n</mujoco>')
+    (tmp_path / "short.xml").write_text(short)
+    with pytest.raises(DesignerError, match="gives 1 of the robot's 2 qpos values"):
+        export_mjcf(
+            Joint.from_coefficients(THETA),
+            tmp_path / "s.xml",
+            into=tmp_path / "short.xml",
+            joint_name="elbow",
+            form="series",
+        )

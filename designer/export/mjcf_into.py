@@ -259,6 +259,48 @@ def _insert_motor(host: _Host, joint_name: str, motor: robot.Sphere, servo: robo
     return len(moved)
 
 
+def _key_layout(host: _Host, joint_name: str) -> dict[str, int]:
+    """Where the host joint's entries sit in a keyframe's vectors (before the motor is inserted)."""
+    j = host.model.joint(joint_name)
+    return {"qpos": int(j.qposadr[0]), "qvel": int(j.dofadr[0]), "nq": host.model.nq, "nv": host.model.nv}
+
+
+def _extend_keys(host: _Host, joint_name: str, at: dict[str, int], rest: float, *, servo_added: bool) -> None:
+    """Give every <key> the inserted motor joint, so a reset puts every body where the host had it.
+
+    The motor takes the host joint's position less the flexure's `rest` deflection (their rotations
+    about the same axis add up to the host's) and its velocity; the flexure starts at `rest`, still.
+    An added servo's control holds the motor where the key puts it. A key whose qpos or qvel is not
+    the host's full length (MuJoCo pads it) is refused: its meaning would change.
+    """
+    root = host.tree.getroot()
+    servo_index = None
+    if servo_added:
+        acts = [e for section in root.iter("actuator") for e in section if isinstance(e.tag, str)]
+        servo_index = [e.get("name") for e in acts].index(f"{joint_name}_motor")
+    for key in root.iter("key"):
+        vectors = {n: key.get(n).split() for n in ("qpos", "qvel", "ctrl") if key.get(n) is not None}
+        for name, size in (("qpos", at["nq"]), ("qvel", at["nv"])):
+            if name in vectors and len(vectors[name]) != size:
+                raise DesignerError(
+                    f"keyframe {key.get('name') or '(unnamed)'} gives {len(vectors[name])} of the robot's "
+                    f"{size} {name} values",
+                    f"write every key's {name} in full before the series edit inserts a motor joint",
+                )
+        host_q = (
+            float(vectors["qpos"][at["qpos"]]) if "qpos" in vectors else float(host.model.qpos0[at["qpos"]])
+        )
+        if "qpos" in vectors:
+            vectors["qpos"][at["qpos"]] = robot.num(host_q - rest)
+            vectors["qpos"].insert(at["qpos"] + 1, robot.num(rest))
+        if "qvel" in vectors:
+            vectors["qvel"].insert(at["qvel"] + 1, "0")
+        if servo_index is not None and "ctrl" in vectors:
+            vectors["ctrl"].insert(servo_index, robot.num(host_q - rest))
+        for name, values in vectors.items():
+            key.set(name, " ".join(values))
+
+
 def _compare_series(before, after, joint_name: str) -> None:
     """Raise unless every host body keeps its world pose and every host joint its numbers.
 
@@ -341,7 +383,9 @@ def into_series(
         motor_inertia=motor_inertia,
         bandwidth=motor_bandwidth,
     )
+    keys = _key_layout(h, joint_name)
     moved = _insert_motor(h, joint_name, clamp, servo)
+    _extend_keys(h, joint_name, keys, rest, servo_added=not moved)
     _flexure(h, joint, a, rest)
     for attr, value in (("ref", "0"), ("limited", "false")):
         h.element.set(attr, value)
