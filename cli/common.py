@@ -124,10 +124,15 @@ def print_json(data: Any) -> None:
     sys.stdout.write(json.dumps(_clean(data), indent=2) + "\n")
 
 
+#: set by `--quiet` (main.run): no progress bars
+QUIET = False
+
+
 @contextlib.contextmanager
 def progress(description: str, enabled: bool = True) -> Iterator[Callable[[float], None]]:
-    """Yield a callback taking the fraction done (0..1); draws a bar only when stderr is a terminal."""
-    if not (enabled and err_console.is_terminal):
+    """Yield a callback taking the fraction done (0..1); draws a bar only when stderr is a terminal
+    and `--quiet` was not given."""
+    if not (enabled and err_console.is_terminal) or QUIET:
         yield lambda fraction: None
         return
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn

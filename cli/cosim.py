@@ -45,6 +45,35 @@ def cosim(
     _print(summary)
 
 
+def _print_verdict(val: dict) -> None:
+    """What --validate found against what is expected: at each macro step the co-simulation agrees
+    with the same spring-damper inside MuJoCo to round-off, and its error against the fine reference
+    falls at least first-order (Gauss-Seidel) as the step halves."""
+    import math
+
+    from designer.cosim.checks import COSIM_ORDER, COSIM_SAME_STEP
+
+    steps = sorted(val["steps"], key=lambda r: -r["step"])
+    ok = True
+    console.print(f"validation against {val['reference']} (errors in rad, m on a translational axis):")
+    console.print(f"  max error against the reference at the scenario's step: {val['max_error']:.3g}")
+    for prev, row in zip([None, *steps], steps, strict=False):
+        line = f"  step {row['step']:g} s: error {row['max_error']:.3g}"
+        if prev is not None and prev["max_error"] > 0 and row["max_error"] > 0:
+            order = math.log2(prev["max_error"] / row["max_error"]) / math.log2(prev["step"] / row["step"])
+            good = order >= COSIM_ORDER
+            ok &= good
+            line += f", order {order:.2f} (expected >= {COSIM_ORDER:g}: {'pass' if good else 'FAIL'})"
+        same = row.get("max_error_same_step")
+        if same is not None:
+            good = same <= COSIM_SAME_STEP
+            ok &= good
+            verdict = "pass" if good else "FAIL"
+            line += f"; same-step MuJoCo {same:.1g} (expected <= {COSIM_SAME_STEP:g}: {verdict})"
+        console.print(line)
+    console.print(f"validation: {'pass' if ok else 'FAIL'}")
+
+
 def _print(summary: dict) -> None:
     from rich.table import Table
 
@@ -70,10 +99,7 @@ def _print(summary: dict) -> None:
         console.print(table)
     val = summary.get("validation")
     if val:
-        console.print(f"validation against {val['reference']}")
-        console.print(f"  max error at the scenario's step: {val['max_error']:.3g} (rad or m)")
-        for row in val["steps"]:
-            console.print(f"  step {row['step']:.4g} s: max error {row['max_error']:.3g} (rad or m)")
+        _print_verdict(val)
     for note in summary.get("notes", []):
         console.print(f"note: {note}")
     ran = {"kernel": "the compiled kernel", "python": "the Python master"}[summary["engine"]]

@@ -10,7 +10,17 @@ import typer
 
 from designer.errors import DesignerError
 
-from .common import DataOpt, FixOpt, JsonOpt, SurrogateOpt, console, output_option, parse_fix, print_json
+from .common import (
+    DataOpt,
+    FixOpt,
+    JsonOpt,
+    SurrogateOpt,
+    console,
+    output_option,
+    parse_fix,
+    print_json,
+    progress,
+)
 
 AxisOpt = Annotated[str, typer.Option("--axis", help="Axis: x y z theta phi psi.")]
 ToleranceOpt = Annotated[
@@ -62,7 +72,8 @@ def fit(
     if out is not None:
         check_output(out, suffixes=[".json"])
     table = load_table(data)
-    sur = Surrogate().fit(table)
+    with progress("fitting (nested leave-one-out)", enabled=not as_json) as bar:
+        sur = Surrogate().fit(table, progress=bar)
     if out is not None:
         sur.save(out)
     report = sur.report() | {"out": str(out) if out else None}

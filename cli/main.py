@@ -32,7 +32,7 @@ import typer  # noqa: E402
 
 from designer.errors import DesignerError  # noqa: E402
 
-from . import cosim, design, export, loop, plots, rig, sweep  # noqa: E402
+from . import common, cosim, design, export, loop, plots, rig, sweep  # noqa: E402
 from .common import flag_message  # noqa: E402
 
 try:  # typer 0.28 vendors click
@@ -73,6 +73,10 @@ def _options(
     ] = False,
     debug: Annotated[
         bool, typer.Option("--debug", help="On an internal error, show the traceback (any position).")
+    ] = False,
+    quiet: Annotated[
+        bool,
+        typer.Option("--quiet", help="No progress bars on stderr (any position; off a terminal always)."),
     ] = False,
 ) -> None:
     """Options of the `designer` command itself (--debug is also accepted after a sub-command)."""
@@ -136,6 +140,10 @@ def run(argv: list[str] | None = None) -> int:
     debug = "--debug" in args[: args.index("--")] if "--" in args else "--debug" in args
     if debug:
         args.remove("--debug")
+    head = args[: args.index("--")] if "--" in args else args
+    common.QUIET = "--quiet" in head  # like --debug, accepted in any position
+    if common.QUIET:
+        args.remove("--quiet")
     with warnings.catch_warnings():
         if not debug:  # library warnings (numpy overflow, deprecations) are not the user's business
             warnings.simplefilter("ignore")

@@ -19,7 +19,7 @@ import functools
 import hashlib
 import itertools
 import json
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -643,13 +643,21 @@ class Surrogate:
 
         return pd.DataFrame(self.training)
 
-    def fit(self, table: Any, *, responses: list[str] | None = None, nested: bool = True) -> Surrogate:
+    def fit(
+        self,
+        table: Any,
+        *,
+        responses: list[str] | None = None,
+        nested: bool = True,
+        progress: Callable[[float], None] | None = None,
+    ) -> Surrogate:
         """Fit c and k of every axis in a coefficient table (path or DataFrame, rig units).
 
         The table goes through `designer.load_table`, so its problems are named with column and row.
         `responses` picks columns such as ["k_x"]; None fits c and k of every axis present.
         `nested` False skips the nested leave-one-out (a report, not part of the fit: the fitted
-        surfaces are the same), for callers that refit many times.
+        surfaces are the same), for callers that refit many times. `progress` is called with the
+        fraction of responses fitted (0..1) after each.
 
         Raises:
             DesignerError: a malformed table (missing factor, NaN, non-positive k), an unknown
@@ -672,7 +680,11 @@ class Surrogate:
             raise DesignerError(f"the table has {len(table)} runs", "a surrogate needs at least 8")
         X = {n: table[n].to_numpy(dtype=float) for n in space.FACTOR_NAMES}
         _check_varied(X)
-        self.models = {r: select(X, table[r].to_numpy(dtype=float), r, nested=nested) for r in responses}
+        self.models = {}
+        for i, r in enumerate(responses):
+            self.models[r] = select(X, table[r].to_numpy(dtype=float), r, nested=nested)
+            if progress is not None:
+                progress((i + 1) / len(responses))
         self.prior = self.calibration = None
         self.table_hash = table_hash(table)
         self.training = {c: table[c].astype(float).tolist() for c in list(space.FACTOR_NAMES) + responses}
