@@ -20,6 +20,17 @@ from . import space, units
 from .errors import DesignerError
 
 BUNDLED_NAME = "study_table3_x.csv"
+#: the widest a printed joint's coefficients can be, per (quantity, rotational), rig units: far
+#: beyond the study's (k_x 0.25-2.1 N/mm, c_x 5e-4-4.5e-3 N.s/mm); a value outside is a unit or
+#: identification error, and a fit would carry it into every prediction
+PLAUSIBLE = {
+    ("k", False): (1e-6, 1e4),
+    ("c", False): (1e-12, 1e3),
+    ("m", False): (1e-9, 1e3),
+    ("k", True): (1e-3, 1e9),
+    ("c", True): (1e-9, 1e8),
+    ("m", True): (1e-15, 1e3),
+}
 
 # accepted unit suffixes per factor and per (quantity, rotational)
 _FACTOR_SUFFIXES = {
@@ -92,6 +103,10 @@ def canonical_columns(raw: pd.DataFrame, *, source: str = "table") -> pd.DataFra
     for col in raw.columns:
         canon = _canonical_name(str(col), source)
         if canon is None:
+            # a CSV reader names a repeated header 'k_x.1': the same quantity twice
+            base = re.match(r"^(.*)\.\d+$", str(col))
+            if base and base[1] in raw.columns and _canonical_name(base[1], source) is not None:
+                raise DesignerError(f"{source}: the column '{base[1]}' appears twice", "keep one of them")
             continue
         if canon in mapping.values():
             raise DesignerError(f"{source}: two columns give '{canon}'", "keep one of them")
@@ -129,7 +144,7 @@ def normalise(raw: pd.DataFrame, source: str = "table") -> pd.DataFrame:
             )
         out[col] = values.astype(float)
     for col in coefficient_columns(out):
-        q = col.split("_", 1)[0]
+        q, axis = col.split("_", 1)
         bad = out[col] <= 0 if q in ("k", "m") else out[col] < 0
         if bad.any():
             row = int(np.flatnonzero(bad.to_numpy())[0])
@@ -137,6 +152,16 @@ def normalise(raw: pd.DataFrame, source: str = "table") -> pd.DataFrame:
                 f"{source}: column '{col}' row {row + 1} is {out[col].iloc[row]:g}; "
                 + ("it must be positive" if q in ("k", "m") else "it must not be negative"),
                 "check the identification of that run or remove it",
+            )
+        lo, hi = PLAUSIBLE[(q, units.is_rotational(axis))]
+        odd = (out[col] > hi) | ((out[col] > 0) & (out[col] < lo))
+        if odd.any():
+            row = int(np.flatnonzero(odd.to_numpy())[0])
+            unit = units.rig_unit(q, axis)
+            raise DesignerError(
+                f"{source}: column '{col}' row {row + 1} is {out[col].iloc[row]:.3g} {unit}, outside what a "
+                f"printed joint can have ({lo:g} to {hi:g} {unit})",
+                "check the units of that column and the identification of that run",
             )
     for f in space.CONTINUOUS:  # physically possible (positive, infill at most 100 %); ranges may extend
         for row, v in enumerate(out[f.name]):

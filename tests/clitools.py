@@ -84,9 +84,13 @@ def make_inputs(folder: Path) -> None:
         "badunit.csv": lambda t: t.rename(columns={k: "k_x [N/m]"}),
         "levels.csv": lambda t: t.assign(layer=0.3),
         "density500.csv": lambda t: t.assign(density=t["density"].where(t.index != 5, 500)),
+        "k1e308.csv": lambda t: t.assign(**{k: t[k].where(t.index != 4, 1e308)}),
+        "subnormal.csv": lambda t: t.assign(**{k: t[k].where(t.index != 4, 5e-324)}),
     }
     for name, change in variants.items():
         change(good.copy()).to_csv(folder / name, index=False)
+    text = (folder / "good.csv").read_text().splitlines()
+    (folder / "dupcol.csv").write_text("\n".join([text[0] + f",{k}"] + [r + ",0.9" for r in text[1:]]) + "\n")
     _make_logs(folder)
     _make_suggestions(folder)
     _make_series(folder)

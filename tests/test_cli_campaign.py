@@ -52,6 +52,9 @@ BAD_TABLES = [
     "badunit.csv",
     "levels.csv",
     "density500.csv",
+    "k1e308.csv",
+    "subnormal.csv",
+    "dupcol.csv",
     "missing.csv",
 ]
 TABLE_COMMANDS = {
