@@ -34,6 +34,15 @@ def _gazebo(name: str, k: float, rest: float) -> list[str]:
     ]
 
 
+#: who reads what of a URDF joint: URDF has no joint spring, only the extension some hosts read
+READERS = (
+    "the spring (<gazebo> springStiffness/springReference) is read by Gazebo only; MuJoCo, pybullet and "
+    "Drake load this joint as a pure damper (<dynamics damping>)",
+    "for the spring in MuJoCo export mjcf --into the robot's MJCF; in pybullet apply -k (q - rest) as the "
+    "joint's torque each step (README: Robot and system formats)",
+)
+
+
 def urdf_text(joint: Joint, *, rest: float = 0.0) -> tuple[str, dict[str, robot.StepAdvice]]:
     """A fixed base link and one moving link per axis, chained; damping declared, spring in extensions
     (springReference `rest`, rad or m)."""
@@ -226,11 +235,11 @@ def export_urdf(
         data, advice = _into_urdf(joint, Path(into), joint_name=joint_name, axis=axis, rest=rest or 0.0)
         with atomic_path(path) as tmp:
             tmp.write_bytes(data)
-        return robot.RobotExport(path, advice)
+        return robot.RobotExport(path, advice, READERS)
     text, advice = urdf_text(robot.with_masses(joint), rest=rest or 0.0)
     with atomic_write(path) as fh:
         fh.write(text)
-    return robot.RobotExport(path, advice)
+    return robot.RobotExport(path, advice, READERS)
 
 
 def export_sdf(joint: Joint, path: str | Path) -> robot.RobotExport:
