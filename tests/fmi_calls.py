@@ -79,11 +79,18 @@ class Fmu:
             self.names.append(name)
 
     def instantiate(
-        self, kind: int = CS, *, name: str = "joint", logging: bool = True, event_mode: bool = False
+        self,
+        kind: int = CS,
+        *,
+        name: str = "joint",
+        logging: bool = True,
+        event_mode: bool = False,
+        resources: str | None = None,
     ):
-        """A new instance (None when instantiation fails)."""
+        """A new instance (None when instantiation fails); `resources`: the FMI 2 resource location
+        to pass (default: the folder's file URI)."""
         if self.version == 2:
-            uri = (self.folder / "resources").as_uri()
+            uri = resources or (self.folder / "resources").as_uri()
             args = (
                 name.encode(),
                 kind,

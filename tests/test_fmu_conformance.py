@@ -451,3 +451,25 @@ def test_partial_derivatives_match_finite_differences(fmu, version, interface):
         assert f("fmi3GetAdjointDerivative", c, refs_u, n_u, refs_k, n_k, doubles(*seed), n_u, out, n_k) == OK
         np.testing.assert_allclose(out[:n_k], seed @ jac, rtol=1e-6, atol=1e-9)
     f.free(c)
+
+
+def test_fmi2_resource_location_in_every_form_the_standard_allows(paths, tmp_path):
+    """FMI 2.0.4 section 2.1.5: file:///path, file:/path, file://localhost/path, percent-encoded UTF-8
+    (a folder with a space and a user called Jürgen). Each loads the start values (k as exported)."""
+    from urllib.parse import quote
+
+    folder = tmp_path / "Jürgen dir"
+    f = Fmu(*unpack(paths[(2, "body")], folder))
+    res = str(folder / "resources")
+    forms = {
+        "file:///": (folder / "resources").as_uri(),
+        "file:/": "file:" + quote(res),
+        "file://localhost/": "file://localhost" + quote(res),
+        "unencoded file:///": "file://" + res,
+    }
+    for form, uri in forms.items():
+        inst = f.instantiate(CS, resources=uri)
+        assert inst, (form, uri, f.log[-3:])
+        f.start(inst)
+        assert f.get(inst, VR["k"]) == [pytest.approx(K_SI)], form
+        f.free(inst)

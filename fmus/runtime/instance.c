@@ -7,6 +7,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef _WIN32
+#include <wchar.h>
+#include <windows.h>
+#endif
 
 #include "model.h"
 
@@ -69,19 +73,36 @@ static int hexValue(char c) {
 }
 
 /* a file path from an FMI 2 resource URI (file:///a%20b/) or an FMI 3 resource path (/a b/) */
+/* A file path from an FMI resource location (FMI 2.0.4 section 2.1.5, FMI 3 resourcePath): a plain
+   path, or a file URI in any form the standard allows: file:///C:/dir, file:/C:/dir, file://localhost/dir,
+   file://host/share (UNC), percent-encoded (UTF-8 bytes). On Windows the slash before a drive letter
+   is dropped (/C:/dir -> C:/dir). */
 static char *pathFromLocation(const char *location) {
     const char *p = location;
     char *path, *out;
     bool uri = strncmp(p, "file:", 5) == 0;
+    bool unc = false;
     if (strncmp(p, "file://", 7) == 0) {
         p += 7;
-        if (strncmp(p, "localhost/", 10) == 0) p += 9;
+        if (strncmp(p, "localhost/", 10) == 0) {
+            p += 9;
+        } else if (*p != '/') {
+            unc = true; /* file://host/share/dir: the authority is a server */
+        }
     } else if (uri) {
         p += 5;
     }
-    path = malloc(strlen(p) + 1);
+    path = malloc(strlen(p) + 3);
     if (!path) return NULL;
-    for (out = path; *p; p++) {
+    out = path;
+    if (unc) {
+        *out++ = '/';
+        *out++ = '/';
+    }
+#ifdef _WIN32
+    if (p[0] == '/' && isalpha((unsigned char)p[1]) && (p[2] == ':' || p[2] == '|')) p++;
+#endif
+    for (; *p; p++) {
         if (uri && *p == '%' && hexValue(p[1]) >= 0 && hexValue(p[2]) >= 0) {
             *out++ = (char)(hexValue(p[1]) * 16 + hexValue(p[2]));
             p += 2;
@@ -91,6 +112,19 @@ static char *pathFromLocation(const char *location) {
     }
     *out = '\0';
     return path;
+}
+
+/* fopen of a UTF-8 path: FMI strings are UTF-8; Windows' fopen takes the ANSI code page, so a folder
+   named for a user called Jürgen is opened through its wide-character name there. */
+static FILE *openUtf8(const char *path, const char *mode) {
+#ifdef _WIN32
+    wchar_t wpath[4096], wmode[8];
+    if (MultiByteToWideChar(CP_UTF8, 0, path, -1, wpath, 4096) == 0) return NULL;
+    if (MultiByteToWideChar(CP_UTF8, 0, mode, -1, wmode, 8) == 0) return NULL;
+    return _wfopen(wpath, wmode);
+#else
+    return fopen(path, mode);
+#endif
 }
 
 static char *startFilePath(const char *resourceDir) {
@@ -120,7 +154,7 @@ static char *trim(char *s) {
 /* zero the model data and apply the start-value file from the FMU's resources */
 static Status loadStartValues(ModelInstance *inst) {
     char line[MAX_LINE];
-    FILE *file = fopen(inst->startFile, "r");
+    FILE *file = openUtf8(inst->startFile, "r");
     bool tokenSeen = false;
     Status status = OK;
     int number = 0;
