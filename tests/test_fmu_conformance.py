@@ -129,12 +129,14 @@ def _dependencies(path, tag: str, vr: int) -> set[int]:
 
 
 def test_d3_fmi3_dependencies_declare_the_tunable_parameters(paths):
-    """Before: Output and derivative dependencies omitted m, c, k, offset, declaring d/dparameter = 0."""
+    """Before: Output and derivative dependencies omitted m, c, k, offset and enabled (switching the
+    spring-damper off changes x.f and x.a), declaring those partial derivatives zero."""
     assert _dependencies(paths[(3, "force")], "Output", VR["f"]) == {
-        VR[x] for x in ("s", "v", "c", "k", "offset")
+        VR[x] for x in ("s", "v", "c", "k", "offset", "enabled")
     }
-    deps = _dependencies(paths[(3, "body")], "ContinuousStateDerivative", VR["a"])
-    assert deps == {VR[x] for x in ("s", "v", "f", "m", "c", "k", "offset")}
+    for tag in ("ContinuousStateDerivative", "Output"):
+        deps = _dependencies(paths[(3, "body")], tag, VR["a"])
+        assert deps == {VR[x] for x in ("s", "v", "f", "m", "c", "k", "offset", "enabled")}
 
 
 @pytest.mark.parametrize("version", [2, 3])

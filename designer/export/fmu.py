@@ -144,7 +144,7 @@ def _io_variables(a: str, interface: str) -> list[Variable]:
                 f"{what} of the joint, -(k (s - offset) + c v)",
                 unit=f,
                 depends_on=(f"{a}.s", f"{a}.v"),
-                parameters=(f"{a}.c", f"{a}.k", f"{a}.offset"),
+                parameters=(f"{a}.c", f"{a}.k", f"{a}.offset", f"{a}.enabled"),
             )
         )
     else:
@@ -186,7 +186,7 @@ def _io_variables(a: str, interface: str) -> list[Variable]:
                 unit=f"{r}/s^2",
                 derivative_of=f"{a}.v",
                 depends_on=(f"{a}.s", f"{a}.v", f"{a}.f"),
-                parameters=(f"{a}.m", f"{a}.c", f"{a}.k", f"{a}.offset"),
+                parameters=(f"{a}.m", f"{a}.c", f"{a}.k", f"{a}.offset", f"{a}.enabled"),
             )
         )
     return out
