@@ -13,6 +13,8 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
 
@@ -49,3 +51,54 @@ def test_readme_commands_run_verbatim(tmp_path):
         assert "Traceback" not in r.stderr, cmd
     assert not (tmp_path / "MUJOCO_LOG.TXT").exists(), "MuJoCo's log left in the current folder"
     print("\n".join(f"{s:6.1f} s  {c}" for s, c in sorted(timings, reverse=True)))
+
+
+def _figure(pattern: str) -> tuple[str, ...]:
+    text = " ".join(README.read_text().split())  # the README wraps sentences anywhere
+    m = re.search(pattern, text)
+    assert m, f"README no longer states: {pattern}"
+    return m.groups()
+
+
+def test_readme_accuracy_figures_are_the_shipped_surrogates():
+    """The figures README states for k_x are what `designer fit --json` reports of the shipped file."""
+    from designer.surrogate import Surrogate
+
+    q2, rmse, mape, inside = _figure(
+        r"k_x is moderately predictable: nested Q2 = ([\d.]+), RMSE ([\d.]+) N/mm, "
+        r"MAPE (\d+) %, (\d+) % of runs"
+    )
+    nested = Surrogate.load().model("k_x").loo_nested
+    assert (float(q2), float(rmse)) == (round(nested["q2"], 2), round(nested["rmse"], 2))
+    assert (int(mape), int(inside)) == (round(nested["mape"]), round(100 * nested["coverage95"]))
+
+
+def test_readme_sweep_figures_are_what_the_example_sweep_prints(tmp_path):
+    """README's example-sweep sentence (percentiles, settle count, share meeting both limits), rerun."""
+    import json
+
+    p5, p50, p95 = map(int, _figure(r"j2's overshoot after its step is (\d+) / (\d+) / (\d+) %"))
+    (settled,) = map(int, _figure(r"only (\d+) of the 200 draws settle"))
+    (share,) = map(float, _figure(r"and ([\d.]+) % of the prints meet both limits"))
+    out = tmp_path / "sweep"
+    example = ROOT / "examples" / "sweep_arm.toml"
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-I",
+            "-c",
+            "from designer_cli.main import main; main()",
+            "sweep",
+            str(example),
+            "-o",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+    )
+    assert run.returncode == 0, run.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    over = summary["percentiles"]["j2.overshoot_pct"]
+    assert (p5, p50, p95) == (round(over["p5"]), round(over["p50"]), round(over["p95"]))
+    assert settled == summary["percentiles"]["j2.settling_time_s"]["n"]
+    assert share == pytest.approx(100 * summary["share_meeting_all"], abs=0.05)
