@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from .common import FixOpt, JsonOpt, SurrogateOpt, console, output_option, parse_fix, print_json
+from .common import FixOpt, JsonOpt, SurrogateOpt, console, output_option, parse_fix, print_json, progress
 from .design import AxisOpt, ToleranceOpt, _load, _parse_goal, _pi, _tolerance, answer
 
 #: the calibrate report's significant digits for a factor and its interval
@@ -102,16 +102,18 @@ def next_(
     """
     from designer.next_prints import next_prints
 
-    result = next_prints(
-        _load(surrogate),
-        k=_parse_goal(k, "--k"),
-        c=_parse_goal(c, "--c"),
-        axis=axis,
-        fixed=parse_fix(fix),
-        n=n,
-        tolerance=_tolerance(tolerance),
-        stop=stop,
-    )
+    with progress("choosing the next prints", enabled=not as_json) as bar:
+        result = next_prints(
+            _load(surrogate),
+            k=_parse_goal(k, "--k"),
+            c=_parse_goal(c, "--c"),
+            axis=axis,
+            fixed=parse_fix(fix),
+            n=n,
+            tolerance=_tolerance(tolerance),
+            stop=stop,
+            progress=bar,
+        )
     answer(result.to_dict(), as_json, _print_next)
 
 

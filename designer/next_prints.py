@@ -16,7 +16,7 @@ nothing more is worth printing before it.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -200,6 +200,7 @@ def next_prints(
     n: int = 3,
     tolerance: float = TOLERANCE,
     stop: float = STOP,
+    progress: Callable[[float], None] | None = None,
 ) -> NextPrints:
     """The `n` designs to print and measure now that most raise the chance the final recommendation
     lands within `tolerance` of every predictable target.
@@ -212,6 +213,7 @@ def next_prints(
         n: how many designs to print now (1 to 10).
         stop: when the current recommendation lands with at least this probability, propose no
             print but the recommendation itself.
+        progress: called with the fraction of the work done (0..1).
 
     Returns:
         A `NextPrints`: the current recommendation and its P, `prints` (empty when `stop`), the
@@ -260,7 +262,9 @@ def next_prints(
     spans = {f.name: f.high - f.low for f in space.CONTINUOUS}
     chosen: list[NextPrint] = []
     known: list[dict[str, float]] = []
-    for _ in range(int(n)):
+    for step in range(int(n)):
+        if progress is not None:
+            progress(step / (n + 1))
         free = [
             c for c in sug.candidates if all(_distance(c.params, p.params, spans) > DISTINCT for p in chosen)
         ]
@@ -283,7 +287,11 @@ def next_prints(
                 {r: float(np.exp(_log_predictive(base, r, pick.params)[0])) for r in scorer.measured},
             )
         )
+    if progress is not None:
+        progress(n / (n + 1))
     p_after = _batch_p(surrogate, scorer, [p.params for p in chosen], pool)
+    if progress is not None:
+        progress(1.0)
     statements += [
         f"the best design now lands within +-{100 * tolerance:g} % with probability {p_now:.2f}; "
         f"after printing and measuring these {len(chosen)}, the best is expected to land with {p_after:.2f}",
