@@ -27,6 +27,8 @@ def cosim(
 ) -> None:
     """Co-simulate joint FMUs with a MuJoCo robot or the virtual rig; write time series, metrics, plot.
 
+    With --validate, exit 1 when the verdict is FAIL (the results are still written).
+
     Example: designer cosim examples/two_link_arm.toml -o results/ --validate
     """
     from designer.cosim import load, run, write_outputs
@@ -39,24 +41,29 @@ def cosim(
         result = run(sc, validate=validate, progress=bar, engine=engine)
     files = write_outputs(result, out)
     summary = result.summary() | {"files": [str(f) for f in files]}
+    passed = _verdict(summary["validation"])[1] if summary.get("validation") else True
     if json_out:
-        print_json(summary)
-        return
-    _print(summary)
+        print_json(summary | ({"validation_passed": passed} if summary.get("validation") else {}))
+    else:
+        _print(summary)
+    if not passed:  # a check failed: the negative answer's exit code (the outputs are written)
+        raise typer.Exit(1)
 
 
-def _print_verdict(val: dict) -> None:
-    """What --validate found against what is expected: at each macro step the co-simulation agrees
-    with the same spring-damper inside MuJoCo to round-off, and its error against the fine reference
-    falls at least first-order (Gauss-Seidel) as the step halves."""
+def _verdict(val: dict) -> tuple[list[str], bool]:
+    """What --validate found against what is expected, as lines, and whether it passed: at each
+    macro step the co-simulation agrees with the same spring-damper inside MuJoCo to round-off, and
+    its error against the fine reference falls at least first-order (Gauss-Seidel) as the step halves."""
     import math
 
     from designer.cosim.checks import COSIM_ORDER, COSIM_SAME_STEP
 
     steps = sorted(val["steps"], key=lambda r: -r["step"])
     ok = True
-    console.print(f"validation against {val['reference']} (errors in rad, m on a translational axis):")
-    console.print(f"  max error against the reference at the scenario's step: {val['max_error']:.3g}")
+    lines = [
+        f"validation against {val['reference']} (errors in rad, m on a translational axis):",
+        f"  max error against the reference at the scenario's step: {val['max_error']:.3g}",
+    ]
     for prev, row in zip([None, *steps], steps, strict=False):
         line = f"  step {row['step']:g} s: error {row['max_error']:.3g}"
         if prev is not None and prev["max_error"] > 0 and row["max_error"] > 0:
@@ -70,8 +77,17 @@ def _print_verdict(val: dict) -> None:
             ok &= good
             verdict = "pass" if good else "FAIL"
             line += f"; same-step MuJoCo {same:.1g} (expected <= {COSIM_SAME_STEP:g}: {verdict})"
+        lines.append(line)
+    lines.append(f"validation: {'pass' if ok else 'FAIL'}")
+    return lines, ok
+
+
+def _print_verdict(val: dict) -> bool:
+    """Print `_verdict`'s lines; return whether the validation passed."""
+    lines, ok = _verdict(val)
+    for line in lines:
         console.print(line)
-    console.print(f"validation: {'pass' if ok else 'FAIL'}")
+    return ok
 
 
 def _print(summary: dict) -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from designer_cli.common import console
 from designer_cli.cosim import _print_verdict
+from designer_cli.cosim import _verdict as verdict
 
 
 def _verdict(steps: list[dict]) -> str:
@@ -30,3 +31,11 @@ def test_same_step_disagreement_fails():
     out = _verdict(steps)
     assert "same-step MuJoCo 0.001 (expected <= 1e-09: FAIL)" in out
     assert out.strip().endswith("validation: FAIL")
+
+
+def test_the_verdict_decides_the_exit():
+    """`cosim --validate` exits 1 on FAIL: the verdict's flag is what the command acts on."""
+    good = [{"step": 2e-3, "max_error": 0.06}, {"step": 4e-3, "max_error": 0.13}]
+    bad = [{"step": 4e-3, "max_error": 0.13}, {"step": 2e-3, "max_error": 0.12}]
+    assert verdict({"reference": "t", "max_error": 0.0, "steps": good})[1]
+    assert not verdict({"reference": "t", "max_error": 0.0, "steps": bad})[1]
