@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from designer.cosim import kernel
+from designer.cosim import binding, kernel
 from designer.cosim.master import Master
 from designer.cosim.references import Chirp, Sine, Step, Trajectory
 from designer.cosim.robot import Robot, SpringDamper, load_spec
@@ -152,7 +152,7 @@ def test_kernel_references_match_python(tmp_path):
     lib = kernel.library()
     for ref in refs:
         keep = []
-        struct = kernel.reference(ref, keep)
+        struct = binding.reference(ref, keep)
         q, v = kernel.ctypes.c_double(), kernel.ctypes.c_double()
         for t in times:
             lib.ks_reference_eval(kernel.ctypes.byref(struct), float(t), q, v)
@@ -286,7 +286,7 @@ def asking_fmus(monkeypatch, every=250, fail_at=None):
     from designer.cosim import fmu as fmu_module
 
     proto = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p)
-    original_init, real_function = fmu_module.FmuSystem.__init__, kernel._function
+    original_init, real_function = fmu_module.FmuSystem.__init__, fmu_module.fmi_function
     events, fakes, keep = [], {}, []
 
     def asking(fmu):
@@ -322,7 +322,7 @@ def asking_fmus(monkeypatch, every=250, fail_at=None):
         return fakes[id(fmu)] if name.endswith("CompletedIntegratorStep") else real_function(fmu, name)
 
     monkeypatch.setattr(fmu_module.FmuSystem, "__init__", init)
-    monkeypatch.setattr(kernel, "_function", function)
+    monkeypatch.setattr(fmu_module, "fmi_function", function)
     return events
 
 

@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DesignerError
+from . import binding as kb
 
 PARAMETERS = ("m", "c", "k", "offset")
 STATUS = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
@@ -134,6 +135,11 @@ def unpack(path: str | Path, folder: str | Path) -> Path:
     from fmpy import extract
 
     return Path(extract(str(path), str(folder), include=lambda n: n.startswith(("binaries/", "resources/"))))
+
+
+def fmi_function(fmu, name: str) -> int:
+    """The address of FMI function `name` in an fmpy FMU's loaded library."""
+    return ctypes.cast(getattr(fmu.dll, name), ctypes.c_void_p).value
 
 
 def _same_instant_capable(md) -> bool:
@@ -293,7 +299,7 @@ class FmuSystem:
         for _ in range(1000):
             more, terminate, *_ = update()
             if terminate:
-                raise self._terminated()
+                raise self.terminated()
             if not more:
                 break
         else:
@@ -407,12 +413,52 @@ class FmuSystem:
             DesignerError: the FMU asked to terminate the simulation.
         """
         if terminate:
-            raise self._terminated()
+            raise self.terminated()
         if enter:
             self.fmu.enterEventMode()
             self._event_iteration()
 
-    def _terminated(self) -> DesignerError:
+    def binding(self) -> kb.Binding:
+        """The instance for the compiled kernel (see designer.cosim.binding): its FMI functions,
+        co-simulation (DoStep) or Model Exchange without states (SetTime, and
+        CompletedIntegratorStep when the FMU needs it), as `do_step` drives it."""
+        v, fmu = self.version, self.fmu
+        names = {
+            "set": "SetFloat64" if v == 3 else "SetReal",
+            "get": "GetFloat64" if v == 3 else "GetReal",
+            "step": "DoStep",
+            "time": "SetTime",
+            "completed": "CompletedIntegratorStep",
+        }
+        wanted = ["set", "get"]
+        if self.kind == "co-simulation":
+            wanted.append("step")
+        else:
+            wanted += ["time", "completed"] if self.needs_completed_step else ["time"]
+
+        def start() -> int:
+            return self._steps
+
+        def finish(steps: int) -> None:
+            self._steps = steps
+
+        def error(call: int, status: int, t: float) -> DesignerError:
+            return self.status_error(f"fmi{v}{names[kb.CALLS[call]]}", status, t)
+
+        return kb.Binding(
+            kb.FMI3 if v == 3 else kb.FMI2,
+            fmu.component,
+            start,
+            finish,
+            functions={w: fmi_function(fmu, f"fmi{v}{names[w]}") for w in wanted},
+            in_vr=self._in_vr,
+            out_vr=self._out_vr,
+            event=lambda: self.completed(True, False),
+            error=error,
+            terminated=self.terminated,
+        )
+
+    def terminated(self) -> DesignerError:
         return DesignerError(
             f"FMU instance {self.fmu.instanceName} asked to terminate the simulation",
             "check the FMU's inputs and parameters",

@@ -25,7 +25,7 @@ from typing import Any
 
 from ..errors import DesignerError
 from .fmu import FmuDescription, FmuSystem
-from .kernel import run_master
+from .kernel import ENGINES, Bound, bind, run_master
 from .master import Master, Trace
 from .robot import Robot, SpringDamper, load_spec
 from .scenario import PARAMETER_FIELDS, JointSource, Scenario
@@ -75,6 +75,7 @@ class Session:
         self.descriptions: dict[str, FmuDescription] = {}
         self.systems: dict[str, FmuSystem] = {}
         self._masters: dict[float, Master] = {}
+        self._bound: dict[float, Bound | None] = {}
         self.closed = False
 
     # ------------------------------------------------------------------ set-up (prepare)
@@ -194,7 +195,25 @@ class Session:
                 p = laws["rig"]
                 check_stable(p["m"], p["c"], p["k"], step)
                 system.stiffness, system.damping = servo_gains(p["m"], p["c"], p["k"])
-        return run_master(master, duration, step, progress=progress, engine=engine)
+        bound = self._kernel(step, master, engine)
+        if bound is None and engine == "auto":
+            engine = "python"
+        return run_master(master, duration, step, progress=progress, engine=engine, bound=bound)
+
+    def _kernel(self, step: float, master: Master, engine: str) -> Bound | None:
+        """The master at `step` bound to the compiled kernel once (None: python, or it cannot)."""
+        if engine not in ENGINES:
+            raise DesignerError(f"unknown engine '{engine}'", f"use one of: {', '.join(ENGINES)}")
+        if engine == "python":
+            return None
+        if step not in self._bound:
+            try:
+                self._bound[step] = bind(master)
+            except DesignerError:
+                if engine == "kernel":
+                    raise
+                self._bound[step] = None
+        return self._bound[step]
 
     def run(
         self,
@@ -230,6 +249,7 @@ class Session:
         if not self.closed:
             self.closed = True
             self._masters.clear()
+            self._bound.clear()
             self._stack.close()
 
     def __enter__(self) -> Session:

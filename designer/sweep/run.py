@@ -51,10 +51,9 @@ def read_journal(path: Path | None) -> dict[str, dict]:
 def _batch_size(spec: Spec, n_cases: int, workers: int) -> int:
     if spec.batch is not None:
         return spec.batch
-    # FMU cases take tens of ms each, so small batches keep workers busy and the bar moving;
-    # the engine path wants large batches for mujoco.rollout
-    cap = 256 if spec.path == "engine" else 8
-    return max(1, min(cap, math.ceil(n_cases / (4 * max(workers, 1)))))
+    # a batch is one prepared Session (FMU path, tens of ms to set up, a few ms a 1 s case) or one
+    # mujoco.rollout (engine path): large batches; four per worker keep the bar moving
+    return max(1, min(256, math.ceil(n_cases / (4 * max(workers, 1)))))
 
 
 @contextlib.contextmanager
