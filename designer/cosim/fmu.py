@@ -76,9 +76,9 @@ def _axes_of(md) -> set[str]:
 class FmuDescription:
     """An FMU's modelDescription.xml, read once: what a run needs from it.
 
-    `path` the archive, `md` fmpy's ModelDescription, `version` 2 or 3, `interface` "force" or "body"
-    (of `axes`), `refs` variable name -> value reference, `starts` variable name -> start value (as
-    written), `axes` the axes the FMU has.
+    `path` the archive (or the folder of an unpacked one), `md` fmpy's ModelDescription, `version`
+    2 or 3, `interface` "force" or "body" (of `axes`), `refs` variable name -> value reference,
+    `starts` variable name -> start value (as written), `axes` the axes the FMU has.
 
     Raises:
         DesignerError: the file is missing, not a readable FMU, without co-simulation, or lacks an axis.
@@ -88,7 +88,7 @@ class FmuDescription:
         from fmpy import read_model_description
 
         path = Path(path)
-        if not path.is_file():
+        if not path.exists():
             raise DesignerError(
                 f"FMU {path} does not exist", "export one with `designer export fmu` or fix the path"
             )
@@ -171,7 +171,7 @@ class FmuSystem:
     ) -> None:
         """Instantiate `fmu` (a path, or its description read once), set `parameters` (SI, keyed
         "axis.field"), initialise it; unpacked into `folder` (kept by its owner) or a temporary
-        folder removed by `close`.
+        folder removed by `close` (an FMU already unpacked, a folder, is used where it is).
 
         Raises:
             DesignerError: not a usable FMU, an unknown parameter, or the FMU refused to start.
@@ -198,11 +198,16 @@ class FmuSystem:
             self.outputs = [f"{a}.{v}" for a in axes for v in ("s", "v", "a")]
         self.needs_completed_step = bool(me and md.md.modelExchange.needsCompletedIntegratorStep)
         self.parameters = dict(parameters or {})
-        self._owned = folder is None
-        self._dir = tempfile.mkdtemp(prefix="designer-fmu-") if folder is None else str(folder)
+        unpacked = md.path.is_dir()
+        self._owned = folder is None and not unpacked
+        if unpacked:
+            self._dir = str(md.path)
+        else:
+            self._dir = tempfile.mkdtemp(prefix="designer-fmu-") if folder is None else str(folder)
         self.log: deque[str] = deque(maxlen=LOG_LINES)
         try:
-            unpack(md.path, self._dir)
+            if not unpacked:
+                unpack(md.path, self._dir)
             self.fmu = self._instantiate(md.md, name, me)
             self._start(self.parameters)
             self._bind(md.refs)

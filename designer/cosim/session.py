@@ -1,10 +1,11 @@
 """Prepare once, run many: a co-simulation `Session` (FMPy's efficient loops, mujoco's `Rollout`).
 
-`prepare(scenario)` does every piece of set-up once: it checks the scenario, exports the joints that
-are not FMU files (or takes the files), reads each modelDescription once, unpacks only `binaries/`
-and `resources/` into one temporary folder, instantiates the FMUs, compiles the MuJoCo model and
-wires the master. `Session.run(parameters)` then resets every system (FMI Reset, `mj_resetData`,
-counters), applies the case's parameters and runs the loop: the cost of a run is the loop itself.
+`prepare(scenario)` does every piece of set-up once: it checks the scenario, unpacks each joint FMU
+(only `binaries/` and `resources/`; a joint given as a `Joint` is written there as its export would
+archive it, without the zip) into one temporary folder, reads each modelDescription once,
+instantiates the FMUs, compiles the MuJoCo model and wires the master. `Session.run(parameters)`
+then resets every system (FMI Reset, `mj_resetData`, counters), applies the case's parameters and
+runs the loop: the cost of a run is the loop itself.
 
     with designer.cosim.prepare(sc) as session:
         for k in (0.2, 0.3, 0.4):
@@ -24,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import DesignerError
-from .fmu import FmuDescription, FmuSystem
+from .fmu import FmuDescription, FmuSystem, unpack
 from .kernel import ENGINES, Bound, bind, run_master
 from .master import Master, Trace
 from .robot import Robot, SpringDamper, load_spec
@@ -51,13 +52,21 @@ def sources(sc: Scenario) -> dict[str, JointSource]:
     return {"rig": sc.rig_joint} if sc.kind == "rig" else dict(sc.joints)
 
 
-def _fmu_file(name: str, src: JointSource, interface: str, folder: Path) -> Path:
-    """The FMU file of a joint source: its file, or its joint exported into `folder`."""
+def _unpacked(src: JointSource, interface: str, folder: Path) -> Path:
+    """A joint's FMU as an importer loads it, in `folder`: an FMU file's binaries/ and resources/, or
+    for a `Joint` the files its export would archive, written there directly (no zip; no sources)."""
     if src.fmu is not None:
-        return Path(src.fmu)
-    from ..export.fmu import export_fmu
+        return unpack(src.fmu, folder)
+    from ..export.fmu import archive_entries
 
-    return export_fmu(src.joint, folder / f"{name}.fmu", fmi_version=src.fmi_version, interface=interface)
+    for name, data in archive_entries(src.joint, src.fmi_version, interface).items():
+        if name.startswith(("binaries/", "resources/")) or name == "modelDescription.xml":
+            target = folder / name
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_bytes(data)
+            if name.startswith("binaries/"):
+                target.chmod(0o755)
+    return folder
 
 
 class Session:
@@ -85,16 +94,14 @@ class Session:
         sc = self.scenario
         interface = "body" if sc.kind == "rig" else "force"
         for name, src in sources(sc).items():
-            path = _fmu_file(name, src, interface, self._folder)
-            md = FmuDescription(path, [src.axis])
+            unpacked = _unpacked(src, interface, self._folder / name)
+            md = FmuDescription(src.fmu or unpacked, [src.axis])
             if md.interface != interface:
                 raise DesignerError(
                     f"the FMU of joint {name} has the {md.interface} interface",
                     f"export it with interface='{interface}'",
                 )
             self.descriptions[name] = md
-            unpacked = self._folder / f"{name}.unpacked"
-            unpacked.mkdir()
             system = FmuSystem(md, [src.axis], name=name, parameters=src.parameters, folder=unpacked)
             self._stack.callback(system.close)
             self.systems[name] = system
