@@ -236,13 +236,13 @@ class FmuSystem:
         """
         given = self.parameters | dict(parameters or {})
         self.log.clear()
+        self._steps, self._h = 0, 0.0
         try:
             self.fmu.reset()
             self._start(given)
         except Exception as exc:
             self._refused(exc, self.name, given)
             raise
-        self._steps, self._h = 0, 0.0
 
     def _refused(self, exc: BaseException, name: str, parameters: Mapping[str, float]) -> None:
         """Raise a DesignerError naming the joint and its parameters when the FMU refused to start

@@ -176,17 +176,25 @@ class Session:
 
     def trace(
         self,
-        case: Mapping[str, Mapping[str, float]],
-        laws: Mapping[str, Mapping[str, float]],
+        case: Mapping[str, Mapping[str, float]] | None = None,
         *,
-        step: float,
-        duration: float,
+        step: float | None = None,
+        duration: float | None = None,
         progress: Progress = None,
         engine: str = "auto",
     ) -> Trace:
-        """Reset every system, apply `case` (from `parameters`), run the loop at `step` for `duration`."""
+        """The time series of one run: every system reset, `case` applied (as `parameters` returns
+        it; None: the scenario as it is), the loop run at `step` for `duration` (s; defaults the
+        scenario's). A step other than the scenario's gets its own robot (or hub), built once.
+
+        Raises:
+            DesignerError: as `run`.
+        """
         if self.closed:
             raise DesignerError("the session is closed", "prepare the scenario again")
+        sc = self.scenario
+        case = self.parameters(None) if case is None else case
+        step = sc.step if step is None else step
         if step not in self._masters:
             self._masters[step] = self._master(step)
         master = self._masters[step]
@@ -199,13 +207,14 @@ class Session:
             if name == "hub":
                 from .rig import check_stable, servo_gains
 
-                p = laws["rig"]
+                p = self.laws(case)["rig"]
                 check_stable(p["m"], p["c"], p["k"], step)
                 system.stiffness, system.damping = servo_gains(p["m"], p["c"], p["k"])
         bound = self._kernel(step, master, engine)
         if bound is None and engine == "auto":
             engine = "python"
-        return run_master(master, duration, step, progress=progress, engine=engine, bound=bound)
+        span = sc.duration if duration is None else duration
+        return run_master(master, span, step, progress=progress, engine=engine, bound=bound)
 
     def _kernel(self, step: float, master: Master, engine: str) -> Bound | None:
         """The master at `step` bound to the compiled kernel once (None: python, or it cannot)."""
