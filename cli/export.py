@@ -260,10 +260,11 @@ def _fmu(
     """The FMU (co-simulation and model exchange) with the shipped binaries for the chosen platforms,
     compiled instead when the C sources were edited or --build asks."""
     from designer.export import build
-    from designer.export.fmu import export_fmu
+    from designer.export.fmu import FMI_VERSIONS, export_fmu
 
     platforms = platforms or "all"
-    compiling = [] if source_only else build.needs_compiling(fmi, platforms, rebuild=build_binaries)
+    checked = not source_only and fmi in FMI_VERSIONS  # export_fmu reports a bad --fmi
+    compiling = build.needs_compiling(fmi, platforms, rebuild=build_binaries) if checked else []
     if compiling:
         why = "--build" if build_binaries else "the C sources differ from the shipped binaries'"
         err_console.print(
