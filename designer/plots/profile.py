@@ -46,6 +46,11 @@ TOLERANCE = 0.10
 PRINTABLE_MIN_MM = 2 * space.WALL_MM + space.NOZZLE_MM
 #: points per continuous factor where the y range of each response's panels is sampled
 _RANGE_POINTS = 5
+#: the simulator's default print-process noise, one standard deviation per continuous factor
+#: (rig units: an FDM printer holds a dimension to about +-0.1 mm; the slicer sets the infill exactly)
+PRINT_NOISE: dict[str, float] = {"density": 0.0, "length": 0.1, "width": 0.1, "height": 0.1}
+#: the simulator's Monte Carlo size (draws of the print noise)
+MC_DRAWS = 4000
 
 
 class _Expr:
@@ -137,15 +142,17 @@ def _value_range(model: ResponseSurface, observed: np.ndarray, target: float | N
     return [max(lo - pad, 0.0) if lo >= 0 else lo - pad, hi + pad]
 
 
-def _target(surrogate: Surrogate, quantity: str, axis: str, value: float) -> dict[str, float]:
-    """A target with its desirability bounds, as `designer suggest` sets them."""
+def _target(surrogate: Surrogate, quantity: str, axis: str, goal: float | str) -> dict[str, Any]:
+    """A goal (a target value, "min" or "max") with its desirability bounds, as `designer suggest`
+    sets them."""
     from ..suggestions import make_target
 
-    t = make_target(surrogate, quantity, axis, value)
-    return {"value": t.value, "low": t.low, "high": t.high, "importance": t.importance}
+    return make_target(surrogate, quantity, axis, goal).to_dict()
 
 
-def _response(surrogate: Surrogate, name: str, statement: str, target: float | None) -> dict[str, Any]:
+def _response(
+    surrogate: Surrogate, name: str, statement: str, target: float | str | None
+) -> dict[str, Any]:
     model = surrogate.model(name)
     observed = np.asarray(surrogate.training[name], float)
     return {
@@ -165,7 +172,8 @@ def _response(surrogate: Surrogate, name: str, statement: str, target: float | N
         "predictable": bool(model.predictable),
         "statement": statement,
         "accuracy": _accuracy(model),
-        "range": _value_range(model, observed, target),
+        "range": _value_range(model, observed, target if isinstance(target, float | int) else None),
+        "observed": [float(v) for v in model.observed_range],
         "target": None if target is None else _target(surrogate, model.quantity, model.axis, target),
     }
 
@@ -202,15 +210,45 @@ def _suggestions(suggestion: Any) -> list[dict[str, Any]]:
                 f"suggestion candidate {i} does not give all six factors",
                 "pass a Suggestion, its to_dict() or such a JSON file",
             ) from None
-        try:
-            space.check_design(params)
-            inside = True
-        except DesignerError:
-            inside = False  # extrapolated: listed, but the sliders cannot reach it
+        # outside the tested ranges: listed with the reason, but the sliders cannot reach it
+        outside = [
+            f"{f.name} {params[f.name]:g} {f.unit} outside {f.describe_range()}"
+            for f in space.FACTORS
+            if not _within(f, params[f.name])
+        ]
         # factors without effect on this design (suggest's "any", e.g. density at 2 mm width)
         free = [n for n in c.get("any", []) if n in space.FACTOR_NAMES]
-        out.append({"rank": i, "params": params, "inside": inside, "any": free})
+        p = c.get("p_within")
+        out.append(
+            {
+                "rank": i,
+                "params": params,
+                "inside": not outside,
+                "outside": outside,
+                "any": free,
+                "p_within": None if p is None else float(p),
+            }
+        )
     return out
+
+
+def _within(f: space.Factor, v: float) -> bool:
+    """Whether a value lies in a factor's tested range (one of its levels when categorical)."""
+    if f.categorical:
+        return any(abs(v - lv) <= 1e-9 for lv in f.levels)
+    return f.low - 1e-9 <= v <= f.high + 1e-9
+
+
+def _search_data() -> dict[str, Any]:
+    """What the page's "maximize" needs to run `designer suggest`'s search: its starts and weights."""
+    from ..suggestions import DISTINCT, N_STARTS, PI_WEIGHT, _starts
+
+    return {
+        "starts": _starts(N_STARTS, len(space.CONTINUOUS)).tolist(),
+        "n_starts": N_STARTS,
+        "pi_weight": PI_WEIGHT,
+        "distinct": DISTINCT,
+    }
 
 
 @dataclass
@@ -295,6 +333,9 @@ def build_profiler(
             "suggestions": _suggestions(suggestion),
             "wall_mm": space.WALL_MM,
             "nozzle_mm": space.NOZZLE_MM,
+            "search": _search_data(),
+            "noise": PRINT_NOISE,
+            "mc_draws": MC_DRAWS,
         }
     )
 
