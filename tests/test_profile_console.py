@@ -186,7 +186,8 @@ def test_layout_fits_the_screen(browser, url, tmp_path, width, height):
     assert sizes[0] <= sizes[1], f"horizontal overflow at {width} px: {sizes}"
     tops = page.js(
         "(() => { const o = {}; for (const s of document.querySelectorAll('svg[data-response]'))"
-        " (o[s.dataset.response] = o[s.dataset.response] || []).push(Math.round(s.getBoundingClientRect().top));"
+        " (o[s.dataset.response] = o[s.dataset.response] || [])"
+        ".push(Math.round(s.getBoundingClientRect().top));"
         " return o; })()"
     )
     assert set(tops) == {"k_x", "c_x"} and all(len(v) == 6 for v in tops.values())
@@ -201,7 +202,8 @@ def test_layout_fits_the_screen(browser, url, tmp_path, width, height):
     small = page.js(
         "[...document.querySelectorAll('button, select, input[type=number], input[type=range], label.lock,"
         " details.flat summary')].map(e => [e.id || e.textContent.slice(0, 20), e.getBoundingClientRect()])"
-        ".filter(([, r]) => r.width > 0 && (r.width < 44 || r.height < 44)).map(([n, r]) => [n, r.width, r.height])"
+        ".filter(([, r]) => r.width > 0 && (r.width < 44 || r.height < 44))"
+        ".map(([n, r]) => [n, r.width, r.height])"
     )
     assert small == [], f"touch targets under 44 px: {small}"
     shot = page.screenshot(tmp_path / f"profile_{width}.png")
@@ -285,11 +287,11 @@ def test_density_pinned_where_the_part_prints_solid(page, sur):
     page.key("Home", 36)
     assert _design(page)["width"] == 2.0
     state = page.js(
-        "({disabled: document.getElementById('s-density').disabled,"
-        " shown: document.getElementById('v-density').textContent,"
-        " label: document.querySelector('svg[data-response=\"k_x\"][data-factor=\"density\"]').getAttribute('aria-label'),"
-        " curve: document.querySelector('svg[data-response=\"k_x\"][data-factor=\"density\"] polyline').getAttribute('points'),"
-        " note: document.getElementById('notes').textContent})"
+        '(() => { const svg = document.querySelector(\'svg[data-response="k_x"][data-factor="density"]\');'
+        " return {disabled: document.getElementById('s-density').disabled,"
+        " shown: document.getElementById('v-density').textContent, label: svg.getAttribute('aria-label'),"
+        " curve: svg.querySelector('polyline').getAttribute('points'),"
+        " note: document.getElementById('notes').textContent}; })()"
     )
     assert state["disabled"] and state["shown"] == "100 % (solid)"
     assert "flat" in state["label"] and "prints solid" in state["note"]
@@ -347,7 +349,8 @@ def test_suggestion_buttons_name_the_factors_and_say_why_one_is_out_of_reach(bro
         in names
     )
     why = page.js(
-        "(() => { const e = document.querySelector('#sug-2 .why'); return [e.textContent, e.offsetHeight]; })()"
+        "(() => { const e = document.querySelector('#sug-2 .why');"
+        " return [e.textContent, e.offsetHeight]; })()"
     )
     assert why[0] == "not shown: width 8 mm outside 2 to 7 mm (an extrapolation the sliders cannot reach)"
     assert why[1] > 0  # visible, not a tooltip
