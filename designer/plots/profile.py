@@ -150,9 +150,7 @@ def _target(surrogate: Surrogate, quantity: str, axis: str, goal: float | str) -
     return make_target(surrogate, quantity, axis, goal).to_dict()
 
 
-def _response(
-    surrogate: Surrogate, name: str, statement: str, target: float | str | None
-) -> dict[str, Any]:
+def _response(surrogate: Surrogate, name: str, statement: str, target: float | str | None) -> dict[str, Any]:
     model = surrogate.model(name)
     observed = np.asarray(surrogate.training[name], float)
     return {
@@ -279,7 +277,7 @@ def build_profiler(
     Args:
         surrogate: the fitted surrogate whose coefficients the page evaluates.
         axis: the axis of the responses (x y z theta phi psi).
-        targets: target values by quantity in rig units, e.g. {"k": 0.8} (N/mm).
+        targets: goals by quantity: a target in rig units, e.g. {"k": 0.8} (N/mm), or "min" or "max".
         tolerance: relative tolerance of "meeting the target" (0.1: within 10 %).
         suggestion: a `Suggestion`, its `to_dict()` or the path of a JSON file of it (what the
             suggest command writes with its JSON option).
