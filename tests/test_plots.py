@@ -164,6 +164,28 @@ def _cosim_frame() -> pd.DataFrame:
     return pd.DataFrame(cols)
 
 
+def test_plot_loo_prints_the_figures_it_draws(tmp_path):
+    """The terminal and the figure give the nested leave-one-out Q2 (0.32 for k_x, not the selected
+    form's optimistic 0.43), and the legend sits below the data."""
+    from designer.plots import loo
+    from designer.surrogate import Surrogate
+
+    sur = Surrogate.load()
+    nested = sur.model("k_x").accuracy["q2"]
+    run = designer("plot", "loo", "-o", "loo.png", cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    line = next(ln for ln in run.stdout.splitlines() if ln.startswith("k_x"))
+    assert f"nested leave-one-out Q2 {nested:.2f}" in line
+    fig = loo.plot_loo(sur, responses=["k_x"])
+    assert f"nested Q2 {nested:.2f}" in fig.axes[0].get_title()
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    assert (
+        fig.axes[0].get_legend().get_window_extent(renderer).y1 <= fig.axes[0].get_window_extent(renderer).y0
+    )
+    assert_inside(fig)
+
+
 def test_signal_units_follow_the_axis():
     from designer.plots.timeseries import signal_unit
 
