@@ -161,6 +161,10 @@ def space_cmd(
     console.print(
         f"{resp} from {view.value_range[0]:.4g} to {view.value_range[1]:.4g} {view.unit} (held: {held})"
     )
+    if not sur.model(resp).predictable:
+        from designer.suggestions import predictability
+
+        console.print(predictability(sur, axis)[response]["statement"])
     if target is not None:
         console.print(
             f"target {target:g} {view.unit} lies inside the 95 % PI over {view.target_in_pi:.0%} of the plot"
