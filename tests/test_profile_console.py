@@ -357,3 +357,25 @@ def test_suggestion_buttons_name_the_factors_and_say_why_one_is_out_of_reach(bro
     page.click("#sug-1")
     assert _design(page)["width"] == 3.5
     page.call("Page.close")
+
+
+def test_every_html_output_fits_a_phone(browser, sur, tmp_path):
+    """plot space --html and the validation report: a viewport meta, no horizontal overflow at 390 px."""
+    from designer import checks, report
+    from designer.data import load_table
+    from designer.data_checks import check_dataset
+    from designer.plots import html3d, space
+
+    html3d.write_scene(space.surface_view(sur, "k_x", resolution=9).scene, tmp_path / "scene.html")
+    figures = tmp_path / "figures"
+    figures.mkdir()
+    results = checks.run_checks(checks.Context(load_table(), figures), (check_dataset,))
+    page_path, _ = report.write_report(results, tmp_path, 1.0)
+    for path in (tmp_path / "scene.html", page_path):
+        assert 'name="viewport"' in path.read_text().replace("'", '"'), path.name
+        page = browser.new_page()
+        page.viewport(390, 844, mobile=True)
+        page.goto(path.resolve().as_uri())
+        sizes = page.js("[document.documentElement.scrollWidth, document.documentElement.clientWidth]")
+        assert sizes[0] <= sizes[1], (path.name, sizes)
+        page.call("Page.close")

@@ -14,7 +14,7 @@ from matplotlib.figure import Figure
 
 from .. import units
 from ..errors import DesignerError
-from .common import new_figure, value_formatter
+from .common import new_figure
 
 #: most panels drawn in one figure
 MAX_PANELS = 8
@@ -100,7 +100,8 @@ def _title(cols: list[str], columns: list[str]) -> str:
         loads = {signal_unit(c, columns) for c in cols if str(c).endswith(".f")}
         word = {frozenset({"N.m"}): "torque f", frozenset({"N"}): "force f"}.get(frozenset(loads), "load f")
         return ", ".join(word if v == "f" else SIGNALS[v][0] for v in variables)
-    return ", ".join(map(str, cols)) if len(cols) <= 3 else f"{len(cols)} signals"
+    text = ", ".join(map(str, cols))
+    return text if len(text) <= 70 else f"{cols[0]} and {len(cols) - 1} more (legend)"
 
 
 def _panels(frame: pd.DataFrame, columns: list[str] | None, time: str) -> dict[str, list[str]]:
@@ -162,7 +163,6 @@ def plot_timeseries(
         ax.legend(fontsize=7.5, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, borderaxespad=0)
         ax.set_title(_title(cols, list(frame.columns)), fontsize=9, loc="left")
         ax.set_ylabel(label, fontsize=8.5)
-        ax.yaxis.set_major_formatter(value_formatter())
         ax.grid(alpha=0.3)
     axes[-1, 0].set_xlabel(f"{time} (s)")
     return fig
