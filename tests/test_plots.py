@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -272,3 +273,26 @@ def test_importing_and_plotting_leave_the_process_alone(tmp_path):
         [sys.executable, "-I", "-c", code, str(tmp_path / "e.png")], capture_output=True, text=True, env=env
     )
     assert run.returncode == 0 and "clean" in run.stdout, run.stderr
+
+
+def test_readme_shows_one_picture_of_each_figure_command():
+    """Every `designer plot` command of README's table has its picture beside it, and each exists."""
+    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+    pictures = re.findall(r"!\[[^\]]*\]\((docs/figures/[^)]+\.png)\)", readme)
+    root = Path(__file__).resolve().parent.parent
+    for rel in pictures:
+        assert_picture(root / rel)
+    commands = set(re.findall(r"`designer plot (\w+)", readme))
+    assert commands == {"effects", "heatmap", "loo", "space", "timeseries"}
+    for name in (
+        "effects",
+        "heatmap",
+        "loo",
+        "space",
+        "volume",
+        "space_c",
+        "timeseries",
+        "cosim_plot",
+        "profiler",
+    ):
+        assert f"docs/figures/{name}.png" in pictures, name
