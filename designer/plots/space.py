@@ -315,6 +315,28 @@ def _run_layers(points: np.ndarray, near: np.ndarray) -> list[Layer]:
     return layers
 
 
+def _target_layers(
+    surface, values: np.ndarray, target: float, unit: str, zrange: tuple[float, float]
+) -> list[Layer]:
+    """The target on a predicted surface: its contour line and that line projected on the floor, or,
+    when the surface never reaches it (a flat or distant response), a plane at its level."""
+    import pyvista as pv
+
+    surface.point_data["value"] = values
+    line = surface.contour([target], scalars="value")
+    if line.n_points:
+        floor = line.copy()
+        floor.points[:, 2] = 0.0
+        return [
+            Layer(f"target {target:g} {unit}", line, color=TARGET_COLOR, size=2.5),
+            Layer("target, projected", floor, color=TARGET_COLOR, size=1.5, opacity=0.6),
+        ]
+    level = float(_unit(target, *zrange))
+    plane = pv.Plane(center=(0.5, 0.5, level), direction=(0, 0, 1), i_size=1, j_size=1)
+    name = f"target {target:g} {unit} (plane: no design reaches it)"
+    return [Layer(name, plane.triangulate(), color=TARGET_COLOR, opacity=0.35)]
+
+
 def surface_view(
     surrogate,
     response: str,
@@ -375,18 +397,7 @@ def surface_view(
     layers += _run_layers(runs, _runs_near(table, held))
     share = None
     if target is not None:
-        mid.point_data["value"] = pred.value
-        line = mid.contour([target], scalars="value")
-        if line.n_points:
-            layers.append(Layer(f"target {target:g} {model.unit}", line, color=TARGET_COLOR, size=2.5))
-            floor = line.copy()
-            floor.points[:, 2] = 0.0
-            layers.append(Layer("target, projected", floor, color=TARGET_COLOR, size=1.5, opacity=0.6))
-        else:  # the surface never reaches the target (a flat or a distant response): draw its level
-            level = float(_unit(target, zlo, zhi))
-            plane = pv.Plane(center=(0.5, 0.5, level), direction=(0, 0, 1), i_size=1, j_size=1)
-            name = f"target {target:g} {model.unit} (plane: no design reaches it)"
-            layers.append(Layer(name, plane.triangulate(), color=TARGET_COLOR, opacity=0.35))
+        layers += _target_layers(mid, pred.value, target, model.unit, (zlo, zhi))
         share = float(np.mean((pred.low <= target) & (target <= pred.high)))
     held_txt = ", ".join(f"{k} {v:g} {space.factor(k).unit}" for k, v in held.items())
     title = f"{response_label(response)} over {x} and {y}; held: {held_txt}"
