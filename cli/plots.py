@@ -344,8 +344,10 @@ def profile_cmd(
 ) -> None:
     """An interactive prediction profiler: one self-contained HTML page (no server, no network).
 
-    Sliders per factor, per response the prediction and its 95 % PI against each factor, targets with
-    the probability of meeting them, suggestions to click.
+    Sliders per factor, per response the prediction and its 95 % PI against each factor; goals
+    (target, min, max) with the probability of meeting them; locks and "maximize" (the search of
+    designer suggest, in the page); a print-noise simulator; remembered settings copied as export
+    commands; suggestions to click.
 
     Example: designer profile --target k=0.8 -o profiler.html
     """

@@ -4,7 +4,11 @@ As JMP's Profiler and Minitab's Response Optimizer do it: a slider per continuou
 buttons for the categorical ones; per response a row of panels with the prediction and its 95 %
 prediction interval against each factor, the others held at the sliders; targets, desirability and
 the probability of landing within a tolerance of the target; a strip of `designer suggest`
-candidates that set the sliders when clicked.
+candidates that set the sliders when clicked. As a design console: goals set on the page, a lock
+per factor and "maximize", which runs `designer suggest`'s search (its cost, starts, rounding and
+ranking; `_search_data` exports what it needs) over the unlocked factors; a simulator propagating
+print-process noise (`PRINT_NOISE`, `MC_DRAWS`) to a defect rate; remembered settings copied as a
+`designer export` command line or as JSON for `--from`.
 
 The page evaluates the surrogate itself, from the exported coefficients: each response's feature
 columns are exported as expression trees recorded by running the surrogate's own feature code
