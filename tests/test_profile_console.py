@@ -124,6 +124,23 @@ def test_maximize_agrees_with_designer_suggest(page, sur, kind, value, moves):
     assert "designer suggest --k" in text and all(f"--fix {n}=" in text for n in held)
 
 
+def test_maximize_with_a_solid_section_locked(page, sur):
+    """Width locked at 2.0 mm: the walls fill the section, suggest holds density at 100 % (solid), and
+    so does the page; the density control stays pinned."""
+    page.js("document.getElementById('s-width').focus()")
+    page.key("Home", 36)
+    page.click("#lock-width")
+    _set_goal(page, "k_x", "target", 1.2)
+    page.click("#maximize")
+    status = page.js("Object.assign({}, document.getElementById('max-status').dataset)")
+    want = _suggest("--k", "1.2", "--fix", "width=2.0")
+    assert want["any"] == ["density"] and want["params"]["density"] == 100
+    assert json.loads(status["design"]) == pytest.approx(want["params"], abs=1e-9)
+    assert float(status["p"]) == pytest.approx(want["p_within"], rel=1e-9)
+    assert page.js("document.getElementById('v-density').textContent") == "100 % (solid)"
+    _check_k(page, sur, ("k_x", "c_x"))
+
+
 def _check_k(page, sur, responses: tuple[str, ...] = ("k_x",)) -> None:
     """The page's predictions and PIs at its setting are the library's, to 1e-9."""
     design = _design(page)
