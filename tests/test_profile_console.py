@@ -346,6 +346,7 @@ def test_remembered_settings_copy_as_command_and_json_that_run(page, sur, tmp_pa
     assert float(k_start(tmp_path / "joint1.fmu")) == pytest.approx(
         float(k_start(tmp_path / "from.fmu")), rel=1e-9
     )
+    assert set(page.requests()) == {page.js("location.href")}  # all that, and no request but the page
     # the table survives a reload (kept in the page's local storage)
     page.goto(page.js("location.href"))
     assert page.js("document.querySelectorAll('#memory tr').length") == 3
