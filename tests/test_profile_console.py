@@ -91,6 +91,7 @@ CASES = [
     ("target", 0.6, {"width": 0.3, "layer": 0.2}),
     ("max", None, {"height": 0.55, "raster": 45.0}),
     ("target", 1.1, {"length": 0.8, "density": 0.4}),
+    ("min", None, {"layer": 0.12}),
 ]
 
 
