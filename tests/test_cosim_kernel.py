@@ -305,7 +305,7 @@ def asking_fmus(monkeypatch, every=250, fail_at=None):
         fake = asking(self.fmu)
         keep.append(fake)
         fakes[id(self.fmu)] = ctypes.cast(fake, ctypes.c_void_p).value
-        self._needs_cis = True
+        self.needs_completed_step = True
 
         def python_completed():
             enter, stop = ctypes.c_int(0), ctypes.c_int(0)

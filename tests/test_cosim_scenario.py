@@ -15,6 +15,7 @@ from designer.errors import DesignerError
 
 # the module, not the function `designer.cosim.run` that shadows it as an attribute of the package
 cosim_run = importlib.import_module("designer.cosim.run")
+cosim_session = importlib.import_module("designer.cosim.session")
 
 ARM = """
 [simulation]
@@ -135,7 +136,7 @@ def test_interrupted_run_leaves_complete_files_or_none(tmp_path, monkeypatch):
     names = sorted(p.name for p in out.iterdir())
     assert names == ["metrics.json", "timeseries.csv", "timeseries.parquet"]
     assert len(np.loadtxt(out / "timeseries.csv", delimiter=",", skiprows=1)) == 201
-    monkeypatch.setattr(cosim_run, "run_master", interrupt)
+    monkeypatch.setattr(cosim_session, "run_master", interrupt)
     with pytest.raises(KeyboardInterrupt):
         write_outputs(run(sc), tmp_path / "none")
     assert not (tmp_path / "none").exists()
@@ -241,7 +242,7 @@ def _coded(**changes):
 
 def test_scenario_built_in_code_runs_in_memory_and_writes_nothing(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    sc = _coded()
+    sc = _coded().check()
     assert sc.kind == "robot" and sc.outputs == {"csv": True, "parquet": True, "plot": True}
     result = run(sc)
     frame = result.to_frame()
@@ -270,8 +271,11 @@ def test_scenario_built_in_code_runs_in_memory_and_writes_nothing(tmp_path, monk
     ],
 )
 def test_invalid_scenario_built_in_code_is_refused_naming_the_field(changes, message):
+    sc = _coded(**changes)  # building stores; checking (by load, prepare, run) refuses
     with pytest.raises(DesignerError, match=message):
-        _coded(**changes)
+        sc.check()
+    with pytest.raises(DesignerError, match=message):
+        run(sc)
 
 
 def test_joint_source_checks_its_fields():
@@ -280,11 +284,11 @@ def test_joint_source_checks_its_fields():
 
     joint = Joint.from_coefficients({"theta": {"k": 330, "c": 0.83}})
     with pytest.raises(DesignerError, match="exactly one of fmu= or joint="):
-        JointSource()
+        JointSource().check()
     with pytest.raises(DesignerError, match="has no axis 'x'"):
-        JointSource(axis="x", joint=joint)
+        JointSource(axis="x", joint=joint).check()
     with pytest.raises(DesignerError, match="'theta.stiffness' is not a parameter"):
-        JointSource(joint=joint, parameters={"theta.stiffness": 1.0})
+        JointSource(joint=joint, parameters={"theta.stiffness": 1.0}).check()
 
 
 @pytest.mark.parametrize(

@@ -241,7 +241,7 @@ def _fmu(system: FmuSystem, out: _System) -> None:
         out.step_fn = _function(fmu, p + "DoStep")
     else:
         out.time_fn = _function(fmu, p + "SetTime")
-        if system._needs_cis:
+        if system.needs_completed_step:
             out.completed_fn = _function(fmu, p + "CompletedIntegratorStep")
     out.in_vr = ctypes.cast(system._in_vr, POINTER(c_uint32))
     out.out_vr = ctypes.cast(system._out_vr, POINTER(c_uint32))

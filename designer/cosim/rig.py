@@ -28,9 +28,14 @@ class HubServo:
         self.chirp = chirp
         self.stiffness = stiffness
         self.damping = damping
+        self._out = np.zeros(2)
+        self.reset()
+
+    def reset(self) -> None:
+        """Back to t = 0."""
         self._steps = 0
         self._h = 0.0
-        self._out = np.zeros(2)
+        self._out[:] = 0.0
 
     def set(self, values: np.ndarray) -> None:
         q, dq = self.chirp(self._steps * self._h)

@@ -161,10 +161,17 @@ class Robot:
         self.inputs = [f"{j}.tau" for j in driven]
         self._input_dof = np.array([self.model.joint(j).dofadr[0] for j in driven], dtype=int)
         self.outputs = [f"{j}.{v}" for v in ("s", "v", "q", "motor") for j in self.joints]
-        self.time = 0.0
-        self._steps = 0
         self.motor_q = np.zeros(len(self.joints))
         self.motor_v = np.zeros(len(self.joints))
+        self.reset()
+
+    def reset(self) -> None:
+        """Back to t = 0 (mj_resetData, counters), each link undeflected where its motor puts it."""
+        import mujoco
+
+        mujoco.mj_resetData(self.model, self.data)
+        self.time = 0.0
+        self._steps = 0
         self._motor(0.0)
         # start undeflected: each link where its motor puts it, moving with it
         self.data.qpos[self.qpos] = self.motor_q

@@ -25,6 +25,7 @@ from .master import Master, Trace
 from .metrics import joint_metrics
 from .robot import Robot, SpringDamper, load_spec
 from .scenario import JointSource, Scenario
+from .session import Session, prepare, robot_system
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -151,13 +152,6 @@ def robot_run(
                 s.close()
 
 
-def robot_reference(sc: Scenario, laws: Mapping, step: float, duration: float, integrator: str) -> Trace:
-    """The same robot with every joint's spring-damper computed inside MuJoCo."""
-    springs = {j: SpringDamper(p["k"], p["c"], p["offset"]) for j, p in laws.items()}
-    robot = Robot(load_spec(sc.model, sc.lengths, sc.masses), sc.motors, step, integrator, in_engine=springs)
-    return run_master(Master({"robot": robot}, []), duration, step)
-
-
 def rig_run(
     sc: Scenario,
     fmu: Path,
@@ -188,13 +182,14 @@ def _angles(res: Trace, joints) -> np.ndarray:
     return np.column_stack([res.column(f"robot.{j}.q") for j in joints])
 
 
-def _validate_rig(sc: Scenario, fmus: Mapping[str, Path], laws: Mapping, progress: Progress) -> dict:
+def _validate_rig(session: Session, case: Mapping, laws: Mapping, progress: Progress) -> dict:
     from .rig import reference
 
+    sc = session.scenario
     p, rows = laws["rig"], []
     steps = sorted(sc.validation_steps, reverse=True)
     for i, h in enumerate([sc.step, *steps]):
-        res = rig_run(sc, fmus["rig"], p, h, sc.validation_duration)
+        res = session.trace(case, laws, step=h, duration=sc.validation_duration)
         s = res.column(f"joint.{sc.rig_joint.axis}.s")
         error = np.max(np.abs(s - reference(p["m"], p["c"], p["k"], sc.hub, res.time)))
         rows.append({"step": h, "max_error": float(error)})
@@ -207,12 +202,20 @@ def _validate_rig(sc: Scenario, fmus: Mapping[str, Path], laws: Mapping, progres
     }
 
 
-def _validate_robot(sc: Scenario, fmus: Mapping[str, Path], laws: Mapping, progress: Progress) -> dict:
+def robot_reference(sc: Scenario, laws: Mapping, step: float, duration: float, integrator: str) -> Trace:
+    """The same robot with every joint's spring-damper computed inside MuJoCo."""
+    springs = {j: SpringDamper(p["k"], p["c"], p["offset"]) for j, p in laws.items()}
+    robot = robot_system(sc, step, integrator=integrator, in_engine=springs)
+    return run_master(Master({"robot": robot}, []), duration, step)
+
+
+def _validate_robot(session: Session, case: Mapping, laws: Mapping, progress: Progress) -> dict:
+    sc = session.scenario
     duration, joints = sc.validation_duration, list(sc.joints)
     steps = sorted(sc.validation_steps, reverse=True)
     fine = min(steps) / 4
     ref_fine = _angles(robot_reference(sc, laws, fine, duration, "rk4"), joints)
-    same = _angles(robot_run(sc, fmus, sc.step, duration, sc.algorithm), joints)
+    same = _angles(session.trace(case, laws, step=sc.step, duration=duration), joints)
     same_ref = _angles(robot_reference(sc, laws, sc.step, duration, sc.integrator), joints)
     rows = []
     for i, h in enumerate(steps):
@@ -222,7 +225,7 @@ def _validate_robot(sc: Scenario, fmus: Mapping[str, Path], laws: Mapping, progr
                 f"validation step {h:g} s is not a multiple of {fine:g} s",
                 "use steps halving from the largest",
             )
-        q = _angles(robot_run(sc, fmus, h, duration, sc.algorithm), joints)
+        q = _angles(session.trace(case, laws, step=h, duration=duration), joints)
         q_same = _angles(robot_reference(sc, laws, h, duration, sc.integrator), joints)
         rows.append(
             {
@@ -270,10 +273,41 @@ def rig_metrics(sc: Scenario, res: Trace, params: Mapping) -> dict:
     }
 
 
+def result(
+    session: Session,
+    case: Mapping[str, Mapping[str, float]],
+    duration: float | None,
+    engine: str,
+    validate: bool,
+    progress: Progress,
+) -> Result:
+    """One run of a prepared session (what `Session.run` returns; `case` as Session.parameters gives it)."""
+    share = 0.5 if validate else 1.0
+
+    def part(offset: float, scale: float) -> Progress:
+        return None if progress is None else (lambda f: progress(offset + scale * f))
+
+    sc = session.scenario
+    laws = session.laws(case)
+    span = sc.duration if duration is None else duration
+    trace = session.trace(case, laws, step=sc.step, duration=span, progress=part(0.0, share), engine=engine)
+    if sc.kind == "rig":
+        metrics, check = rig_metrics(sc, trace, laws["rig"]), _validate_rig
+    else:
+        metrics, check = robot_metrics(sc, trace, laws), _validate_robot
+    validation = check(session, case, laws, part(share, 1.0 - share)) if validate else None
+    return Result(
+        sc, trace.time, trace.columns, trace.values, metrics, laws, validation, trace.delays, trace.engine
+    )
+
+
 def run(
     scenario: Scenario, *, validate: bool = False, progress: Progress = None, engine: str = "auto"
 ) -> Result:
-    """Co-simulate `scenario` and return the result in memory; no file is written.
+    """Co-simulate `scenario` once and return the result in memory; no file is written.
+
+    `with prepare(scenario) as s: return s.run(...)`: for many runs of one scenario, prepare a
+    `Session` yourself and call its `run` per case.
 
     Args:
         scenario: a `Scenario` (built in code, or read by `designer.cosim.load`).
@@ -285,29 +319,11 @@ def run(
             and it can run every system; `Result.engine` says which ran.
 
     Raises:
-        DesignerError: an FMU that cannot be loaded, a co-simulation that diverges.
+        DesignerError: a bad scenario, an FMU that cannot be loaded or refuses its parameters, a
+            co-simulation that diverges.
     """
-    share = 0.5 if validate else 1.0
-
-    def part(offset: float, scale: float) -> Progress:
-        return None if progress is None else (lambda f: progress(offset + scale * f))
-
-    sc = scenario
-    with joint_fmus(sc) as fmus:
-        if sc.kind == "rig":
-            laws = {"rig": law(sc.rig_joint, fmus["rig"])}
-            trace = rig_run(sc, fmus["rig"], laws["rig"], sc.step, sc.duration, part(0.0, share), engine)
-            metrics = rig_metrics(sc, trace, laws["rig"])
-            check = _validate_rig if validate else None
-        else:
-            laws = {j: law(src, fmus[j]) for j, src in sc.joints.items()}
-            trace = robot_run(sc, fmus, sc.step, sc.duration, sc.algorithm, part(0.0, share), engine)
-            metrics = robot_metrics(sc, trace, laws)
-            check = _validate_robot if validate else None
-        validation = None if check is None else check(sc, fmus, laws, part(share, 1.0 - share))
-    return Result(
-        sc, trace.time, trace.columns, trace.values, metrics, laws, validation, trace.delays, trace.engine
-    )
+    with prepare(scenario) as session:
+        return session.run(validate=validate, progress=progress, engine=engine)
 
 
 def rig_log(result: Result) -> pd.DataFrame:
