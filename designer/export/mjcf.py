@@ -145,7 +145,7 @@ def export_mjcf(
         if joint_name is None:
             raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
         if form == "series":
-            advice = into_series(
+            advice, notes = into_series(
                 joint,
                 into,
                 path,
@@ -155,7 +155,7 @@ def export_mjcf(
                 motor_inertia=motor_inertia,
                 motor_bandwidth=motor_bandwidth,
             )
-            return robot.RobotExport(path, advice)
+            return robot.RobotExport(path, advice, notes)
         advice, notes = into_parallel(
             joint,
             into,

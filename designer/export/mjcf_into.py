@@ -281,9 +281,10 @@ def _insert_motor(host: _Host, joint_name: str, motor: robot.Sphere, servo: robo
     link = host.element.getparent()
     parent = link.getparent()
     body = etree.Element("body", name=f"{joint_name}_motor")
-    for attr in _FRAME:
+    # the link's childclass gave the host joint its defaults: the motor joint, its copy, needs it too
+    for attr in (*_FRAME, "childclass"):
         if attr in link.attrib:
-            body.set(attr, link.attrib.pop(attr))
+            body.set(attr, link.get(attr) if attr == "childclass" else link.attrib.pop(attr))
     parent.insert(parent.index(link), body)
     motor_joint = copy.deepcopy(host.element)
     motor_joint.set("name", f"{joint_name}_motor")
@@ -309,8 +310,10 @@ def _insert_motor(host: _Host, joint_name: str, motor: robot.Sphere, servo: robo
         section = root.find("actuator")
         if section is None:
             section = etree.SubElement(root, "actuator")
+        # ctrllimited stated: a host's actuator defaults may limit control to a range it never gave
         servo_xml = (
-            f'<position name="{joint_name}_motor" joint="{joint_name}_motor" kp="{robot.num(servo.kp)}"/>'
+            f'<position name="{joint_name}_motor" joint="{joint_name}_motor" kp="{robot.num(servo.kp)}" '
+            'ctrllimited="false"/>'
         )
         section.append(etree.fromstring(servo_xml))
     return len(moved)
@@ -358,12 +361,14 @@ def _extend_keys(host: _Host, joint_name: str, at: dict[str, int], rest: float, 
             key.set(name, " ".join(values))
 
 
-def _compare_series(before, after, joint_name: str) -> None:
+def _compare_series(before, after, joint_name: str, *, sprung: frozenset[str], notes: list[str]) -> None:
     """Raise unless every host body keeps its world pose and every host joint its numbers.
 
     MuJoCo numbers bodies and joints in the file's depth-first order, so the inserted motor body and
     joint shift the ids after them by one; the host joint is compared with the motor joint, which
-    took over its type, axis and range.
+    took over its type, axis and range. Joints in `sprung` take stiffness and damping from the mass
+    matrix (MuJoCo's springdamper), which the motor body's mass changes: their change is appended to
+    `notes` rather than refused.
     """
     import mujoco
 
@@ -382,17 +387,76 @@ def _compare_series(before, after, joint_name: str) -> None:
             and np.allclose(data[0].xquat[i], data[1].xquat[shifted(i, motor_body)], atol=1e-12)
         )
     ]
+    drift = 0.0
     for i in range(before.njnt):
         mine, theirs = before.joint(i), after.joint(shifted(i, motor_joint + 1))
-        fields = (
-            ("type", "range", "axis", "limited")
-            if i == motor_joint
-            else ("type", "range", "axis", "limited", "stiffness", "armature", "damping")
-        )
+        fields = ["type", "range", "axis", "limited"]
+        if i != motor_joint:
+            fields += ["armature"] if mine.name in sprung else ["stiffness", "armature", "damping"]
+        if mine.name in sprung and i != motor_joint:
+            for f in ("stiffness", "damping"):
+                a, b = float(getattr(mine, f)[0]), float(getattr(theirs, f)[0])
+                drift = max(drift, abs(b - a) / abs(a) if a else abs(b))
         if not all(np.array_equal(getattr(mine, f), getattr(theirs, f)) for f in fields):
             changed.append(mine.name or f"joint {i}")
     if changed:
         raise RuntimeError(f"the series edit changed host bodies or joints: {', '.join(changed)}")
+    if drift > 0:
+        notes.append(
+            f"stiffness and damping of the {len(sprung - {joint_name})} joints with springdamper (MuJoCo "
+            f"derives them from the mass matrix) changed by up to {drift:.2g} (relative): the motor body "
+            "adds mass"
+        )
+
+
+def _refuse_limit_sensors(host: _Host, joint_name: str) -> None:
+    """Refuse a series edit of a joint that a joint-limit sensor reads: the flexure has no limit."""
+    import mujoco
+
+    kinds = {mujoco.mjtSensor.mjSENS_JOINTLIMITPOS, mujoco.mjtSensor.mjSENS_JOINTLIMITVEL}
+    kinds |= {mujoco.mjtSensor.mjSENS_JOINTLIMITFRC}
+    readers = [
+        s.name or s.type.name for s in host.spec.sensors if s.type in kinds and s.objname == joint_name
+    ]
+    if readers:
+        raise DesignerError(
+            f"sensor {', '.join(readers)} reads the limit of robot joint '{joint_name}', which the series "
+            "form moves to the motor joint (the flexure has no limit)",
+            f"point the sensor at {joint_name}_motor in the robot first, or use form='parallel'",
+        )
+
+
+def _series_notes(host: _Host, joint_name: str, si: dict, moved: int, rest: float) -> list[str]:
+    """What the series edit did to the host's own values, one sentence each (SI)."""
+    j = host.model.joint(joint_name)
+    dof, adr = j.dofadr[0], j.qposadr[0]
+    unit = "rad" if host.hinge else "m"
+    old = (float(j.stiffness[0]), float(host.model.dof_damping[dof]), float(host.model.dof_armature[dof]))
+    new = (si["k"], si["c"], si["m"])
+    notes = [
+        f"{joint_name} is now the flexure (SI): "
+        + ", ".join(
+            f"{n} {a:.4g} -> {b:.4g}"
+            for n, a, b in zip(("stiffness", "damping", "armature"), old, new, strict=True)
+        )
+        + f", springref {float(host.model.qpos_spring[adr]):.4g} -> {rest:.4g} {unit}"
+    ]
+    if j.limited[0]:
+        lo, hi = (float(v) for v in j.range)
+        notes.append(f"range [{lo:.4g}, {hi:.4g}] {unit} moved to {joint_name}_motor; {joint_name} unlimited")
+    if float(host.model.qpos0[adr]) != 0.0:
+        notes.append(
+            f"{joint_name}'s ref {float(host.model.qpos0[adr]):.4g} {unit} -> 0 (the motor keeps it)"
+        )
+    notes.append(
+        f"{moved} actuator(s) moved from {joint_name} to {joint_name}_motor"
+        if moved
+        else f"position servo {joint_name}_motor added (no actuator drove {joint_name})"
+    )
+    keys = host.model.nkey
+    if keys:
+        notes.append(f"{keys} keyframe(s) extended with {joint_name}_motor (the host's angle less the rest)")
+    return notes
 
 
 def into_series(
@@ -405,7 +469,7 @@ def into_series(
     rest: float = 0.0,
     motor_inertia: float | None = None,
     motor_bandwidth: float | None = None,
-) -> dict[str, StepAdvice]:
+) -> tuple[dict[str, StepAdvice], tuple[str, ...]]:
     """Write a copy of MJCF `host` to `path` with motor -> flexure -> link at robot joint `joint_name`.
 
     A motor body `<joint_name>_motor` (carrying the flexure's clamped part) is inserted before the
@@ -415,16 +479,19 @@ def into_series(
     armature = its moving inertia, springref = `rest`, unlimited). With no actuator on the joint, a
     position servo is added (see `robot.Servo`). Sensors, tendons and
     equalities on `joint_name` now see the flexure's deflection. Returns the step advice of the flexure
-    (motor held) and, when added, of the servo (flexure held), inertias from the mass matrix.
+    (motor held) and, when added, of the servo (flexure held), inertias from the mass matrix, and one
+    note per host value the edit changed.
 
     Raises:
-        DesignerError: as `into_parallel`, or when the names `<joint_name>_motor` are taken.
+        DesignerError: as `into_parallel`, when the names `<joint_name>_motor` are taken, or when a
+            joint-limit sensor reads the joint.
     """
     h = _open(host, joint_name)
     a = _axis(joint, axis, h, joint_name)
     taken = {e.name for e in (*h.spec.joints, *h.spec.bodies, *h.spec.actuators)}
     if f"{joint_name}_motor" in taken:
         raise DesignerError(f"the robot already has something named {joint_name}_motor", "rename it first")
+    _refuse_limit_sensors(h, joint_name)
     full = robot.with_masses(joint)
     si, clamp = full.axes[a].si(), robot.links(full)[a]
     # the link as the flexure sees it: the host's inertia at the joint, less the armature the motor
@@ -441,15 +508,18 @@ def into_series(
         bandwidth=motor_bandwidth,
     )
     keys = _key_layout(h, joint_name)
+    sprung = frozenset(j.name for j in h.spec.joints if j.springdamper[0] > 0)
     moved = _insert_motor(h, joint_name, clamp, servo)
+    notes = _series_notes(h, joint_name, si, moved, rest)
     _extend_keys(h, joint_name, keys, rest, servo_added=not moved)
     _flexure(h, joint, a, rest)
     for attr, value in (("ref", "0"), ("limited", "false")):
         h.element.set(attr, value)
-    after = _write_checked(h, path, partial(_compare_series, h.model, joint_name=joint_name))
+    check = partial(_compare_series, h.model, joint_name=joint_name, sprung=sprung, notes=notes)
+    after = _write_checked(h, path, check)
     diag = _mass_diagonal(after)
     flex_dof, motor_dof = after.joint(joint_name).dofadr[0], after.joint(f"{joint_name}_motor").dofadr[0]
     advice = {joint_name: step_advice(si["k"], si["c"], diag[flex_dof])}
     if not moved:
         advice[f"{joint_name}_motor"] = step_advice(servo.kp, servo.kv, diag[motor_dof])
-    return advice
+    return advice, tuple(notes)
