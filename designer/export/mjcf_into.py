@@ -146,7 +146,7 @@ def _mass_diagonal(model) -> np.ndarray:
     return np.diag(full)
 
 
-def _compare_parallel(before, after, joint_name: str) -> None:
+def _compare_parallel(before, after, joint_name: str, k: float, c: float) -> None:
     """Raise if compiling the edited model changed anything but the joint and its mass-matrix terms."""
     j = after.joint(joint_name)
     index = {"jnt": j.id, "dof": j.dofadr[0], "qpos": j.qposadr[0]}
@@ -161,11 +161,32 @@ def _compare_parallel(before, after, joint_name: str) -> None:
         if a.shape != b.shape or not np.array_equal(a, b, equal_nan=True):
             changed.append(name)
     changed += [g for g in ("opt", "vis") if repr(getattr(before, g)) != repr(getattr(after, g))]
+    _check_joint(after, joint_name, k, c)
     if changed:
         raise RuntimeError(f"editing one joint changed the compiled model's {', '.join(changed)}")
 
 
-def _flexure(host: _Host, joint: Joint, a: str, rest: float) -> dict[str, str]:
+def _springdamper_off(host: _Host, joint_name: str, values: dict[str, str], notes: list[str]) -> None:
+    """Add springdamper="0 0" to `values` (and say so) when the host joint has one: MuJoCo would
+    otherwise compute stiffness and damping from it and ignore the flexure's."""
+    timeconst, ratio = (float(v) for v in host.spec.joint(joint_name).springdamper)
+    if timeconst > 0:
+        values["springdamper"] = "0 0"
+        notes.append(
+            f"springdamper (time constant {timeconst:.4g} s, damping ratio {ratio:.4g}) -> 0 0: MuJoCo would "
+            "derive stiffness and damping from it in place of the flexure's"
+        )
+
+
+def _check_joint(after, joint_name: str, k: float, c: float) -> None:
+    """Raise unless MuJoCo compiled the edited joint with exactly stiffness `k` and damping `c`."""
+    j = after.joint(joint_name)
+    got = (float(j.stiffness[0]), float(after.dof_damping[j.dofadr[0]]))
+    if got != (k, c):
+        raise RuntimeError(f"joint {joint_name} compiled with stiffness, damping {got}, not {(k, c)}")
+
+
+def _flexure(host: _Host, joint: Joint, a: str, rest: float, notes: list[str]) -> dict[str, str]:
     """Set the joint element's stiffness, damping, armature (moving inertia, if known) and springref;
     return them as written."""
     si = joint.axes[a].si()
@@ -173,6 +194,7 @@ def _flexure(host: _Host, joint: Joint, a: str, rest: float) -> dict[str, str]:
     if si["m"] is not None:
         values["armature"] = si["m"]
     values = {attr: robot.num(v) for attr, v in values.items()}
+    _springdamper_off(host, host.element.get("name"), values, notes)
     for attr, v in values.items():
         host.element.set(attr, v)
     return values
@@ -214,9 +236,9 @@ def into_parallel(
     raw = h.path.read_bytes()
     encoding = h.tree.docinfo.encoding or "utf-8"
     text = _retag(raw.decode(encoding), joint_name, values)
-    check = partial(_compare_parallel, h.model, joint_name=joint_name)
-    after = _write_checked(h, path, check, text.encode(encoding))
     si = joint.axes[a].si()
+    check = partial(_compare_parallel, h.model, joint_name=joint_name, k=si["k"], c=si["c"])
+    after = _write_checked(h, path, check, text.encode(encoding))
     dof = after.joint(joint_name).dofadr[0]
     return {joint_name: step_advice(si["k"], si["c"], _mass_diagonal(after)[dof])}, notes
 
@@ -263,6 +285,7 @@ def _parallel_values(
         )
     notes += [f"{attr}: {old[attr]:.4g} -> {v:.4g} (SI)" for attr, v in new.items() if v != old[attr]]
     values = {attr: robot.num(h.angle(v) if attr == "springref" else v) for attr, v in new.items()}
+    _springdamper_off(h, joint_name, values, notes)
     return values, tuple(notes)
 
 
@@ -361,14 +384,12 @@ def _extend_keys(host: _Host, joint_name: str, at: dict[str, int], rest: float, 
             key.set(name, " ".join(values))
 
 
-def _compare_series(before, after, joint_name: str, *, sprung: frozenset[str], notes: list[str]) -> None:
+def _compare_series(before, after, joint_name: str, k: float, c: float) -> None:
     """Raise unless every host body keeps its world pose and every host joint its numbers.
 
     MuJoCo numbers bodies and joints in the file's depth-first order, so the inserted motor body and
     joint shift the ids after them by one; the host joint is compared with the motor joint, which
-    took over its type, axis and range. Joints in `sprung` take stiffness and damping from the mass
-    matrix (MuJoCo's springdamper), which the motor body's mass changes: their change is appended to
-    `notes` rather than refused.
+    took over its type, axis and range.
     """
     import mujoco
 
@@ -387,26 +408,50 @@ def _compare_series(before, after, joint_name: str, *, sprung: frozenset[str], n
             and np.allclose(data[0].xquat[i], data[1].xquat[shifted(i, motor_body)], atol=1e-12)
         )
     ]
-    drift = 0.0
     for i in range(before.njnt):
         mine, theirs = before.joint(i), after.joint(shifted(i, motor_joint + 1))
-        fields = ["type", "range", "axis", "limited"]
-        if i != motor_joint:
-            fields += ["armature"] if mine.name in sprung else ["stiffness", "armature", "damping"]
-        if mine.name in sprung and i != motor_joint:
-            for f in ("stiffness", "damping"):
-                a, b = float(getattr(mine, f)[0]), float(getattr(theirs, f)[0])
-                drift = max(drift, abs(b - a) / abs(a) if a else abs(b))
+        fields = (
+            ("type", "range", "axis", "limited")
+            if i == motor_joint
+            else ("type", "range", "axis", "limited", "stiffness", "armature", "damping")
+        )
         if not all(np.array_equal(getattr(mine, f), getattr(theirs, f)) for f in fields):
             changed.append(mine.name or f"joint {i}")
     if changed:
         raise RuntimeError(f"the series edit changed host bodies or joints: {', '.join(changed)}")
-    if drift > 0:
-        notes.append(
-            f"stiffness and damping of the {len(sprung - {joint_name})} joints with springdamper (MuJoCo "
-            f"derives them from the mass matrix) changed by up to {drift:.2g} (relative): the motor body "
-            "adds mass"
-        )
+    _check_joint(after, joint_name, k, c)
+
+
+def _freeze_springdampers(host: _Host, joint_name: str) -> list[str]:
+    """Write out the compiled stiffness and damping of every other joint with a springdamper.
+
+    MuJoCo derives those from the mass matrix, so the motor body's mass would change them; written
+    out (springdamper 0 0) they stay what the host compiled them to.
+    """
+    frozen = []
+    for j in host.spec.joints:
+        if j.name == joint_name or j.springdamper[0] <= 0:
+            continue
+        found = host.tree.getroot().xpath("//worldbody//joint[@name=$n]", n=j.name) if j.name else []
+        if len(found) != 1:
+            raise DesignerError(
+                f"joint {j.name or '(unnamed)'} takes stiffness and damping from springdamper, which the "
+                "series edit's motor body would change, and designer cannot find it in the file to keep them",
+                "name the joint in the robot's file, or use form='parallel'",
+            )
+        compiled = host.model.joint(j.name)
+        found[0].set("stiffness", robot.num(compiled.stiffness[0]))
+        found[0].set("damping", robot.num(host.model.dof_damping[compiled.dofadr[0]]))
+        found[0].set("springdamper", "0 0")
+        frozen.append(j.name)
+    if not frozen:
+        return []
+    named = ", ".join(frozen[:3]) + (", ..." if len(frozen) > 3 else "")
+    return [
+        f"{len(frozen)} joints with springdamper ({named}) "
+        "keep their compiled stiffness and damping, now written out (springdamper 0 0): MuJoCo derives them "
+        "from the mass matrix, which the motor body changes"
+    ]
 
 
 def _refuse_limit_sensors(host: _Host, joint_name: str) -> None:
@@ -416,7 +461,9 @@ def _refuse_limit_sensors(host: _Host, joint_name: str) -> None:
     kinds = {mujoco.mjtSensor.mjSENS_JOINTLIMITPOS, mujoco.mjtSensor.mjSENS_JOINTLIMITVEL}
     kinds |= {mujoco.mjtSensor.mjSENS_JOINTLIMITFRC}
     readers = [
-        s.name or s.type.name for s in host.spec.sensors if s.type in kinds and s.objname == joint_name
+        s.name or s.type.name.removeprefix("mjSENS_").lower()
+        for s in host.spec.sensors
+        if s.type in kinds and s.objname == joint_name
     ]
     if readers:
         raise DesignerError(
@@ -508,14 +555,14 @@ def into_series(
         bandwidth=motor_bandwidth,
     )
     keys = _key_layout(h, joint_name)
-    sprung = frozenset(j.name for j in h.spec.joints if j.springdamper[0] > 0)
     moved = _insert_motor(h, joint_name, clamp, servo)
     notes = _series_notes(h, joint_name, si, moved, rest)
+    notes += _freeze_springdampers(h, joint_name)
     _extend_keys(h, joint_name, keys, rest, servo_added=not moved)
-    _flexure(h, joint, a, rest)
+    _flexure(h, joint, a, rest, notes)
     for attr, value in (("ref", "0"), ("limited", "false")):
         h.element.set(attr, value)
-    check = partial(_compare_series, h.model, joint_name=joint_name, sprung=sprung, notes=notes)
+    check = partial(_compare_series, h.model, joint_name=joint_name, k=si["k"], c=si["c"])
     after = _write_checked(h, path, check)
     diag = _mass_diagonal(after)
     flex_dof, motor_dof = after.joint(joint_name).dofadr[0], after.joint(f"{joint_name}_motor").dofadr[0]

@@ -127,11 +127,23 @@ def sdf_text(joint: Joint) -> tuple[str, dict[str, robot.StepAdvice]]:
     return "\n".join([*lines, "  </model>", "</sdf>", ""]), advice
 
 
+def _host_values(root, element, joint_name: str) -> dict[str, float]:
+    """The joint's damping and Gazebo spring as the host URDF gives them (URDF's default damping 0)."""
+    dynamics = element.find("dynamics")
+    old = {"damping": float(dynamics.get("damping", 0)) if dynamics is not None else 0.0}
+    for tag in ("springStiffness", "springReference"):
+        found = root.xpath(f"/robot/gazebo[@reference=$n]/{tag}", n=joint_name)
+        if found:
+            old[tag] = float(found[0].text)
+    return old
+
+
 def _into_urdf(
-    joint: Joint, host: Path, *, joint_name: str, axis: str | None, rest: float
-) -> tuple[bytes, dict[str, robot.StepAdvice]]:
+    joint: Joint, host: Path, *, joint_name: str, axis: str | None, rest: float | None
+) -> tuple[bytes, dict[str, robot.StepAdvice], tuple[str, ...]]:
     """The host URDF's bytes with `joint_name`'s damping and Gazebo spring set, the rest as written;
-    and the joint's step advice (none when the links it moves declare no inertia)."""
+    the joint's step advice (none when the links it moves declare no inertia); one note per host
+    value changed or kept (old -> new, SI). `rest` None keeps the host's springReference (else 0)."""
     from lxml import etree
 
     if not host.is_file():
@@ -157,13 +169,25 @@ def _into_urdf(
             "give an axis of the same kind as the robot joint",
         )
     si = joint.axes[a].si()
+    old = _host_values(root, found[0], joint_name)
+    notes = []
+    if rest is None:
+        rest = old.get("springReference", 0.0)
+        how = "kept at the host's" if "springReference" in old else "set to"
+        notes.append(f"springReference {how} {rest:.4g} (give rest to set it)")
+    new = {"damping": si["c"], "springStiffness": si["k"], "springReference": rest}
+    notes += [
+        f"{tag}: {'none' if tag not in old else format(old[tag], '.4g')} -> {v:.4g} (SI)"
+        for tag, v in new.items()
+        if v != old.get(tag)
+    ]
     encoding = tree.docinfo.encoding or "utf-8"
     # the robot-level <joint> among every element <joint name=...> (a <transmission> names its joint too)
     nth = [j.getparent() is root for j in root.iter("joint") if j.get("name") == joint_name].index(True)
     text = _set_damping(host.read_bytes().decode(encoding), joint_name, robot.num(si["c"]), nth)
     moved = moved_inertia(root, joint_name)
     advice = {joint_name: step_advice(si["k"], si["c"], moved)} if moved > 0 else {}
-    return _set_spring(text, joint_name, si["k"], rest).encode(encoding), advice
+    return _set_spring(text, joint_name, si["k"], rest).encode(encoding), advice, tuple(notes)
 
 
 def _set_damping(text: str, joint_name: str, damping: str, nth: int) -> str:
@@ -232,10 +256,10 @@ def export_urdf(
     if into is not None:
         if joint_name is None:
             raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
-        data, advice = _into_urdf(joint, Path(into), joint_name=joint_name, axis=axis, rest=rest or 0.0)
+        data, advice, notes = _into_urdf(joint, Path(into), joint_name=joint_name, axis=axis, rest=rest)
         with atomic_path(path) as tmp:
             tmp.write_bytes(data)
-        return robot.RobotExport(path, advice, READERS)
+        return robot.RobotExport(path, advice, notes + READERS)
     text, advice = urdf_text(robot.with_masses(joint), rest=rest or 0.0)
     with atomic_write(path) as fh:
         fh.write(text)
