@@ -30,7 +30,10 @@ def test_ssd_runs_in_fmpy_like_the_fmus_and_alternatives_are_parameter_sets(tmp_
 
     wrist = Joint.from_coefficients({"theta": {"k": 50.0, "c": 0.5, "m": 1e-5}}, name="Wrist")
     path = export_ssp(
-        [JOINT, wrist], tmp_path / "joints.ssp", alternatives={"FlexJoint": {"stiffer": STIFFER}}
+        [JOINT, wrist],
+        tmp_path / "joints.ssp",
+        alternatives={"FlexJoint": {"stiffer": STIFFER}},
+        system_connectors=True,
     )
     ssd = read_ssd(str(path))  # validates against the normative SSP 1.0 schemas FMPy ships
     bound = {c.name: c.parameterBindings[0].source for c in ssd.system.elements}
@@ -76,6 +79,68 @@ def test_ssd_runs_in_fmpy_like_the_fmus_and_alternatives_are_parameter_sets(tmp_
     assert np.max(np.abs(x - step_response(0.01, 2.0, 800.0, 2.0, t))) < 1e-9
     assert np.max(np.abs(runs["bound"]["Wrist_theta.s"] - step_response(1e-5, 5e-4, 0.05, 0.01, t))) < 1e-9
     assert np.max(np.abs(runs["stiffer"]["FlexJoint_x.s"] - step_response(0.01, 4.0, 1600.0, 2.0, t))) < 1e-9
+
+
+def _with_ssv_k(path: Path, out: Path, old: bytes, new: bytes) -> Path:
+    """A copy of SSP archive `path` whose bound SSV states k `new` where it stated `old` (text edit)."""
+    with zipfile.ZipFile(path) as zin, zipfile.ZipFile(out, "w") as zout:
+        for name in zin.namelist():
+            data = zin.read(name)
+            if name == "resources/FlexJoint.ssv":
+                before = b'<ssv:Parameter name="x.k"><ssv:Real value="' + old
+                assert data.count(before) == 1
+                data = data.replace(before, b'<ssv:Parameter name="x.k"><ssv:Real value="' + new)
+            zout.writestr(name, data)
+    return out
+
+
+def _libcosim_deflection(path: Path, load: float) -> float:
+    """libcosim loads the SSP (applying the SSD's parameter binding); a constant load on x.f held
+    from the start; the deflection x.s after 2 s (settled: damping ratio 0.35 at 45 Hz)."""
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimObserver import CosimObserver
+
+    log_output_level(CosimLogLevel.ERROR)
+    execution = CosimExecution.from_ssp_file(str(path), step_size=int(1e5))  # 0.1 ms in ns
+    observer = CosimObserver.create_last_value()
+    execution.add_observer(observer)
+    index = execution.slave_index_from_instance_name("FlexJoint")
+    refs = {v.name.decode(): v.reference for v in execution.slave_variables(index)}
+    execution.real_initial_value(index, refs["x.f"], load)
+    execution.simulate_until(int(2e9))
+    return observer.last_real_values(index, [refs["x.s"]])[0]
+
+
+def test_doubling_k_in_the_ssv_halves_the_deflection_in_fmpy_and_libcosim(tmp_path):
+    """Both SSP runners apply the SSD's parameter binding: k edited in the SSV alone changes the run."""
+    pytest.importorskip("libcosimpy")
+    from fmpy.ssp.simulation import simulate_ssp
+
+    from designer.export.ssp import bound_parameters, fmpy_parameter_set
+
+    load, k = 2.0, 800.0  # N, N/m: 2.5 mm static deflection
+    default = export_ssp(JOINT, tmp_path / "j.ssp")
+    stiff = _with_ssv_k(default, tmp_path / "stiff.ssp", b"800.0", b"1600.0")
+    assert bound_parameters(stiff)["FlexJoint.x.k"] == 2 * k
+    # libcosim: every connection needs startElement and endElement, so the default SSD has none
+    assert b"<ssd:Connection " not in zipfile.ZipFile(default).read("SystemStructure.ssd")
+    got = [_libcosim_deflection(p, load) for p in (default, stiff)]
+    assert got == pytest.approx([load / k, load / (2 * k)], rel=1e-9)
+    # fmpy.ssp drives the system's connectors (system_connectors=True) and applies the set it is given
+    wired = export_ssp(JOINT, tmp_path / "w.ssp", system_connectors=True)
+    stiff_wired = _with_ssv_k(wired, tmp_path / "stiff_w.ssp", b"800.0", b"1600.0")
+    runs = [
+        simulate_ssp(
+            str(p),
+            stop_time=2.0,
+            step_size=1e-3,
+            parameter_set=fmpy_parameter_set(p),
+            input={"FlexJoint_x.f": constant(load)},
+        )["FlexJoint_x.s"][-1]
+        for p in (wired, stiff_wired)
+    ]
+    assert runs == pytest.approx([load / k, load / (2 * k)], rel=1e-9)
 
 
 def test_ssp_refuses_wrong_suffix_and_foreign_alternatives(tmp_path):
