@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 
 from designer.errors import DesignerError
+from designer.export.checks import joint_numbers, other_joint_changes, pose_changes
 from designer.export.mjcf import export_mjcf
 from designer.export.urdf import export_urdf
 from designer.joint import Joint
@@ -101,48 +102,13 @@ def _joints(spec, package: str, name: str) -> list[str]:
     return list(dict.fromkeys(picked))
 
 
-def _poses(model, key: int | None) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Every named body's world position and orientation at the reference pose or keyframe `key`."""
-    data = mujoco.MjData(model)
-    if key is not None:
-        mujoco.mj_resetDataKeyframe(model, data, key)
-    mujoco.mj_kinematics(model, data)
-    return {model.body(i).name: (data.xpos[i].copy(), data.xquat[i].copy()) for i in range(model.nbody)}
-
-
-def _numbers(model, name: str) -> dict[str, np.ndarray]:
-    """A joint's numbers as MuJoCo compiled them (SI)."""
-    j = model.joint(name)
-    dof, adr = j.dofadr[0], j.qposadr[0]
-    return {
-        "stiffness": j.stiffness.copy(),
-        "damping": model.dof_damping[dof : dof + 1].copy(),
-        "armature": model.dof_armature[dof : dof + 1].copy(),
-        "frictionloss": model.dof_frictionloss[dof : dof + 1].copy(),
-        "springref": model.qpos_spring[adr : adr + 1].copy(),
-        "ref": model.qpos0[adr : adr + 1].copy(),
-        "range": j.range.copy(),
-        "limited": j.limited.copy(),
-        "axis": j.axis.copy(),
-        "pos": j.pos.copy(),
-    }
-
-
-def _same_poses(before, after, *, skip: set[str]) -> None:
+def _same_poses(before, after) -> None:
     """Every host body where it was, at the reference pose and at each keyframe (same keys, in order)."""
-    assert after.nkey == before.nkey
-    for key in [None, *range(before.nkey)]:
-        old, new = _poses(before, key), _poses(after, key)
-        for body, (pos, quat) in old.items():
-            if body in skip:
-                continue
-            assert np.allclose(pos, new[body][0], atol=1e-9), (body, key)
-            # q and -q are the same orientation
-            assert np.allclose(abs(np.dot(quat, new[body][1])), 1.0, atol=1e-9), (body, key)
+    assert pose_changes(before, after) == []
 
 
 def _check_parallel(before, after, name: str, si: dict, notes: tuple[str, ...]) -> None:
-    old, new = _numbers(before, name), _numbers(after, name)
+    old, new = joint_numbers(before, name), joint_numbers(after, name)
     assert new["stiffness"][0] == si["k"] and new["damping"][0] == si["c"]
     assert new["springref"][0] == pytest.approx(old["springref"][0], rel=1e-12, abs=1e-15)
     expected_armature = old["armature"][0] if old["armature"][0] > 0 else si["m"]
@@ -159,7 +125,11 @@ def _check_parallel(before, after, name: str, si: dict, notes: tuple[str, ...]) 
 
 
 def _check_series(before, after, name: str, si: dict, notes: tuple[str, ...]) -> None:
-    old, new, motor = _numbers(before, name), _numbers(after, name), _numbers(after, f"{name}_motor")
+    old, new, motor = (
+        joint_numbers(before, name),
+        joint_numbers(after, name),
+        joint_numbers(after, f"{name}_motor"),
+    )
     assert new["stiffness"][0] == si["k"] and new["damping"][0] == si["c"] and new["armature"][0] == si["m"]
     assert new["springref"][0] == 0.0 and new["limited"][0] == 0
     for field in ("range", "limited", "axis", "ref"):
@@ -173,18 +143,6 @@ def _check_series(before, after, name: str, si: dict, notes: tuple[str, ...]) ->
         assert f"{before.nkey} keyframe(s) extended" in text
     if old["limited"][0]:
         assert f"moved to {name}_motor" in text
-
-
-def _check_others(before, after, name: str, notes: tuple[str, ...]) -> None:
-    """Every other joint's numbers exactly as the host had them (a joint with a springdamper too: MuJoCo
-    derives its stiffness and damping from the mass matrix, which the series form's motor changes)."""
-    for i in range(before.njnt):
-        other = before.joint(i).name
-        if other == name or not other:
-            continue
-        old, new = _numbers(before, other), _numbers(after, other)
-        for field, value in old.items():
-            assert np.array_equal(value, new[field]), (other, field)
 
 
 @pytest.mark.parametrize("package, path", _mjcf_cases())
@@ -212,8 +170,8 @@ def test_mjcf_into_every_model_the_packages_ship(copies, package, path):
                 assert any(n.startswith("springdamper (time constant") for n in out.notes), out.notes
             if form == "series" and any(j.springdamper[0] > 0 and j.name != name for j in spec.joints):
                 assert any("keep their compiled stiffness and damping" in n for n in out.notes), out.notes
-            _check_others(before, after, name, out.notes)
-            _same_poses(before, after, skip=set())
+            assert other_joint_changes(before, after, name) == []
+            _same_poses(before, after)
             tried += 1
     assert tried or before.njnt == 0
 

@@ -10,11 +10,13 @@ import pytest
 
 from designer import Joint
 from designer.errors import DesignerError
-from designer.export.checks import step_response
+from designer.export.checks import libcosim_ssp_run, ssp_with_value, step_response
 from designer.export.ssp import export_ssp, read_ssv
 
 JOINT = Joint.from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}})
 STIFFER = Joint.from_coefficients({"x": {"k": 1.6, "c": 4e-3, "m": 0.01}})
+#: the SSV the SSD binds to the joint's component
+SSV = "resources/FlexJoint.ssv"
 
 
 def constant(value: float):
@@ -81,37 +83,6 @@ def test_ssd_runs_in_fmpy_like_the_fmus_and_alternatives_are_parameter_sets(tmp_
     assert np.max(np.abs(runs["stiffer"]["FlexJoint_x.s"] - step_response(0.01, 4.0, 1600.0, 2.0, t))) < 1e-9
 
 
-def _with_ssv_k(path: Path, out: Path, old: bytes, new: bytes) -> Path:
-    """A copy of SSP archive `path` whose bound SSV states k `new` where it stated `old` (text edit)."""
-    with zipfile.ZipFile(path) as zin, zipfile.ZipFile(out, "w") as zout:
-        for name in zin.namelist():
-            data = zin.read(name)
-            if name == "resources/FlexJoint.ssv":
-                before = b'<ssv:Parameter name="x.k"><ssv:Real value="' + old
-                assert data.count(before) == 1
-                data = data.replace(before, b'<ssv:Parameter name="x.k"><ssv:Real value="' + new)
-            zout.writestr(name, data)
-    return out
-
-
-def _libcosim_deflection(path: Path, load: float) -> float:
-    """libcosim loads the SSP (applying the SSD's parameter binding); a constant load on x.f held
-    from the start; the deflection x.s after 2 s (settled: damping ratio 0.35 at 45 Hz)."""
-    from libcosimpy.CosimExecution import CosimExecution
-    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
-    from libcosimpy.CosimObserver import CosimObserver
-
-    log_output_level(CosimLogLevel.ERROR)
-    execution = CosimExecution.from_ssp_file(str(path), step_size=int(1e5))  # 0.1 ms in ns
-    observer = CosimObserver.create_last_value()
-    execution.add_observer(observer)
-    index = execution.slave_index_from_instance_name("FlexJoint")
-    refs = {v.name.decode(): v.reference for v in execution.slave_variables(index)}
-    execution.real_initial_value(index, refs["x.f"], load)
-    execution.simulate_until(int(2e9))
-    return observer.last_real_values(index, [refs["x.s"]])[0]
-
-
 def test_doubling_k_in_the_ssv_halves_the_deflection_in_fmpy_and_libcosim(tmp_path):
     """Both SSP runners apply the SSD's parameter binding: k edited in the SSV alone changes the run."""
     pytest.importorskip("libcosimpy")
@@ -121,19 +92,22 @@ def test_doubling_k_in_the_ssv_halves_the_deflection_in_fmpy_and_libcosim(tmp_pa
 
     load, k = 2.0, 800.0  # N, N/m: 2.5 mm static deflection
     default = export_ssp(JOINT, tmp_path / "j.ssp")
-    stiff = _with_ssv_k(default, tmp_path / "stiff.ssp", b"800.0", b"1600.0")
+    stiff = ssp_with_value(default, tmp_path / "stiff.ssp", ssv=SSV, parameter="x.k", value=2 * k)
     assert bound_parameters(stiff)["FlexJoint.x.k"] == 2 * k
     # libcosim: every connection needs startElement and endElement, so the default SSD has none
     assert b"<ssd:Connection " not in zipfile.ZipFile(default).read("SystemStructure.ssd")
-    got = [_libcosim_deflection(p, load) for p in (default, stiff)]
+    got = [
+        libcosim_ssp_run(p, element="FlexJoint", load=("x.f", load), output="x.s")[-1]
+        for p in (default, stiff)
+    ]
     assert got == pytest.approx([load / k, load / (2 * k)], rel=1e-9)
     # fmpy.ssp drives the system's connectors (system_connectors=True) and applies the set it is given
     wired = export_ssp(JOINT, tmp_path / "w.ssp", system_connectors=True)
-    stiff_wired = _with_ssv_k(wired, tmp_path / "stiff_w.ssp", b"800.0", b"1600.0")
+    stiff_wired = ssp_with_value(wired, tmp_path / "stiff_w.ssp", ssv=SSV, parameter="x.k", value=2 * k)
     runs = [
         simulate_ssp(
             str(p),
-            stop_time=2.0,
+            stop_time=0.5,
             step_size=1e-3,
             parameter_set=fmpy_parameter_set(p),
             input={"FlexJoint_x.f": constant(load)},
