@@ -242,7 +242,7 @@ def test_urdf_into_pybullet_data_robots(tmp_path, file, name):
         float(gz[0].findtext("springStiffness")) == si["k"] and float(gz[0].findtext("springReference")) == 0
     )
     text = " | ".join(out.notes)
-    assert "damping: " in text and f"-> {si['c']:.4g} (SI)" in text and "Gazebo only" in text
+    assert "damping: " in text and f"-> {si['c']:.4g} (SI)" in text and "MuJoCo and pybullet" in text
     client = p.connect(p.DIRECT)
     try:
         flags = p.URDF_USE_INERTIA_FROM_FILE
@@ -263,3 +263,54 @@ def test_urdf_into_pybullet_data_robots(tmp_path, file, name):
         assert np.allclose(old["pose"], new["pose"], atol=1e-12), joint
         if joint != name:
             assert old["damping"] == new["damping"], joint
+
+
+def drake_joint_torque(path: Path, name: str, positions: list[float], *, prismatic: bool) -> list[float]:
+    """Drake's generalized force on joint `name` of URDF `path` (gravity off, at rest) at each position
+    of that joint, every other joint at its default: the joint's spring as Drake reads it."""
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import MultibodyPlant
+    from pydrake.multibody.tree import MultibodyForces
+
+    plant = MultibodyPlant(0.0)
+    parser = Parser(plant)
+    parser.package_map().PopulateFromFolder(str(path.parent))
+    parser.AddModels(str(path))
+    plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, 0.0])
+    plant.Finalize()
+    context = plant.CreateDefaultContext()
+    joint = plant.GetJointByName(name)
+    out = []
+    for q in positions:
+        joint.set_translation(context, q) if prismatic else joint.set_angle(context, q)
+        forces = MultibodyForces(plant)
+        plant.CalcForceElementsContribution(context, forces)
+        out.append(float(plant.CalcGeneralizedForces(context, forces)[joint.velocity_start()]))
+    return out
+
+
+@pytest.mark.parametrize("file, name", URDF_ROBOTS)
+def test_urdf_into_pybullet_data_robots_gives_drake_the_spring(tmp_path, file, name):
+    """Drake reads the spring from the export's bushing: -k (q - rest) on the joint, exactly."""
+    pybullet_data = pytest.importorskip("pybullet_data")
+    pytest.importorskip("pydrake", reason="pydrake (Drake) is not installed: pip install drake")
+    host = Path(pybullet_data.getDataPath()) / file
+    folder = tmp_path / "robot"
+    shutil.copytree(
+        host.parent, folder, ignore=shutil.ignore_patterns("*.py", "__pycache__"), dirs_exist_ok=True
+    )
+    prismatic = "finger" in name
+    axis, rest, span = ("x", 0.01, 0.02) if prismatic else ("theta", 0.3, 1.0)
+    try:
+        drake_joint_torque(folder / host.name, name, [0.0], prismatic=prismatic)
+    except (
+        RuntimeError
+    ) as exc:  # the robot as shipped does not load in Drake (xArm6: repeated actuator names)
+        pytest.skip(f"Drake does not load {file} as shipped: {str(exc)[:120]}")
+    out = export_urdf(
+        JOINT, folder / "flex.urdf", into=folder / host.name, joint_name=name, axis=axis, rest=rest
+    )
+    positions = [rest - 0.5 * span, rest, rest + 0.2 * span]
+    got = drake_joint_torque(out.path, name, positions, prismatic=prismatic)
+    want = [-SI[axis]["k"] * (q - rest) for q in positions]
+    assert got == pytest.approx(want, rel=1e-9, abs=1e-15)
