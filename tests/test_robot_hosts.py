@@ -166,6 +166,7 @@ def test_mjcf_into_every_model_the_packages_ship(copies, package, path):
             after = mujoco.MjModel.from_xml_path(str(out.path))
             check = _check_parallel if form == "parallel" else _check_series
             check(before, after, name, SI[axis], out.notes)
+            assert "qpos0" in out.advice[name].basis
             if spec.joint(name).springdamper[0] > 0:
                 assert any(n.startswith("springdamper (time constant") for n in out.notes), out.notes
             if form == "series" and any(j.springdamper[0] > 0 and j.name != name for j in spec.joints):
@@ -241,6 +242,8 @@ def test_urdf_into_pybullet_data_robots(tmp_path, file, name):
     assert (
         float(gz[0].findtext("springStiffness")) == si["k"] and float(gz[0].findtext("springReference")) == 0
     )
+    if name in out.advice:  # the links the joint moves state their inertia
+        assert "flags=p.URDF_USE_INERTIA_FROM_FILE" in out.advice[name].text()
     text = " | ".join(out.notes)
     assert "damping: " in text and f"-> {si['c']:.4g} (SI)" in text and "MuJoCo and pybullet" in text
     client = p.connect(p.DIRECT)

@@ -74,7 +74,7 @@ def series_text(
     link = robot.links(joint)[a]
     moving = link.inertia if rot else link.mass
     si = joint.axes[a].si()
-    flex = step_advice(si["k"], si["c"], moving)
+    flex = step_advice(si["k"], si["c"], moving, basis="about the joint axis: the link, the motor held")
     # the motor turns its armature, its body (the flexure's clamped part, as the link) and the link
     servo = robot.Servo.for_flexure(
         flex, carried=2 * moving, motor_inertia=motor_inertia, bandwidth=motor_bandwidth
@@ -82,7 +82,12 @@ def series_text(
     n = joint.name
     advice = {
         f"{n}_{a}": flex,
-        f"{n}_motor": step_advice(servo.kp, servo.kv, servo.motor_inertia + 2 * moving),
+        f"{n}_motor": step_advice(
+            servo.kp,
+            servo.kv,
+            servo.motor_inertia + 2 * moving,
+            basis="about the joint axis: the motor's armature, its body and the link, the flexure held",
+        ),
     }
     kind = "hinge" if rot else "slide"
     body = [

@@ -40,6 +40,11 @@ _DERIVED = {
 }
 #: compiled-model arrays the parallel edit sets, per joint, degree of freedom or qpos entry
 _EDITED = {"jnt_stiffness": "jnt", "dof_damping": "dof", "dof_armature": "dof", "qpos_spring": "qpos"}
+#: what the advice's inertia is when it comes from the compiled robot
+MASS_MATRIX_BASIS = (
+    "about the joint axis: MuJoCo's joint-space inertia (armature included) at the reference pose qpos0, "
+    "the other joints held"
+)
 #: body attributes that place a body in its parent's frame
 _FRAME = ("pos", "quat", "euler", "axisangle", "xyaxes", "zaxis")
 
@@ -240,7 +245,8 @@ def into_parallel(
     check = partial(_compare_parallel, h.model, joint_name=joint_name, k=si["k"], c=si["c"])
     after = _write_checked(h, path, check, text.encode(encoding))
     dof = after.joint(joint_name).dofadr[0]
-    return {joint_name: step_advice(si["k"], si["c"], _mass_diagonal(after)[dof])}, notes
+    inertia = _mass_diagonal(after)[dof]
+    return {joint_name: step_advice(si["k"], si["c"], inertia, basis=MASS_MATRIX_BASIS)}, notes
 
 
 def _parallel_values(
@@ -566,7 +572,11 @@ def into_series(
     after = _write_checked(h, path, check)
     diag = _mass_diagonal(after)
     flex_dof, motor_dof = after.joint(joint_name).dofadr[0], after.joint(f"{joint_name}_motor").dofadr[0]
-    advice = {joint_name: step_advice(si["k"], si["c"], diag[flex_dof])}
+    held = {"basis": MASS_MATRIX_BASIS.replace("the other joints held", "the motor and other joints held")}
+    advice = {joint_name: step_advice(si["k"], si["c"], diag[flex_dof], **held)}
     if not moved:
-        advice[f"{joint_name}_motor"] = step_advice(servo.kp, servo.kv, diag[motor_dof])
+        held = {
+            "basis": MASS_MATRIX_BASIS.replace("the other joints held", "the flexure and other joints held")
+        }
+        advice[f"{joint_name}_motor"] = step_advice(servo.kp, servo.kv, diag[motor_dof], **held)
     return advice, tuple(notes)

@@ -34,11 +34,17 @@ def _gazebo(name: str, k: float, rest: float) -> list[str]:
     ]
 
 
+#: what a URDF --into advice's inertia is
+INERTIA_BASIS = (
+    "about the joint axis at the zero pose, from the links' <inertial> as written (origin and rpy honoured), "
+    "the other joints held at 0; pybullet uses it only when loaded with flags=p.URDF_USE_INERTIA_FROM_FILE "
+    "(by default it recomputes inertia from the collision shapes)"
+)
 #: who reads what of a URDF joint: URDF has no joint spring, only the extension some hosts read
 READERS = (
     "the spring is read by Gazebo (<gazebo> springStiffness/springReference) and Drake (a "
-    "<drake:linear_bushing_rpy> on the joint axis, exact within half a turn of the rest); MuJoCo and pybullet "
-    "load this joint as a pure damper (<dynamics damping>)",
+    "<drake:linear_bushing_rpy> on the joint axis, exact within half a turn of the rest); MuJoCo and "
+    "pybullet load this joint as a pure damper (<dynamics damping>)",
     "for the spring in MuJoCo export mjcf --into the robot's MJCF; in pybullet apply -k (q - rest) as the "
     "joint's torque each step (README: Robot and system formats)",
 )
@@ -214,7 +220,7 @@ def _into_urdf(
     nth = [j.getparent() is root for j in root.iter("joint") if j.get("name") == joint_name].index(True)
     text = _set_damping(host.read_bytes().decode(encoding), joint_name, robot.num(si["c"]), nth)
     moved = moved_inertia(root, joint_name)
-    advice = {joint_name: step_advice(si["k"], si["c"], moved)} if moved > 0 else {}
+    advice = {joint_name: step_advice(si["k"], si["c"], moved, basis=INERTIA_BASIS)} if moved > 0 else {}
     text = _set_spring(text, joint_name, si["k"], rest)
     text = _add_drake_spring(text, root, found[0], si["k"], rest, prismatic=not rot)
     return text.encode(encoding), advice, tuple(notes)
