@@ -15,7 +15,7 @@ import typer
 
 from designer.errors import DesignerError
 
-from .common import console, print_json, progress
+from .common import console, err_console, print_json, progress
 
 export_app = typer.Typer(
     help="Export a joint: FMU (FMI 2/3), Modelica, MJCF, URDF, SDF or SSP.", no_args_is_help=True
@@ -104,7 +104,7 @@ Platforms = Annotated[
     str | None,  # noqa: UP007
     typer.Option(
         help="binaries for: all, host, or a comma list of x86_64-linux, aarch64-linux, "
-        "x86_64-windows, x86_64-darwin, aarch64-darwin (default: all when ziglang is installed)"
+        "x86_64-windows, x86_64-darwin, aarch64-darwin (default: all)"
     ),
 ]
 
@@ -280,13 +280,23 @@ def _fmu(
     interface: str,
     source_only: bool,
     platforms: str | None,
+    build_binaries: bool,
 ) -> _FmuWritten:
-    """The FMU (co-simulation and model exchange), compiled on first use for the chosen platforms."""
+    """The FMU (co-simulation and model exchange) with the shipped binaries for the chosen platforms,
+    compiled instead when the C sources were edited or --build asks."""
     from designer.export import build
-    from designer.export.fmu import export_fmu
+    from designer.export.fmu import FMI_VERSIONS, export_fmu
 
-    platforms = platforms or ("all" if build.zig_available() else "host")
-    with progress("exporting FMU (compiling on first use)") as tick:
+    platforms = platforms or "all"
+    checked = not source_only and fmi in FMI_VERSIONS  # export_fmu reports a bad --fmi
+    compiling = build.needs_compiling(fmi, platforms, rebuild=build_binaries) if checked else []
+    if compiling:
+        why = "--build" if build_binaries else "the C sources differ from the shipped binaries'"
+        err_console.print(
+            f"compiling the FMU binary for {', '.join(compiling)} ({why}); "
+            "a first Windows build takes minutes"
+        )
+    with progress("exporting FMU") as tick:
         path = export_fmu(
             joint,
             output,
@@ -295,6 +305,7 @@ def _fmu(
             source_only=source_only,
             progress=tick,
             platforms=platforms,
+            rebuild=build_binaries,
         )
     built = [] if source_only else build.resolve_platforms(platforms)
     return _FmuWritten(path, fmi, interface, source_only, built)
@@ -307,6 +318,17 @@ FMU_OPTIONS = (
         "source_only", Annotated[bool, typer.Option("--source-only", help="no binary: sources/ only")], False
     ),
     _option("platforms", Platforms, None),
+    _option(
+        "build_binaries",
+        Annotated[
+            bool,
+            typer.Option(
+                "--build",
+                help="compile the binaries (Zig, the build extra) instead of copying the shipped ones",
+            ),
+        ],
+        False,
+    ),
 )
 
 
