@@ -259,6 +259,15 @@ def test_urdf_into_pybullet_data_robots(tmp_path, file, name):
         p.disconnect(client)
     before, after = states
     assert after[name]["damping"] == si["c"]
+    # MuJoCo reads URDF damping too: where it loads the robot, the joint and nothing else changes
+    try:
+        host_mj = mujoco.MjModel.from_xml_path(str(folder / host.name))
+    except ValueError:  # package:// mesh paths (xArm6, Panda), which MuJoCo does not resolve
+        host_mj = None
+    if host_mj is not None:
+        out_mj = mujoco.MjModel.from_xml_path(str(out.path))
+        assert joint_numbers(out_mj, name)["damping"][0] == si["c"]
+        assert other_joint_changes(host_mj, out_mj, name) == [] and pose_changes(host_mj, out_mj) == []
     assert before.keys() == after.keys()
     for joint, old in before.items():
         new = after[joint]
