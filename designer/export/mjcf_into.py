@@ -563,6 +563,10 @@ def into_series(
     keys = _key_layout(h, joint_name)
     moved = _insert_motor(h, joint_name, clamp, servo)
     notes = _series_notes(h, joint_name, si, moved, rest)
+    notes.append(
+        f"{joint_name}_motor armature {servo.motor_inertia:.4g} (the motor's reflected inertia; the host "
+        f"joint's was {host_armature:.4g})"
+    )
     notes += _freeze_springdampers(h, joint_name)
     _extend_keys(h, joint_name, keys, rest, servo_added=not moved)
     _flexure(h, joint, a, rest, notes)
