@@ -326,3 +326,27 @@ def test_urdf_into_pybullet_data_robots_gives_drake_the_spring(tmp_path, file, n
     got = drake_joint_torque(out.path, name, positions, prismatic=prismatic)
     want = [-SI[axis]["k"] * (q - rest) for q in positions]
     assert got == pytest.approx(want, rel=1e-9, abs=1e-15)
+
+
+@pytest.mark.parametrize(
+    "package, sub, file, name",
+    [
+        ("gymnasium", "envs/mujoco/assets", "humanoid.xml", "right_knee"),
+        ("mujoco", "testdata", "model.xml", "hipy_0"),
+    ],
+)
+def test_a_new_rest_on_a_joint_a_fixed_tendon_couples(copies, package, sub, file, name):
+    """MuJoCo derives the tendon's spring length from the new springref: the export runs (it exited 3
+    before), the rest is exact, and nothing else of the host changes."""
+    folder = _package_dir(package, sub)
+    if folder is None:
+        pytest.skip(f"{package} is not installed")
+    host = copies(folder / file)
+    before = mujoco.MjModel.from_xml_path(str(host))
+    lo, hi = before.joint(name).range if before.joint(name).limited[0] else (-1.0, 1.0)
+    rest = 0.3 * lo + 0.7 * hi
+    out = export_mjcf(JOINT, host.parent / f"{name}_rest.xml", into=host, joint_name=name, rest=rest)
+    after = mujoco.MjModel.from_xml_path(str(out.path))
+    assert joint_numbers(after, name)["springref"][0] == pytest.approx(rest, rel=1e-12)
+    assert other_joint_changes(before, after, name) == [] and pose_changes(before, after) == []
+    assert any(n.startswith("springref: ") for n in out.notes), out.notes
