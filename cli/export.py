@@ -332,14 +332,16 @@ FMU_OPTIONS = (
 )
 
 
-def _ssp(joint: Joint, output: Path, suggestion: Source, *, interface: str) -> Path:
+def _ssp(joint: Joint, output: Path, suggestion: Source, *, interface: str, system_connectors: bool) -> Path:
     """The SSP archive; from a suggestion, every candidate becomes an SSV parameter set."""
     from designer.export.ssp import candidate_sets, export_ssp
 
     sets = None
     if suggestion is not None:
         sets = {joint.name: candidate_sets(suggestion[0], axes=list(joint.axes), name=joint.name)}
-    return export_ssp(joint, output, alternatives=sets, interface=interface)
+    return export_ssp(
+        joint, output, alternatives=sets, interface=interface, system_connectors=system_connectors
+    )
 
 
 def _formats(snippet: Callable[..., None]) -> None:
@@ -407,5 +409,19 @@ def _formats(snippet: Callable[..., None]) -> None:
         "an SSP archive (SSD, FMI 2 FMU, SSV parameter sets in SI; --from: one set per candidate)",
         _ssp,
         "designer export ssp --from suggestion.json -o joint.ssp",
-        (_option("interface", Annotated[str, typer.Option(help="body (load in) or force")], "body"),),
+        (
+            _option("interface", Annotated[str, typer.Option(help="body (load in) or force")], "body"),
+            _option(
+                "system_connectors",
+                Annotated[
+                    bool,
+                    typer.Option(
+                        "--system-connectors",
+                        help="also wire each joint's inputs and outputs to the system's connectors (for "
+                        "fmpy.ssp; libcosim cannot load such connections)",
+                    ),
+                ],
+                False,
+            ),
+        ),
     )
