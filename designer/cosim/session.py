@@ -155,7 +155,8 @@ class Session:
                     )
                 if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                     raise DesignerError(
-                        f"parameters['{name}']['{key}'] = {value!r} is not a number", "give SI"
+                        f"parameters['{name}']['{key}'] = {value!r} is not a finite number",
+                        "give its value in SI",
                     )
                 out[name][str(key)] = float(value)
         return out
