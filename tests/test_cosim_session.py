@@ -120,6 +120,23 @@ def test_prepare_failing_halfway_frees_what_it_built(scratch):
     assert list(scratch.iterdir()) == [] and not _LOGS
 
 
+def test_a_model_mujoco_cannot_compile_is_one_line_after_the_fmus_were_built(tmp_path, scratch):
+    """MuJoCo parses the model but cannot compile it (a missing mesh): the FMUs, instantiated
+    first, are freed and the folder removed."""
+    xml = tmp_path / "robot.xml"
+    xml.write_text(
+        '<mujoco><worldbody><body name="b"><joint name="j1" type="hinge" axis="0 1 0"/>'
+        '<geom type="mesh" mesh="nosuch"/></body></worldbody></mujoco>'
+    )
+    sc = short()
+    sc = replace(sc, model=xml, joints={"j1": sc.joints["j1"]}, motors={})
+    with pytest.raises(DesignerError) as info:
+        prepare(sc)
+    assert info.value.problem.startswith("MuJoCo cannot compile the robot model: Error: mesh 'nosuch'")
+    assert "\n" not in info.value.problem
+    assert list(scratch.iterdir()) == [] and not _LOGS
+
+
 def test_a_closed_session_refuses_to_run(scratch):
     session = prepare(short())
     session.close()
@@ -278,6 +295,17 @@ parameters = { "theta.k" = -5.0 }
 axis = "theta"
 coefficients = { k = 330, c = 0.83 }
 """
+
+
+def test_negative_k_in_a_scenario_names_joint_and_parameter_and_leaves_nothing(tmp_path, scratch):
+    """The FMU refuses the override: one DesignerError naming joint and parameter with the FMU's
+    log line, and neither the joints' files nor their unpacked archives stay in the temporary folder."""
+    (tmp_path / "neg.toml").write_text(textwrap.dedent(NEGATIVE))
+    with pytest.raises(DesignerError) as err:
+        cosim.run(cosim.load(tmp_path / "neg.toml"))
+    assert err.value.problem.startswith("joint j1: the FMU refused to start with theta.k = -5 (")
+    assert "must not be negative" in err.value.problem and "\n" not in err.value.problem
+    assert list(scratch.iterdir()) == [] and not _LOGS
 
 
 def test_cli_negative_k_is_one_line_exit_2_and_leaves_nothing(tmp_path):
