@@ -10,7 +10,7 @@ import pytest
 import typer
 from typer.testing import CliRunner
 
-from designer.cosim import load, run, write_outputs
+from designer.cosim import load, prepare, run, write_outputs
 from designer.errors import DesignerError
 
 # the module, not the function `designer.cosim.run` that shadows it as an attribute of the package
@@ -60,10 +60,10 @@ def arm(tmp_path, duration=10.0, step=1e-3, joint2=J2):
 
 def test_two_link_arm_through_fmus_matches_in_engine_reference(tmp_path):
     sc = load(arm(tmp_path))
-    with cosim_run.joint_fmus(sc) as fmus:
-        laws = {j: cosim_run.law(src, fmus[j]) for j, src in sc.joints.items()}
-        res = cosim_run.robot_run(sc, fmus, sc.step, sc.duration, "gauss-seidel")
-        ref = cosim_run.robot_reference(sc, laws, sc.step, sc.duration, "euler")
+    with prepare(sc) as session:
+        laws = session.laws(session.parameters(None))
+        res = session.trace()
+    ref = cosim_run.robot_reference(sc, laws, sc.step, sc.duration, "euler")
     assert laws["j1"]["k"] == pytest.approx(0.33) and laws["j1"]["c"] == pytest.approx(8.3e-4)
     for j in sc.joints:
         assert np.abs(res.column(f"robot.{j}.q") - ref.column(f"robot.{j}.q")).max() <= 1e-6
@@ -182,12 +182,12 @@ def test_joints_from_a_design_and_a_suggestion_run_through_the_surrogate(tmp_pat
     # the suggestion's k on x (N/mm) taken to theta with the PRB model: K = k (0.85 L)^2
     k2 = doc["candidates"][1]["predicted"]["k"]["value"] * (0.85 * 24) ** 2
     assert expect["j2"].k == pytest.approx(k2, rel=1e-9) and 250 < k2 < 420
-    with cosim_run.joint_fmus(sc) as fmus:
-        for j, src in sc.joints.items():
-            law = cosim_run.law(src, fmus[j])
-            assert law["k"] == pytest.approx(expect[j].k * 1e-3, rel=1e-9)  # N.mm/rad -> N.m/rad
-            assert law["c"] == pytest.approx(expect[j].c * 1e-3, rel=1e-9)
-        res = cosim_run.robot_run(sc, fmus, sc.step, sc.duration, "gauss-seidel")
+    with prepare(sc) as session:
+        laws = session.laws(session.parameters(None))
+        for j in sc.joints:
+            assert laws[j]["k"] == pytest.approx(expect[j].k * 1e-3, rel=1e-9)  # N.mm/rad -> N.m/rad
+            assert laws[j]["c"] == pytest.approx(expect[j].c * 1e-3, rel=1e-9)
+        res = session.trace()
     assert np.abs(res.column("robot.j2.s")).max() > 0.01
     assert sc.joints["j2"].joint.provenance["source"] == "suggestion s.json, candidate 2"
 

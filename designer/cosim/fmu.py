@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DesignerError
+from . import binding as kb
 
 PARAMETERS = ("m", "c", "k", "offset")
 STATUS = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
@@ -75,9 +76,9 @@ def _axes_of(md) -> set[str]:
 class FmuDescription:
     """An FMU's modelDescription.xml, read once: what a run needs from it.
 
-    `path` the archive, `md` fmpy's ModelDescription, `version` 2 or 3, `interface` "force" or "body"
-    (of `axes`), `refs` variable name -> value reference, `starts` variable name -> start value (as
-    written), `axes` the axes the FMU has.
+    `path` the archive (or the folder of an unpacked one), `md` fmpy's ModelDescription, `version`
+    2 or 3, `interface` "force" or "body" (of `axes`), `refs` variable name -> value reference,
+    `starts` variable name -> start value (as written), `axes` the axes the FMU has.
 
     Raises:
         DesignerError: the file is missing, not a readable FMU, without co-simulation, or lacks an axis.
@@ -87,7 +88,7 @@ class FmuDescription:
         from fmpy import read_model_description
 
         path = Path(path)
-        if not path.is_file():
+        if not path.exists():
             raise DesignerError(
                 f"FMU {path} does not exist", "export one with `designer export fmu` or fix the path"
             )
@@ -136,6 +137,11 @@ def unpack(path: str | Path, folder: str | Path) -> Path:
     return Path(extract(str(path), str(folder), include=lambda n: n.startswith(("binaries/", "resources/"))))
 
 
+def fmi_function(fmu, name: str) -> int:
+    """The address of FMI function `name` in an fmpy FMU's loaded library."""
+    return ctypes.cast(getattr(fmu.dll, name), ctypes.c_void_p).value
+
+
 def _same_instant_capable(md) -> bool:
     """True if the FMU's Model Exchange interface can evaluate its outputs at one instant without
     integration: it has the interface, no continuous states and no event indicators."""
@@ -165,7 +171,7 @@ class FmuSystem:
     ) -> None:
         """Instantiate `fmu` (a path, or its description read once), set `parameters` (SI, keyed
         "axis.field"), initialise it; unpacked into `folder` (kept by its owner) or a temporary
-        folder removed by `close`.
+        folder removed by `close` (an FMU already unpacked, a folder, is used where it is).
 
         Raises:
             DesignerError: not a usable FMU, an unknown parameter, or the FMU refused to start.
@@ -192,11 +198,16 @@ class FmuSystem:
             self.outputs = [f"{a}.{v}" for a in axes for v in ("s", "v", "a")]
         self.needs_completed_step = bool(me and md.md.modelExchange.needsCompletedIntegratorStep)
         self.parameters = dict(parameters or {})
-        self._owned = folder is None
-        self._dir = tempfile.mkdtemp(prefix="designer-fmu-") if folder is None else str(folder)
+        unpacked = md.path.is_dir()
+        self._owned = folder is None and not unpacked
+        if unpacked:
+            self._dir = str(md.path)
+        else:
+            self._dir = tempfile.mkdtemp(prefix="designer-fmu-") if folder is None else str(folder)
         self.log: deque[str] = deque(maxlen=LOG_LINES)
         try:
-            unpack(md.path, self._dir)
+            if not unpacked:
+                unpack(md.path, self._dir)
             self.fmu = self._instantiate(md.md, name, me)
             self._start(self.parameters)
             self._bind(md.refs)
@@ -225,13 +236,13 @@ class FmuSystem:
         """
         given = self.parameters | dict(parameters or {})
         self.log.clear()
+        self._steps, self._h = 0, 0.0
         try:
             self.fmu.reset()
             self._start(given)
         except Exception as exc:
             self._refused(exc, self.name, given)
             raise
-        self._steps, self._h = 0, 0.0
 
     def _refused(self, exc: BaseException, name: str, parameters: Mapping[str, float]) -> None:
         """Raise a DesignerError naming the joint and its parameters when the FMU refused to start
@@ -293,7 +304,7 @@ class FmuSystem:
         for _ in range(1000):
             more, terminate, *_ = update()
             if terminate:
-                raise self._terminated()
+                raise self.terminated()
             if not more:
                 break
         else:
@@ -407,12 +418,52 @@ class FmuSystem:
             DesignerError: the FMU asked to terminate the simulation.
         """
         if terminate:
-            raise self._terminated()
+            raise self.terminated()
         if enter:
             self.fmu.enterEventMode()
             self._event_iteration()
 
-    def _terminated(self) -> DesignerError:
+    def binding(self) -> kb.Binding:
+        """The instance for the compiled kernel (see designer.cosim.binding): its FMI functions,
+        co-simulation (DoStep) or Model Exchange without states (SetTime, and
+        CompletedIntegratorStep when the FMU needs it), as `do_step` drives it."""
+        v, fmu = self.version, self.fmu
+        names = {
+            "set": "SetFloat64" if v == 3 else "SetReal",
+            "get": "GetFloat64" if v == 3 else "GetReal",
+            "step": "DoStep",
+            "time": "SetTime",
+            "completed": "CompletedIntegratorStep",
+        }
+        wanted = ["set", "get"]
+        if self.kind == "co-simulation":
+            wanted.append("step")
+        else:
+            wanted += ["time", "completed"] if self.needs_completed_step else ["time"]
+
+        def start() -> int:
+            return self._steps
+
+        def finish(steps: int) -> None:
+            self._steps = steps
+
+        def error(call: int, status: int, t: float) -> DesignerError:
+            return self.status_error(f"fmi{v}{names[kb.CALLS[call]]}", status, t)
+
+        return kb.Binding(
+            kb.FMI3 if v == 3 else kb.FMI2,
+            fmu.component,
+            start,
+            finish,
+            functions={w: fmi_function(fmu, f"fmi{v}{names[w]}") for w in wanted},
+            in_vr=self._in_vr,
+            out_vr=self._out_vr,
+            event=lambda: self.completed(True, False),
+            error=error,
+            terminated=self.terminated,
+        )
+
+    def terminated(self) -> DesignerError:
         return DesignerError(
             f"FMU instance {self.fmu.instanceName} asked to terminate the simulation",
             "check the FMU's inputs and parameters",

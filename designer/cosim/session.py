@@ -1,10 +1,11 @@
 """Prepare once, run many: a co-simulation `Session` (FMPy's efficient loops, mujoco's `Rollout`).
 
-`prepare(scenario)` does every piece of set-up once: it checks the scenario, exports the joints that
-are not FMU files (or takes the files), reads each modelDescription once, unpacks only `binaries/`
-and `resources/` into one temporary folder, instantiates the FMUs, compiles the MuJoCo model and
-wires the master. `Session.run(parameters)` then resets every system (FMI Reset, `mj_resetData`,
-counters), applies the case's parameters and runs the loop: the cost of a run is the loop itself.
+`prepare(scenario)` does every piece of set-up once: it checks the scenario, unpacks each joint FMU
+(only `binaries/` and `resources/`; a joint given as a `Joint` is written there as its export would
+archive it, without the zip) into one temporary folder, reads each modelDescription once,
+instantiates the FMUs, compiles the MuJoCo model and wires the master. `Session.run(parameters)`
+then resets every system (FMI Reset, `mj_resetData`, counters), applies the case's parameters and
+runs the loop: the cost of a run is the loop itself.
 
     with designer.cosim.prepare(sc) as session:
         for k in (0.2, 0.3, 0.4):
@@ -24,8 +25,8 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import DesignerError
-from .fmu import FmuDescription, FmuSystem
-from .kernel import run_master
+from .fmu import FmuDescription, FmuSystem, unpack
+from .kernel import ENGINES, Bound, bind, run_master
 from .master import Master, Trace
 from .robot import Robot, SpringDamper, load_spec
 from .scenario import PARAMETER_FIELDS, JointSource, Scenario
@@ -51,13 +52,21 @@ def sources(sc: Scenario) -> dict[str, JointSource]:
     return {"rig": sc.rig_joint} if sc.kind == "rig" else dict(sc.joints)
 
 
-def _fmu_file(name: str, src: JointSource, interface: str, folder: Path) -> Path:
-    """The FMU file of a joint source: its file, or its joint exported into `folder`."""
+def _unpacked(src: JointSource, interface: str, folder: Path) -> Path:
+    """A joint's FMU as an importer loads it, in `folder`: an FMU file's binaries/ and resources/, or
+    for a `Joint` the files its export would archive, written there directly (no zip; no sources)."""
     if src.fmu is not None:
-        return Path(src.fmu)
-    from ..export.fmu import export_fmu
+        return unpack(src.fmu, folder)
+    from ..export.fmu import archive_entries
 
-    return export_fmu(src.joint, folder / f"{name}.fmu", fmi_version=src.fmi_version, interface=interface)
+    for name, data in archive_entries(src.joint, src.fmi_version, interface).items():
+        if name.startswith(("binaries/", "resources/")) or name == "modelDescription.xml":
+            target = folder / name
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_bytes(data)
+            if name.startswith("binaries/"):
+                target.chmod(0o755)
+    return folder
 
 
 class Session:
@@ -75,6 +84,7 @@ class Session:
         self.descriptions: dict[str, FmuDescription] = {}
         self.systems: dict[str, FmuSystem] = {}
         self._masters: dict[float, Master] = {}
+        self._bound: dict[float, Bound | None] = {}
         self.closed = False
 
     # ------------------------------------------------------------------ set-up (prepare)
@@ -84,16 +94,14 @@ class Session:
         sc = self.scenario
         interface = "body" if sc.kind == "rig" else "force"
         for name, src in sources(sc).items():
-            path = _fmu_file(name, src, interface, self._folder)
-            md = FmuDescription(path, [src.axis])
+            unpacked = _unpacked(src, interface, self._folder / name)
+            md = FmuDescription(src.fmu or unpacked, [src.axis])
             if md.interface != interface:
                 raise DesignerError(
                     f"the FMU of joint {name} has the {md.interface} interface",
                     f"export it with interface='{interface}'",
                 )
             self.descriptions[name] = md
-            unpacked = self._folder / f"{name}.unpacked"
-            unpacked.mkdir()
             system = FmuSystem(md, [src.axis], name=name, parameters=src.parameters, folder=unpacked)
             self._stack.callback(system.close)
             self.systems[name] = system
@@ -168,17 +176,25 @@ class Session:
 
     def trace(
         self,
-        case: Mapping[str, Mapping[str, float]],
-        laws: Mapping[str, Mapping[str, float]],
+        case: Mapping[str, Mapping[str, float]] | None = None,
         *,
-        step: float,
-        duration: float,
+        step: float | None = None,
+        duration: float | None = None,
         progress: Progress = None,
         engine: str = "auto",
     ) -> Trace:
-        """Reset every system, apply `case` (from `parameters`), run the loop at `step` for `duration`."""
+        """The time series of one run: every system reset, `case` applied (as `parameters` returns
+        it; None: the scenario as it is), the loop run at `step` for `duration` (s; defaults the
+        scenario's). A step other than the scenario's gets its own robot (or hub), built once.
+
+        Raises:
+            DesignerError: as `run`.
+        """
         if self.closed:
             raise DesignerError("the session is closed", "prepare the scenario again")
+        sc = self.scenario
+        case = self.parameters(None) if case is None else case
+        step = sc.step if step is None else step
         if step not in self._masters:
             self._masters[step] = self._master(step)
         master = self._masters[step]
@@ -191,10 +207,29 @@ class Session:
             if name == "hub":
                 from .rig import check_stable, servo_gains
 
-                p = laws["rig"]
+                p = self.laws(case)["rig"]
                 check_stable(p["m"], p["c"], p["k"], step)
                 system.stiffness, system.damping = servo_gains(p["m"], p["c"], p["k"])
-        return run_master(master, duration, step, progress=progress, engine=engine)
+        bound = self._kernel(step, master, engine)
+        if bound is None and engine == "auto":
+            engine = "python"
+        span = sc.duration if duration is None else duration
+        return run_master(master, span, step, progress=progress, engine=engine, bound=bound)
+
+    def _kernel(self, step: float, master: Master, engine: str) -> Bound | None:
+        """The master at `step` bound to the compiled kernel once (None: python, or it cannot)."""
+        if engine not in ENGINES:
+            raise DesignerError(f"unknown engine '{engine}'", f"use one of: {', '.join(ENGINES)}")
+        if engine == "python":
+            return None
+        if step not in self._bound:
+            try:
+                self._bound[step] = bind(master)
+            except DesignerError:
+                if engine == "kernel":
+                    raise
+                self._bound[step] = None
+        return self._bound[step]
 
     def run(
         self,
@@ -230,6 +265,7 @@ class Session:
         if not self.closed:
             self.closed = True
             self._masters.clear()
+            self._bound.clear()
             self._stack.close()
 
     def __enter__(self) -> Session:

@@ -7,6 +7,7 @@ with status "failed" and its message; it does not stop the batch.
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import time
 from collections.abc import Iterator, Sequence
@@ -24,11 +25,44 @@ from .cases import Case
 
 @dataclass(frozen=True)
 class Task:
-    """A batch for one worker: the scenario, the evaluation path ("fmu" | "engine") and the cases."""
+    """A batch for one worker: the scenario, the evaluation path ("fmu" | "engine") and the cases.
+
+    `hold`: the worker keeps its prepared Session for the next batch of the same scenario (local
+    processes and this process, which close it at their end; not Dask workers, whose end is not
+    the sweep's).
+    """
 
     scenario: Scenario
     path: str
     cases: tuple[Case, ...]
+    hold: bool = False
+
+
+#: the Session this process holds between batches of one scenario (Task.hold), by the scenario's repr
+_HELD: dict[str, Session] = {}
+
+
+def held(sc: Scenario) -> Session:
+    """The Session this process holds for `sc`, prepared on first use (the one held before, for
+    another scenario, is closed)."""
+    from ..cosim import prepare
+
+    key = repr(sc)
+    session = _HELD.get(key)
+    if session is None:
+        release()
+        session = _HELD[key] = prepare(sc)
+    return session
+
+
+def release() -> None:
+    """Close the Session this process holds: its FMU instances freed, its temporary folder removed
+    (at the end of a sweep in this process, and when a worker process exits)."""
+    while _HELD:
+        _HELD.popitem()[1].close()
+
+
+atexit.register(release)
 
 
 def si_law(src: JointSource, coefficients: dict[str, float]) -> dict[str, float]:
@@ -103,24 +137,29 @@ def _failure(exc: Exception) -> Exception:
 
 
 def _fmu_batch(task: Task) -> list[dict]:
-    """The batch's cases through one prepared Session: set-up once, then a reset and a run per case."""
+    """The batch's cases through one prepared Session: set-up once, then a reset and a run per case.
+    After a failed case the session is closed and the next case prepares a fresh one."""
     from ..cosim import prepare
 
     rows = []
-    try:
-        session = prepare(task.scenario)
-    except Exception as exc:  # e.g. an FMU that cannot be loaded: every case of the batch fails
-        return [case_row(case, outcome=_failure(exc), wall=0.0) for case in task.cases]
-    with session:
+    with contextlib.ExitStack() as stack:
+        session: Session | None = None
         for case in task.cases:
             start = time.perf_counter()
             try:
+                if session is None:
+                    session = (
+                        held(task.scenario) if task.hold else stack.enter_context(prepare(task.scenario))
+                    )
                 if task.scenario.kind == "rig":
                     outcome: dict | Exception = rig_identification(session, case=case)
                 else:
                     outcome = fmu_result(session, case=case).metrics
             except Exception as exc:  # a failed case is recorded, never fatal to the sweep
                 outcome = _failure(exc)
+                if session is not None:
+                    release() if task.hold else session.close()
+                    session = None
             rows.append(case_row(case, outcome=outcome, wall=time.perf_counter() - start))
     return rows
 
@@ -161,6 +200,8 @@ def evaluate(task: Task) -> list[dict]:
         return _engine_batch(task) if task.path == "engine" else _fmu_batch(task)
 
 
-def batches(scenario: Scenario, *, path: str, cases: Sequence[Case], size: int) -> list[Task]:
-    """Cases split into tasks of at most `size`."""
-    return [Task(scenario, path, tuple(cases[i : i + size])) for i in range(0, len(cases), size)]
+def batches(
+    scenario: Scenario, *, path: str, cases: Sequence[Case], size: int, hold: bool = False
+) -> list[Task]:
+    """Cases split into tasks of at most `size` (`hold`: see Task)."""
+    return [Task(scenario, path, tuple(cases[i : i + size]), hold) for i in range(0, len(cases), size)]
