@@ -9,6 +9,7 @@ in one piece by scipy at tight tolerance.
 from __future__ import annotations
 
 import ctypes
+from collections.abc import Mapping
 from ctypes import c_double, c_int64
 
 import numpy as np
@@ -65,6 +66,15 @@ class HubServo:
     def do_step(self, h: float) -> None:
         self._h = h
         self._steps += 1
+
+    def tune(self, law: Mapping[str, float], step: float) -> None:
+        """Set the servo's gains for a joint with SI `law` m, c, k (servo_gains).
+
+        Raises:
+            DesignerError: the sampled loop would be unstable at macro step `step` (s).
+        """
+        check_stable(law["m"], law["c"], law["k"], step)
+        self.stiffness, self.damping = servo_gains(law["m"], law["c"], law["k"])
 
     def binding(self) -> kb.Binding:
         """The hub for the compiled kernel (see designer.cosim.binding)."""

@@ -22,14 +22,18 @@ import math
 import tempfile
 from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import DesignerError
 from .fmu import FmuDescription, FmuSystem, unpack
 from .kernel import ENGINES, Bound, bind, run_master
 from .master import Master, Trace
+from .rig import HubServo
 from .robot import Robot, SpringDamper, load_spec
 from .scenario import PARAMETER_FIELDS, JointSource, Scenario
+
+if TYPE_CHECKING:
+    from .run import Result
 
 Progress = Callable[[float], None] | None
 
@@ -113,8 +117,6 @@ class Session:
         systems: dict[str, Any] = {}
         connections = []
         if sc.kind == "rig":
-            from .rig import HubServo
-
             a = sc.rig_joint.axis
             systems = {"joint": self.systems["rig"], "hub": HubServo(sc.hub, 0.0, 0.0)}
             connections = [(f"joint.{a}.s", "hub.s"), (f"joint.{a}.v", "hub.v"), ("hub.f", f"joint.{a}.f")]
@@ -201,16 +203,12 @@ class Session:
         master = self._masters[step]
         for name, system in self.systems.items():
             system.reset(case[name])
-        for name, system in master.systems.items():
+        for system in master.systems.values():
             if isinstance(system, FmuSystem):
                 continue
             system.reset()
-            if name == "hub":
-                from .rig import check_stable, servo_gains
-
-                p = self.laws(case)["rig"]
-                check_stable(p["m"], p["c"], p["k"], step)
-                system.stiffness, system.damping = servo_gains(p["m"], p["c"], p["k"])
+            if isinstance(system, HubServo):  # the rig's servo loop is tuned to the case's joint
+                system.tune(self.laws(case)["rig"], step)
         bound = self._kernel(step, master, engine)
         if bound is None and engine == "auto":
             engine = "python"
@@ -240,7 +238,7 @@ class Session:
         engine: str = "auto",
         validate: bool = False,
         progress: Progress = None,
-    ):
+    ) -> Result:
         """Run one case and return its `Result` (in memory; nothing is written).
 
         Args:
