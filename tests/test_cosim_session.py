@@ -156,6 +156,42 @@ def test_construction_stores_and_check_validates():
         src.check()
 
 
+def test_prepare_reads_each_file_once_and_unpacks_only_what_loads(tmp_path, scratch, monkeypatch):
+    """A loaded scenario with a joint FMU file and a joint exported on the fly: prepare parses the MJCF
+    once and reads no model description again (load read the file's; the exported one is read from
+    its folder); the session's folder holds binaries/ and resources/ (and the exported joint's
+    modelDescription.xml), no sources."""
+    import fmpy
+
+    from designer.cosim import robot, session
+    from designer.export.fmu import export_fmu
+
+    sc = short()
+    path = export_fmu(sc.joints["j1"].joint, tmp_path / "j1.fmu")
+    sc = replace(sc, joints=sc.joints | {"j1": cosim.JointSource(fmu=path)}).check()
+    reads, parses = [], []
+    real_read, real_spec = fmpy.read_model_description, robot.load_spec
+    monkeypatch.setattr(fmpy, "read_model_description", lambda *a, **k: reads.append(a) or real_read(*a, **k))
+    monkeypatch.setattr(session, "load_spec", lambda *a: parses.append(a) or real_spec(*a))
+    monkeypatch.setattr(robot, "load_spec", lambda *a: parses.append(a) or real_spec(*a))
+    with prepare(sc) as s:
+        (folder,) = scratch.iterdir()
+        assert sorted(p.name for p in (folder / "j1").iterdir()) == ["binaries", "resources"]
+        assert sorted(p.name for p in (folder / "j2").iterdir()) == [
+            "binaries",
+            "modelDescription.xml",
+            "resources",
+        ]
+        assert [Path(a[0]).name for a in reads] == ["j2"]  # the exported joint's, from its folder
+        assert len(parses) == 1
+        s.run()
+        s.run({"j1": {"theta.k": 0.4}})
+        assert len(reads) == 1 and len(parses) == 1  # runs read nothing
+    with prepare(replace(sc, duration=0.1)):  # a changed scenario is checked again
+        assert len(parses) == 3
+    assert list(scratch.iterdir()) == []
+
+
 def _resources(folder: Path) -> dict[str, int]:
     return {
         "open files": len(os.listdir("/proc/self/fd")),

@@ -284,7 +284,7 @@ def prepare(scenario: Scenario) -> Session:
         DesignerError: a bad scenario, an FMU that cannot be read or refuses its parameters (with its
             log line), a robot model MuJoCo cannot compile. Whatever was built is freed first.
     """
-    sc = scenario.check()
+    sc = scenario if scenario.checked else scenario.check()
     stack = contextlib.ExitStack()
     try:
         folder = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="designer-cosim-")))

@@ -214,7 +214,7 @@ def check(spec: Spec) -> Spec:
         DesignerError: a rig scenario with the engine path or limits, a case naming an unknown
             joint, or a Monte Carlo sweep without its count; a bad scenario (Scenario.check).
     """
-    sc = spec.scenario.check()
+    sc = spec.scenario if spec.scenario.checked else spec.scenario.check()
     spec = dataclasses.replace(spec, scenario=sc)
     if sc.kind == "rig" and (spec.path != "fmu" or spec.limits):
         raise DesignerError(
