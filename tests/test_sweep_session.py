@@ -50,9 +50,19 @@ def test_one_session_per_worker_until_a_case_fails(scratch, monkeypatch):
     assert list(scratch.iterdir()) == [] and not evaluate._HELD
 
 
-def test_local_worker_processes_leave_nothing_behind(scratch):
+@pytest.mark.parametrize("start", ["spawn", "fork"])
+def test_local_worker_processes_leave_nothing_behind(scratch, start):
+    """Worker processes hold a Session between batches and close it when they end: spawned ones
+    (the default executor's) and forked ones (a user's ProcessPoolExecutor), which skip atexit."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
     serial = sweep.run(spec(), executor=SerialExecutor()).table
-    processes = sweep.run(spec(workers=2, batch=1)).table  # spawned processes, a batch per case
+    if start == "spawn":
+        processes = sweep.run(spec(workers=2, batch=1)).table  # the default executor, a batch per case
+    else:
+        with ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("fork")) as pool:
+            processes = sweep.run(spec(workers=2, batch=1), executor=pool).table
     assert list(processes["status"]) == ["ok", "ok", "failed", "ok"]
     assert list(scratch.iterdir()) == []  # the workers closed their sessions when they exited
     numbers = [c for c in serial.columns if c.startswith("j") and serial[c].dtype.kind == "f"]

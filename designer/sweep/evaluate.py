@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import atexit
 import contextlib
+import multiprocessing.util
+import os
 import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
@@ -40,6 +42,8 @@ class Task:
 
 #: the Session this process holds between batches of one scenario (Task.hold), by the scenario's repr
 _HELD: dict[str, Session] = {}
+#: the processes in which `release` is registered as a multiprocessing finalizer
+_FINALIZED: set[int] = set()
 
 
 def held(sc: Scenario) -> Session:
@@ -52,6 +56,11 @@ def held(sc: Scenario) -> Session:
     if session is None:
         release()
         session = _HELD[key] = prepare(sc)
+        if os.getpid() not in _FINALIZED:
+            # a worker process closes it when it ends: multiprocessing runs its finalizers then, also
+            # in forked workers, which skip atexit (registered here, in the worker: a fork clears them)
+            multiprocessing.util.Finalize(None, release, exitpriority=10)
+            _FINALIZED.add(os.getpid())
     return session
 
 
