@@ -73,6 +73,22 @@ def release() -> None:
 
 atexit.register(release)
 
+#: how many `holding` blocks are open in this process
+_OPEN = [0]
+
+
+@contextlib.contextmanager
+def holding() -> Iterator[None]:
+    """Keep the Session this process holds for the block's batches, and close it when the outermost
+    block ends (a sweep, or a tune's generations)."""
+    _OPEN[0] += 1
+    try:
+        yield
+    finally:
+        _OPEN[0] -= 1
+        if not _OPEN[0]:
+            release()
+
 
 def si_law(src: JointSource, coefficients: dict[str, float]) -> dict[str, float]:
     """The SI k and c of a case's joint (rig units in, on the joint's axis)."""
