@@ -280,6 +280,28 @@ def test_a_system_the_kernel_cannot_bind_is_named():
         kernel.bind(Master({"hold": Hold()}, []))
 
 
+def test_a_system_struct_of_the_wrong_size_is_refused(monkeypatch):
+    """The kernel checks each system's own struct (its binding's mirror) against the C's size."""
+    import ctypes
+
+    from designer.cosim import kernel
+    from designer.cosim.robot import Robot
+
+    real = Robot.binding
+
+    def short_struct(self):
+        b = real(self)
+        b.struct = (ctypes.c_char * 8)()
+        return b
+
+    monkeypatch.setattr(Robot, "binding", short_struct)
+    with prepare(short()) as session:
+        with pytest.raises(DesignerError, match=r"struct for system robot \(\d+ bytes\) does not match"):
+            session.run(engine="kernel")
+        assert session.run().engine == "python"  # auto falls back
+    assert kernel.library() is not None
+
+
 def test_in_engine_law_is_the_one_definition():
     """MuJoCo's actuator force equals SpringDamper.torque at every step (the Python robot), the
     kernel computes the same bits, and the sweeps' rollout controls are SpringDamper.control."""

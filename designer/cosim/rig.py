@@ -91,7 +91,7 @@ class HubServo:
         def finish(steps: int) -> None:
             self._steps, self._h, self._out[:] = struct.steps, struct.h, list(struct.out)
 
-        return kb.Binding(kb.SERVO, ctypes.addressof(struct), start, finish, keep=keep)
+        return kb.Binding(kb.SERVO, ctypes.addressof(struct), start, finish, keep=keep, struct=struct)
 
 
 def servo_gains(m: float, c: float, k: float) -> tuple[float, float]:

@@ -303,4 +303,12 @@ class Robot:
         def finish(steps: int) -> None:
             self._steps, self.time = struct.steps, struct.time
 
-        return kb.Binding(kb.ROBOT, ctypes.addressof(struct), start, finish, keep=keep)
+        return kb.Binding(
+            kb.ROBOT,
+            ctypes.addressof(struct),
+            start,
+            finish,
+            keep=keep,
+            error=lambda call, status, t: diverged(t),
+            struct=struct,
+        )
