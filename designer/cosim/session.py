@@ -91,10 +91,24 @@ class Session:
         self._bound: dict[float, Bound | None] = {}
         self.closed = False
 
+    @property
+    def master(self) -> Master:
+        """The systems wired at the scenario's step (robot or hub, and the joint FMUs).
+
+        Raises:
+            DesignerError: the session is closed.
+        """
+        self._open()
+        return self._masters[self.scenario.step]
+
+    def _open(self) -> None:
+        if self.closed:
+            raise DesignerError("the session is closed", "prepare the scenario again")
+
     # ------------------------------------------------------------------ set-up (prepare)
 
     def _load(self) -> None:
-        """Export or take each joint FMU, read its description, instantiate it; wire the master."""
+        """Unpack (or write) each joint FMU, read its description, instantiate it; wire the master."""
         sc = self.scenario
         interface = "body" if sc.kind == "rig" else "force"
         for name, src in sources(sc).items():
@@ -193,8 +207,7 @@ class Session:
         Raises:
             DesignerError: as `run`.
         """
-        if self.closed:
-            raise DesignerError("the session is closed", "prepare the scenario again")
+        self._open()
         sc = self.scenario
         case = self.parameters(None) if case is None else case
         step = sc.step if step is None else step
