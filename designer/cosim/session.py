@@ -90,6 +90,7 @@ class Session:
         self._masters: dict[float, Master] = {}
         self._bound: dict[float, Bound | None] = {}
         self.closed = False
+        self._load()  # what it builds is registered on `stack`, which its caller closes on failure
 
     @property
     def master(self) -> Master:
@@ -302,7 +303,6 @@ def prepare(scenario: Scenario) -> Session:
     try:
         folder = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="designer-cosim-")))
         session = Session(sc, stack, folder)
-        session._load()
     except BaseException:
         stack.close()
         raise
