@@ -100,16 +100,16 @@ class Binding:
     (the system's own ctypes mirror of its C struct, whose size the kernel checks) or an FMU
     instance; `functions` the FMI functions' addresses by CALLS name; `in_vr`, `out_vr` ctypes
     uint32 arrays of value references (FMUs) or None; `keep` what must stay alive while bound.
-    `start()` brings the C side to the system's state before a run and returns its step count;
-    `finish(steps)` hands the kernel's count (and whatever the system's struct advanced) back after
-    a run; `event()` runs an event iteration the instance asked for; `error(call, status, t)` and
-    `terminated()` give the DesignerError for a failed call (for the robot: MuJoCo's divergence
-    warning at time t) or a terminate request.
+    `start(step)` brings the C side to the system's state before a run at macro step `step` (s) and
+    returns its step count; `finish(steps)` hands the kernel's count (and whatever the system's
+    struct advanced) back after a run; `event()` runs an event iteration the instance asked for;
+    `error(call, status, t)` and `terminated()` give the DesignerError for a failed call (for the
+    robot: MuJoCo's divergence warning at time t) or a terminate request.
     """
 
     kind: int
     instance: int
-    start: Callable[[], int]
+    start: Callable[[float], int]
     finish: Callable[[int], None]
     functions: Mapping[str, int] = field(default_factory=dict)
     in_vr: Any = None

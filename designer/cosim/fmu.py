@@ -424,13 +424,17 @@ class FmuSystem:
         """Act on CompletedIntegratorStep's answer: stop, or an event iteration (also for the kernel).
 
         Raises:
-            DesignerError: the FMU asked to terminate the simulation.
+            DesignerError: the FMU asked to terminate the simulation, or an event-mode call returned
+                an error status (with the FMU's log).
         """
         if terminate:
             raise self.terminated()
         if enter:
-            self.fmu.enterEventMode()
-            self._event_iteration()
+            try:
+                self.fmu.enterEventMode()
+                self._event_iteration()
+            except Exception as exc:
+                self._surface(exc)
 
     def binding(self) -> kb.Binding:
         """The instance for the compiled kernel (see designer.cosim.binding): its FMI functions,
@@ -450,7 +454,8 @@ class FmuSystem:
         else:
             wanted += ["time", "completed"] if self.needs_completed_step else ["time"]
 
-        def start() -> int:
+        def start(step: float) -> int:
+            self._h = step  # the macro step the kernel runs, for the time in error messages
             return self._steps
 
         def finish(steps: int) -> None:

@@ -200,7 +200,7 @@ class Bound:
         n = steps(duration, step)
         master = self.master
         for out, b in zip(self._structs, self._bindings, strict=True):
-            out.steps, out.asked, out.failed = b.start(), 0, 0
+            out.steps, out.asked, out.failed = b.start(step), 0, 0
         values = np.empty((n + 1, len(master.columns)))
         state = _Run(
             n_systems=len(self._structs),

@@ -82,7 +82,7 @@ class HubServo:
         struct = ServoStruct(kb.reference(self.chirp, keep))
         keep.append(struct)
 
-        def start() -> int:
+        def start(step: float) -> int:
             struct.stiffness, struct.damping = self.stiffness, self.damping
             struct.out[:] = list(self._out)
             struct.steps, struct.h, struct.chirp.cursor = self._steps, self._h, 0

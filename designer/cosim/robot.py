@@ -294,7 +294,7 @@ class Robot:
         )
         keep += [refs, qposadr, dofadr, inputs, engine_act, engine_joint, engine_law, struct]
 
-        def start() -> int:
+        def start(step: float) -> int:
             struct.steps, struct.time = self._steps, self.time
             for ref in refs:
                 ref.cursor = 0
