@@ -67,25 +67,3 @@ def test_local_worker_processes_leave_nothing_behind(scratch, start):
     assert list(scratch.iterdir()) == []  # the workers closed their sessions when they exited
     numbers = [c for c in serial.columns if c.startswith("j") and serial[c].dtype.kind == "f"]
     np.testing.assert_array_equal(serial[numbers].to_numpy(), processes[numbers].to_numpy())
-
-
-def test_tune_prepares_once_for_all_its_generations(scratch, monkeypatch):
-    from designer.sweep.limits import parse_limit
-    from designer.sweep.tune import tune
-
-    real, prepared = cosim.prepare, []
-    monkeypatch.setattr(cosim, "prepare", lambda sc: prepared.append(sc) or real(sc))
-    sc = with_duration(cosim.load(EXAMPLE.parent / "tune_one_link.toml"), 0.3)
-    result = tune(
-        sc,
-        objective="tracking_rms",
-        limits=[parse_limit("overshoot<=20%")],
-        bounds={"j1.k": (200, 600), "j1.c": (5, 150)},
-        path="fmu",
-        executor=SerialExecutor(),
-        maxiter=2,
-        popsize=3,
-        robustness=0,
-    )
-    assert result.evaluations > 6 and len(prepared) == 1
-    assert list(scratch.iterdir()) == [] and not evaluate._HELD
