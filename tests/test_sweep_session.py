@@ -67,3 +67,25 @@ def test_local_worker_processes_leave_nothing_behind(scratch, start):
     assert list(scratch.iterdir()) == []  # the workers closed their sessions when they exited
     numbers = [c for c in serial.columns if c.startswith("j") and serial[c].dtype.kind == "f"]
     np.testing.assert_array_equal(serial[numbers].to_numpy(), processes[numbers].to_numpy())
+
+
+def test_a_held_session_is_for_its_exact_scenario(scratch):
+    """Scenarios differing in one sample of a long motor trajectory (numpy elides it in a plain
+    repr) get their own Session."""
+    from dataclasses import replace
+
+    t = np.linspace(0.0, 0.2, 2001)
+    q = 0.1 * np.sin(5 * t)
+    sc = with_duration(cosim.load(EXAMPLE), 0.2)
+    first = replace(sc, motors=sc.motors | {"j1": cosim.Trajectory(t, q)}).check()
+    q2 = q.copy()
+    q2[1000] += 1e-3
+    second = replace(first, motors=first.motors | {"j1": cosim.Trajectory(t, q2)}).check()
+    try:
+        one = evaluate.held(first)
+        assert evaluate.held(first) is one
+        two = evaluate.held(second)
+        assert two is not one and one.closed and not two.closed
+    finally:
+        evaluate.release()
+    assert list(scratch.iterdir()) == []

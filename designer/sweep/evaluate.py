@@ -40,7 +40,7 @@ class Task:
     hold: bool = False
 
 
-#: the Session this process holds between batches of one scenario (Task.hold), by the scenario's repr
+#: the Session this process holds between batches of one scenario (Task.hold), by the scenario's full repr
 _HELD: dict[str, Session] = {}
 #: the processes in which `release` is registered as a multiprocessing finalizer
 _FINALIZED: set[int] = set()
@@ -51,7 +51,8 @@ def held(sc: Scenario) -> Session:
     another scenario, is closed)."""
     from ..cosim import prepare
 
-    key = repr(sc)
+    with np.printoptions(threshold=2**31, precision=17):  # every sample of a trajectory, exactly
+        key = repr(sc)
     session = _HELD.get(key)
     if session is None:
         release()
