@@ -78,7 +78,8 @@ class Session:
 
     Attributes: `scenario` (checked), `descriptions` (each joint FMU's modelDescription, read once),
     `systems` (the FMU systems by name), `master` (the wiring at the scenario's step). Build it with
-    `prepare`; use it as a context manager or call `close()`.
+    `prepare`; use it as a context manager or call `close()`. A session runs one case at a time:
+    its FMU instances and MjData are its own; prepare one per thread.
     """
 
     def __init__(self, scenario: Scenario, stack: contextlib.ExitStack, folder: Path) -> None:
