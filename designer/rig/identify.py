@@ -101,6 +101,11 @@ class AxisFit:
     load_delay_s: float
     #: the load sensor's low-pass undone in the fit (e.g. "butter2:200Hz"), or None
     load_filter: str | None
+    #: an unknown low-pass the load's noise spectrum shows (`channel.LowpassEstimate.to_dict()` plus
+    #: `c_shift`, about -k x its delay: the bias it gives c), or None; c_se includes |c_shift|
+    load_lowpass: dict | None
+    #: c's standard error from the fit alone (c_se adds an unknown channel lag's shift in quadrature)
+    c_se_fit: float
     #: change of c when the load is shifted by one more sample (rig units), and that over |c|
     c_per_sample_skew: float
     c_skew_relative: float
@@ -263,12 +268,19 @@ def fit_axis(
     c_se, k_se = (float(v) * scale for v in main.se[1:3])
     if not np.isfinite([m_log, c, k, c_se, k_se, main.r2]).all():
         raise AxisFailed("the fit is not finite (values too large or degenerate)")
+    lag = _unknown_lowpass(log, axis, spec.band, load_delay_s, load_filter)
     if k <= 0 or c < 0 or main.r2 < MIN_R2:
         raise AxisFailed(
             f"physically impossible fit: k = {k:.4g} {units.rig_unit('k', axis)}, "
             f"c = {c:.4g} {units.rig_unit('c', axis)}, R2 = {main.r2:.3g} "
             f"(needs k > 0, c >= 0, R2 >= {MIN_R2:g})"
+            + (
+                ""
+                if lag is None
+                else "; " + _lag_text(lag.to_dict(), k * lag.delay_s, units.rig_unit("c", axis))
+            )
         )
+    c_channel = 0.0 if lag is None else k * lag.delay_s
     c_skew = float(main.also_beta[1]) * scale - c
     wide = [(ch, main)] + [_fit(spec, p * top, correct) for p in PASS_EDGES[1:]]
     m_rows = [
@@ -294,7 +306,7 @@ def fit_axis(
         c=c,
         k=k,
         m_se=m_se,
-        c_se=c_se,
+        c_se=float(np.hypot(c_se, c_channel)),
         k_se=k_se,
         r2=main.r2,
         nrmse=float(np.sqrt(main.rss / main.rows) / max(float(y.max() - y.min()), 1e-300)),
@@ -306,6 +318,8 @@ def fit_axis(
         | {"filter_pass_hz": ch.pass_edge, "filter_stop_hz": bandlib.STOP_RATIO * ch.pass_edge},
         load_delay_s=load_delay_s,
         load_filter=None if load_filter is None else str(load_filter),
+        load_lowpass=None if lag is None else lag.to_dict() | {"c_shift": -c_channel},
+        c_se_fit=c_se,
         c_per_sample_skew=c_skew,
         c_skew_relative=abs(c_skew) / c if c > 0 else float("inf"),
         m_bandwidths=m_rows,
@@ -314,6 +328,28 @@ def fit_axis(
     )
     fit.warnings.extend(_warnings(fit, stable, amp.varies, freq.varies, log.rate))
     return fit
+
+
+def _unknown_lowpass(log: RigLog, axis: str, band, delay: float, given) -> channel.LowpassEstimate | None:
+    """The load channel's unknown low-pass, from its noise spectrum (None when a delay or a filter is
+    given, or the noise is white to Nyquist)."""
+    if delay or given is not None:
+        return None
+    load = log.data[LOAD[axis]].to_numpy(dtype=np.float64)
+    return channel.detect_lowpass(load, log.dropouts[axis], log.rate, (band.low, band.high))
+
+
+def _lag_text(lag: dict, shift: float, cu: str, c: float | None = None) -> str:
+    """The sentence on an unknown low-pass of the load channel (`LowpassEstimate.to_dict()`), with the
+    shift of c it causes and, given c, that shift over c."""
+    share = "" if c is None else f" ({100 * shift / c:.2g} % of c; c's standard error includes it)"
+    return (
+        f"the load's noise falls towards Nyquist (to {100 * lag['roll_off']:.2g} %) as a low-pass at about "
+        f"{channel.parse(lag['filter']).cutoff_hz:.3g} Hz would make it (like {lag['filter']}), and the load "
+        f"sensor's filter was not given: its lag of about {1e3 * lag['delay_s']:.2g} ms makes c low by about "
+        f"{shift:.2g} {cu}{share}; give the sensor's filter (load_filter='{lag['filter']}' if that is it) "
+        "or its delay (load_delay_s)"
+    )
 
 
 def _geometric(log: RigLog, axis: str) -> float | None:
@@ -326,6 +362,8 @@ def _warnings(fit: AxisFit, stable: bool, k_varies: bool, c_varies: bool, rate: 
     """Doubtful but possible fits: skew sensitivity, nonlinearity, an unstable or imprecise m."""
     out = []
     cu, ku = units.rig_unit("c", fit.axis), units.rig_unit("k", fit.axis)
+    if fit.load_lowpass is not None:
+        out.append(_lag_text(fit.load_lowpass, -fit.load_lowpass["c_shift"], cu, fit.c))
     if fit.c_skew_relative > SKEW_WARN:
         out.append(
             f"c is dominated by the channels' timing: one sample ({1e3 / rate:.3g} ms) of skew between the "
