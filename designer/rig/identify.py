@@ -34,7 +34,7 @@ from .. import space, units
 from ..errors import DesignerError
 from ..mass import specimen_mass
 from . import band as bandlib
-from . import channel
+from . import channel, departures
 from .logs import LOAD, RigLog, missing, read_log, validate_frame
 from .nonlinear import amplitude_table, frequency_table
 from .regress import solve
@@ -113,6 +113,10 @@ class AxisFit:
     m_bandwidths: list[dict]
     k_amplitude: dict
     c_frequency: dict
+    #: each candidate departure's test (`departures.Departure.to_dict()`), by name
+    departures: dict
+    #: the departure the data supports, named, with its size and the linear fit's c and k, or None
+    departure: dict | None
     warnings: list[str] = field(default_factory=list)
 
     def mass(self) -> float | None:
@@ -247,13 +251,9 @@ def _fit(spec: bandlib.Spectra, pass_edge: float, correct, *, skew_s: float | No
     return ch, solve(x, ch.y, ch.keep, noise, _lags(ch), also=ch.y_skew)
 
 
-def fit_axis(
-    log: RigLog, axis: str, *, load_delay_s: float = 0.0, load_filter: channel.LoadFilter | None = None
-) -> AxisFit:
-    """Fit one axis of a validated log; raise AxisFailed with the reason when it cannot or should not.
-
-    `load_delay_s` and `load_filter`: the load channel's known delay and low-pass, undone exactly.
-    """
+def _checked(log: RigLog, axis: str, load_delay_s: float, load_filter: channel.LoadFilter | None):
+    """Spectra, the main filtered channels and fit, the load correction and any unknown low-pass of
+    one axis; raise AxisFailed when the sampling is too slow or the fit impossible."""
     spec = _spectra(log, axis)
     top = spec.band.high
     scale = spec.scale_f / spec.scale_r
@@ -265,25 +265,24 @@ def fit_axis(
             f"frequency {top:.3g} Hz (or the excitation is aliased)"
         )
     m_log, c, k = (float(v) * scale for v in main.beta[:3])
-    c_se, k_se = (float(v) * scale for v in main.se[1:3])
-    if not np.isfinite([m_log, c, k, c_se, k_se, main.r2]).all():
+    if not np.isfinite([m_log, c, k, *main.se[:3], main.r2]).all():
         raise AxisFailed("the fit is not finite (values too large or degenerate)")
-    lag = _unknown_lowpass(log, axis, spec.band, load_delay_s, load_filter)
+    lag = _unknown_lowpass(log, axis, spec, load_delay_s, load_filter)
     if k <= 0 or c < 0 or main.r2 < MIN_R2:
+        cu = units.rig_unit("c", axis)
         raise AxisFailed(
-            f"physically impossible fit: k = {k:.4g} {units.rig_unit('k', axis)}, "
-            f"c = {c:.4g} {units.rig_unit('c', axis)}, R2 = {main.r2:.3g} "
-            f"(needs k > 0, c >= 0, R2 >= {MIN_R2:g})"
-            + (
-                ""
-                if lag is None
-                else "; " + _lag_text(lag.to_dict(), k * lag.delay_s, units.rig_unit("c", axis))
-            )
+            f"physically impossible fit: k = {k:.4g} {units.rig_unit('k', axis)}, c = {c:.4g} {cu}, "
+            f"R2 = {main.r2:.3g} (needs k > 0, c >= 0, R2 >= {MIN_R2:g})"
+            + ("" if lag is None else "; " + _lag_text(lag.to_dict(), k * lag.delay_s, cu))
         )
-    c_channel = 0.0 if lag is None else k * lag.delay_s
-    c_skew = float(main.also_beta[1]) * scale - c
-    wide = [(ch, main)] + [_fit(spec, p * top, correct) for p in PASS_EDGES[1:]]
-    m_rows = [
+    return spec, ch, main, correct, lag
+
+
+def _masses(spec: bandlib.Spectra, ch, sol, correct, axis: str) -> tuple[list[dict], bool, bandlib.Channels]:
+    """m at the main and the wider derivative bandwidths, and whether they agree within 2 SE."""
+    scale = spec.scale_f / spec.scale_r
+    wide = [(ch, sol)] + [_fit(spec, p * spec.band.high, correct) for p in PASS_EDGES[1:]]
+    rows = [
         {
             "pass_hz": w_ch.pass_edge,
             "m": units.to_si("m_log", axis, float(s.beta[0]) * scale),
@@ -291,14 +290,38 @@ def fit_axis(
         }
         for w_ch, s in wide
     ]
+    stable = all(abs(row["m"] - rows[0]["m"]) <= 2 * rows[0]["m_se"] for row in rows[1:])
+    return rows, stable, wide[-1][0]
+
+
+def fit_axis(
+    log: RigLog, axis: str, *, load_delay_s: float = 0.0, load_filter: channel.LoadFilter | None = None
+) -> AxisFit:
+    """Fit one axis of a validated log; raise AxisFailed with the reason when it cannot or should not.
+
+    `load_delay_s` and `load_filter`: the load channel's known delay and low-pass, undone exactly.
+    When friction or a drift of k is detected (`departures`), m, c, k come from the model with it.
+    """
+    spec, ch, main, correct, lag = _checked(log, axis, load_delay_s, load_filter)
+    scale = spec.scale_f / spec.scale_r
+    x, noise = _design(ch)
+    tests = departures.test(spec, ch, x, noise, _lags(ch), scale)
+    found = departures.supported(tests)
+    sol = found.solution if found is not None and found.name in departures.ADOPTED else main
+    if found is not None and found.name == "friction" and lag is not None:
+        lag = _unknown_lowpass(log, axis, spec, load_delay_s, load_filter, friction=found.value)
+    m_log, c, k = (float(v) * scale for v in sol.beta[:3])
+    c_se, k_se = (float(v) * scale for v in sol.se[1:3])
+    c_channel = 0.0 if lag is None else k * lag.delay_s
+    c_skew = float(main.also_beta[1]) * scale - float(main.beta[1]) * scale
+    m_rows, stable, widest = _masses(spec, ch, sol, correct, axis)
     m, m_se = m_rows[0]["m"], m_rows[0]["m_se"]
-    stable = all(abs(row["m"] - m) <= 2 * m_se for row in m_rows[1:])
     identified = bool(m > 0 and m_se <= M_REL_SE * m and stable)
-    amp = amplitude_table(wide[-1][0], _lags(wide[-1][0]), scale, spec.scale_r)
+    amp = amplitude_table(widest, _lags(widest), scale, spec.scale_r)
     freq = frequency_table(ch, float(main.beta[0]), _lags(ch), scale)
     y = ch.y[ch.keep]
     inertia = float(
-        np.std(main.beta[0] * ch.x[ch.keep, 0]) / max(np.std(main.beta[2] * ch.x[ch.keep, 2]), 1e-300)
+        np.std(sol.beta[0] * ch.x[ch.keep, 0]) / max(np.std(sol.beta[2] * ch.x[ch.keep, 2]), 1e-300)
     )
     fit = AxisFit(
         axis=axis,
@@ -308,9 +331,9 @@ def fit_axis(
         m_se=m_se,
         c_se=float(np.hypot(c_se, c_channel)),
         k_se=k_se,
-        r2=main.r2,
-        nrmse=float(np.sqrt(main.rss / main.rows) / max(float(y.max() - y.min()), 1e-300)),
-        samples=main.rows,
+        r2=sol.r2,
+        nrmse=float(np.sqrt(sol.rss / sol.rows) / max(float(y.max() - y.min()), 1e-300)),
+        samples=sol.rows,
         m_identified=identified,
         m_geometric=None if identified else _geometric(log, axis),
         inertia_ratio=inertia,
@@ -325,18 +348,28 @@ def fit_axis(
         m_bandwidths=m_rows,
         k_amplitude=amp.to_dict(),
         c_frequency=freq.to_dict(),
+        departures={name: d.to_dict() for name, d in tests.items()},
+        departure=None if found is None else departures.describe(found, main, scale, spec, axis, freq.rows),
     )
     fit.warnings.extend(_warnings(fit, stable, amp.varies, freq.varies, log.rate))
     return fit
 
 
-def _unknown_lowpass(log: RigLog, axis: str, band, delay: float, given) -> channel.LowpassEstimate | None:
+def _unknown_lowpass(
+    log: RigLog, axis: str, spec: bandlib.Spectra, delay: float, given, friction: float = 0.0
+) -> channel.LowpassEstimate | None:
     """The load channel's unknown low-pass, from its noise spectrum (None when a delay or a filter is
-    given, or the noise is white to Nyquist)."""
+    given, or the noise is white to Nyquist). `friction`: a Coulomb force (rig units) found in the
+    load, taken out first (its square wave's harmonics would otherwise pass for a falling spectrum)."""
     if delay or given is not None:
         return None
     load = log.data[LOAD[axis]].to_numpy(dtype=np.float64)
-    return channel.detect_lowpass(load, log.dropouts[axis], log.rate, (band.low, band.high))
+    if friction:
+        _, v = bandlib.series_motion(spec, PASS_EDGES[0] * spec.band.high)
+        factor = log.rate / spec.rate
+        centres = np.arange(v.size) * factor + (factor - 1) / 2
+        load = load - friction * np.sign(np.interp(np.arange(load.size), centres, v))
+    return channel.detect_lowpass(load, log.dropouts[axis], log.rate, (spec.band.low, spec.band.high))
 
 
 def _lag_text(lag: dict, shift: float, cu: str, c: float | None = None) -> str:
@@ -371,19 +404,22 @@ def _warnings(fit: AxisFit, stable: bool, k_varies: bool, c_varies: bool, rate: 
             f"{fit.c_skew_relative:.2g} times c: give the known channel delay (load_delay_s) or sample "
             "faster, or c is uncertain by that much"
         )
-    if k_varies:
+    if fit.departure is not None:
+        out.append(fit.departure["text"])
+    if k_varies and fit.departure is None:
         rows = fit.k_amplitude["rows"]
         out.append(
             f"k depends on amplitude beyond its uncertainty ({rows[0]['k']:.4g} to {rows[-1]['k']:.4g} {ku} "
-            f"from the smallest to the largest deflection band, p = {fit.k_amplitude['p_equal']:.2g}): "
-            "the spring is not linear; k is an amplitude average"
+            f"from the smallest to the largest deflection band, p = {fit.k_amplitude['p_equal']:.2g}), and "
+            "none of friction, a cubic spring, viscoelastic damping or a drift of k explains it; k is an "
+            "amplitude average"
         )
-    if c_varies:
+    if c_varies and fit.departure is None:
         rows = fit.c_frequency["rows"]
         out.append(
             f"c depends on frequency beyond its uncertainty ({rows[0]['c']:.4g} to {rows[-1]['c']:.4g} {cu} "
-            f"from the lowest to the highest band, p = {fit.c_frequency['p_equal']:.2g}): the damping is "
-            "not viscous; c is a band average"
+            f"from the lowest to the highest band, p = {fit.c_frequency['p_equal']:.2g}), and none of "
+            "friction, a cubic spring, viscoelastic damping or a drift of k explains it; c is a band average"
         )
     if fit.m > 0 and fit.m_se <= M_REL_SE * fit.m and not stable:
         out.append("m is precise but changes with the derivative bandwidth (biased): not taken as identified")
