@@ -234,12 +234,33 @@ def _cycles(ch: bandlib.Channels) -> float:
     return float(np.count_nonzero(s[1:] != s[:-1]) / 2)
 
 
+def _check_dropouts(spec: bandlib.Spectra, ch: bandlib.Channels) -> None:
+    """Fail, naming the dropouts, a log whose gaps (and the rows the filter loses around each) leave
+    under MIN_VALID of the record usable: not the excitation's fault."""
+    inside = int(np.floor((spec.samples - 1) * ch.t.size / spec.n)) + 1
+    usable = ch.keep.sum() / max(inside, 1)
+    if usable >= MIN_VALID or not spec.filled.any():
+        return
+    longest = bandlib.fill_tolerant(spec)
+    edges = np.diff(np.concatenate(([0], spec.filled.astype(np.int8), [0])))
+    runs = np.flatnonzero(edges == -1) - np.flatnonzero(edges == 1)
+    transition = (bandlib.STOP_RATIO - 1.0) * ch.pass_edge
+    raise AxisFailed(
+        f"dropouts leave only {100 * usable:.2g} % of the record usable: {int((runs > longest).sum())} gaps "
+        f"longer than {1e3 * (longest + 1) / spec.rate:.3g} ms (of {100 * spec.filled.mean():.2g} % of the "
+        f"samples, after block means of {1e3 / spec.rate:.3g} ms), each costing "
+        f"{bandlib.GUARD_TRANSITIONS / transition:.2g} s either side to the filter; the excitation is not "
+        "the problem: fix the sensor or its wiring, or record again"
+    )
+
+
 def _fit(spec: bandlib.Spectra, pass_edge: float, correct, *, skew_s: float | None = None):
     """Filter at `pass_edge` and fit; fail a log with too few cycles or usable rows.
 
     With `skew_s`, the solution's `also_beta` is the fit with the load advanced by that much more.
     """
     ch = bandlib.filtered(spec, pass_edge, correct, skew_s)
+    _check_dropouts(spec, ch)
     cycles = _cycles(ch)
     if cycles < MIN_CYCLES:
         raise AxisFailed(f"only {cycles:.3g} cycles of excitation (at least {MIN_CYCLES:g} needed)")
