@@ -198,10 +198,15 @@ def _spectra(log: RigLog, axis: str) -> bandlib.Spectra:
     f = log.data[LOAD[axis]].to_numpy()
     valid = 1.0 - log.missing_fraction.get(LOAD[axis], float(missing(f).mean()))
     if valid < MIN_VALID:
-        raise AxisFailed(f"the load channel {LOAD[axis]} has only {100 * valid:.3g} % valid samples")
+        raise AxisFailed(
+            f"the load channel {LOAD[axis]} has only {100 * valid:.3g} % valid samples (the rest NaN, "
+            "infinite or stuck at zero)"
+        )
     usable = 1.0 - np.count_nonzero(log.dropouts[axis]) / log.dropouts[axis].size
     if usable < MIN_VALID:
-        raise AxisFailed(f"only {100 * usable:.3g} % of the samples are valid")
+        raise AxisFailed(
+            f"only {100 * usable:.3g} % of the samples are valid (NaN, infinite, stuck or in gaps)"
+        )
     factor = max(1, int(log.rate // bandlib.PRE_RATE))
     spec = bandlib.spectra(r, f, log.dropouts[axis], log.rate, factor)
     # the full rate when the band is too high for the block means, or when they show no band (a
