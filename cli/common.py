@@ -153,6 +153,8 @@ def progress(description: str, enabled: bool = True) -> Iterator[Callable[[float
 #: speaks to Python callers, the command line to its users, so the one error path translates
 FLAGS: tuple[tuple[str, str], ...] = (
     (r"\bsource_only=True\b", "--source-only"),
+    (r"\bplatforms=\"(\w+)\"", r"--platforms \1"),
+    (r"\brebuild=True\b", "--build"),
     (r"\bfmi_version=", "--fmi "),
     (r"\binterface=", "--interface "),
     (r"\ballow_extrapolation=True\b", "--allow-extrapolation"),

@@ -15,7 +15,7 @@ import typer
 
 from designer.errors import DesignerError
 
-from .common import console, print_json, progress
+from .common import console, err_console, print_json, progress
 
 export_app = typer.Typer(
     help="Export a joint: FMU (FMI 2/3), Modelica, MJCF, URDF, SDF or SSP.", no_args_is_help=True
@@ -104,7 +104,7 @@ Platforms = Annotated[
     str | None,  # noqa: UP007
     typer.Option(
         help="binaries for: all, host, or a comma list of x86_64-linux, aarch64-linux, "
-        "x86_64-windows, x86_64-darwin, aarch64-darwin (default: all when ziglang is installed)"
+        "x86_64-windows, x86_64-darwin, aarch64-darwin (default: all)"
     ),
 ]
 
@@ -280,13 +280,23 @@ def _fmu(
     interface: str,
     source_only: bool,
     platforms: str | None,
+    build_binaries: bool,
 ) -> _FmuWritten:
-    """The FMU (co-simulation and model exchange), compiled on first use for the chosen platforms."""
+    """The FMU (co-simulation and model exchange) with the shipped binaries for the chosen platforms,
+    compiled instead when the C sources were edited or --build asks."""
     from designer.export import build
-    from designer.export.fmu import export_fmu
+    from designer.export.fmu import FMI_VERSIONS, export_fmu
 
-    platforms = platforms or ("all" if build.zig_available() else "host")
-    with progress("exporting FMU (compiling on first use)") as tick:
+    platforms = platforms or "all"
+    checked = not source_only and fmi in FMI_VERSIONS  # export_fmu reports a bad --fmi
+    compiling = build.needs_compiling(fmi, platforms, rebuild=build_binaries) if checked else []
+    if compiling:
+        why = "--build" if build_binaries else "the C sources differ from the shipped binaries'"
+        err_console.print(
+            f"compiling the FMU binary for {', '.join(compiling)} ({why}); "
+            "a first Windows build takes minutes"
+        )
+    with progress("exporting FMU") as tick:
         path = export_fmu(
             joint,
             output,
@@ -295,6 +305,7 @@ def _fmu(
             source_only=source_only,
             progress=tick,
             platforms=platforms,
+            rebuild=build_binaries,
         )
     built = [] if source_only else build.resolve_platforms(platforms)
     return _FmuWritten(path, fmi, interface, source_only, built)
@@ -307,17 +318,63 @@ FMU_OPTIONS = (
         "source_only", Annotated[bool, typer.Option("--source-only", help="no binary: sources/ only")], False
     ),
     _option("platforms", Platforms, None),
+    _option(
+        "build_binaries",
+        Annotated[
+            bool,
+            typer.Option(
+                "--build",
+                help="compile the binaries (Zig, the build extra) instead of copying the shipped ones",
+            ),
+        ],
+        False,
+    ),
 )
 
 
-def _ssp(joint: Joint, output: Path, suggestion: Source, *, interface: str) -> Path:
+def _ssp(joint: Joint, output: Path, suggestion: Source, *, interface: str, system_connectors: bool) -> Path:
     """The SSP archive; from a suggestion, every candidate becomes an SSV parameter set."""
     from designer.export.ssp import candidate_sets, export_ssp
 
     sets = None
     if suggestion is not None:
         sets = {joint.name: candidate_sets(suggestion[0], axes=list(joint.axes), name=joint.name)}
-    return export_ssp(joint, output, alternatives=sets, interface=interface)
+    return export_ssp(
+        joint, output, alternatives=sets, interface=interface, system_connectors=system_connectors
+    )
+
+
+#: the options of `export mjcf` beyond the joint's: where it goes in a robot and how
+MJCF_OPTIONS = (
+    INTO,
+    ROBOT_JOINT,
+    REST,
+    AXIS_PICK,
+    _option("form", Annotated[str, typer.Option(help="parallel or series (motor -> flexure)")], "parallel"),
+    _option("motor_inertia", Annotated[float | None, typer.Option(help="series: SI")], None),  # noqa: UP007
+    _option("motor_bandwidth", Annotated[float | None, typer.Option(help="series: servo Hz")], None),  # noqa: UP007
+    _option(
+        "allow_outside_range",
+        Annotated[bool, typer.Option(help="accept a --rest outside the robot joint's range")],
+        False,
+    ),
+)
+#: the options of `export ssp` beyond the joint's
+SSP_OPTIONS = (
+    _option("interface", Annotated[str, typer.Option(help="body (load in) or force")], "body"),
+    _option(
+        "system_connectors",
+        Annotated[
+            bool,
+            typer.Option(
+                "--system-connectors",
+                help="also wire each joint's inputs and outputs to the system's connectors (for "
+                "fmpy.ssp; libcosim cannot load such connections)",
+            ),
+        ],
+        False,
+    ),
+)
 
 
 def _formats(snippet: Callable[..., None]) -> None:
@@ -347,22 +404,7 @@ def _formats(snippet: Callable[..., None]) -> None:
         _mjcf,
         "designer export mjcf --k 50 --c 0.5 --m 1e-5 --axis theta --into robot.xml --joint elbow "
         "-o robot_flex.xml",
-        (
-            INTO,
-            ROBOT_JOINT,
-            REST,
-            AXIS_PICK,
-            _option(
-                "form", Annotated[str, typer.Option(help="parallel or series (motor -> flexure)")], "parallel"
-            ),
-            _option("motor_inertia", Annotated[float | None, typer.Option(help="series: SI")], None),  # noqa: UP007
-            _option("motor_bandwidth", Annotated[float | None, typer.Option(help="series: servo Hz")], None),  # noqa: UP007
-            _option(
-                "allow_outside_range",
-                Annotated[bool, typer.Option(help="accept a --rest outside the robot joint's range")],
-                False,
-            ),
-        ),
+        MJCF_OPTIONS,
     )
     snippet(
         "urdf",
@@ -385,5 +427,5 @@ def _formats(snippet: Callable[..., None]) -> None:
         "an SSP archive (SSD, FMI 2 FMU, SSV parameter sets in SI; --from: one set per candidate)",
         _ssp,
         "designer export ssp --from suggestion.json -o joint.ssp",
-        (_option("interface", Annotated[str, typer.Option(help="body (load in) or force")], "body"),),
+        SSP_OPTIONS,
     )

@@ -16,9 +16,12 @@ response surface gets wrong there. Per response, in log space:
 - ``e ~ N(0, sigma_n^2)``: print-to-print scatter, from the study's replicated runs (pure error),
   never below 2.5 %.
 
-Far from the user's runs the prediction is the study's, times the estimated printer factor, with the
-study's interval widened by the factor's uncertainty; at a measured design it converges to the
-measurements. With no run, calibration returns the study surrogate itself.
+The correction is observed at the study's own runs too: each one's residual from the study's
+prediction is the model's error g there (plus print scatter), on the study's printer (no factor b).
+So near a design the study measured, one print of the user's pins both the printer factor and the
+local error; near the user's runs the prediction converges to their measurements; far from every run
+it is the study's, times the estimated printer factor, with the study's interval widened by the
+factor's uncertainty. With no run of the user's, `calibrate` returns the study surrogate itself.
 """
 
 from __future__ import annotations
@@ -137,6 +140,8 @@ class CalibratedSurface(ResponseSurface):
 
     runs: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))  # (n, 6) designs, factor order
     observed: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (n,) measured values
+    #: (n,) 1 for the user's runs (they carry the printer factor), 0 for the study's own runs
+    own: np.ndarray = field(default_factory=lambda: np.zeros(0))
     length: float = 1.0
     noise: float = MIN_NOISE
     printer_sd: float = PRINTER_SD
@@ -147,12 +152,15 @@ class CalibratedSurface(ResponseSurface):
         base: ResponseSurface,
         runs: np.ndarray,
         observed: np.ndarray,
+        own: np.ndarray,
         length: float,
         noise: float,
         printer_sd: float = PRINTER_SD,
     ) -> CalibratedSurface:
         shared = {f.name: getattr(base, f.name) for f in fields(ResponseSurface)}
-        surf = cls(**shared, runs=runs, observed=observed, length=length, noise=noise, printer_sd=printer_sd)
+        surf = cls(
+            **shared, runs=runs, observed=observed, own=own, length=length, noise=noise, printer_sd=printer_sd
+        )
         surf._prepare(base)
         return surf
 
@@ -162,12 +170,16 @@ class CalibratedSurface(ResponseSurface):
         mu0, s0 = _log_moments(base, X)
         self._Zu = coded(X)
         self._sgu = np.sqrt(np.maximum(s0**2 - self.noise**2, 0.25 * s0**2))
-        K = self._prior_cov(self._Zu, self._sgu, self._Zu, self._sgu) + self.noise**2 * np.eye(len(mu0))
+        K = self._prior_cov(self._Zu, self._sgu, self.own, self._Zu, self._sgu, self.own)
+        K += self.noise**2 * np.eye(len(mu0))
         self._Kinv = np.linalg.inv(K) if len(mu0) else np.zeros((0, 0))
         self._alpha = self._Kinv @ (np.log(self.observed) - mu0)
 
-    def _prior_cov(self, Za: np.ndarray, sa: np.ndarray, Zb: np.ndarray, sb: np.ndarray) -> np.ndarray:
-        return self.printer_sd**2 + np.outer(sa, sb) * _correlation(Za, Zb, self.length)
+    def _prior_cov(
+        self, Za: np.ndarray, sa: np.ndarray, ua: np.ndarray, Zb: np.ndarray, sb: np.ndarray, ub: np.ndarray
+    ) -> np.ndarray:
+        """Prior covariance of log y between designs a and b (u: 1 on the user's printer, 0 the study's)."""
+        return self.printer_sd**2 * np.outer(ua, ub) + np.outer(sa, sb) * _correlation(Za, Zb, self.length)
 
     @property
     def transform(self) -> str:
@@ -178,7 +190,7 @@ class CalibratedSurface(ResponseSurface):
         mu0, s0 = _log_moments(self._base, X)
         Z = coded(X)
         sg = np.sqrt(np.maximum(s0**2 - self.noise**2, 0.25 * s0**2))
-        C = self._prior_cov(Z, sg, self._Zu, self._sgu)
+        C = self._prior_cov(Z, sg, np.ones(len(Z)), self._Zu, self._sgu, self.own)
         var = s0**2 + self.printer_sd**2 - np.einsum("ij,jk,ik->i", C, self._Kinv, C)
         return mu0 + C @ self._alpha, np.sqrt(np.maximum(var, self.noise**2))
 
@@ -197,7 +209,8 @@ class CalibratedSurface(ResponseSurface):
         if len(self._Zu):
             z = ca.vertcat(*_coded_symbolic(x))
             d2 = ca.sum1((ca.repmat(z, 1, len(self._Zu)) - ca.DM(self._Zu.T)) ** 2).T
-            c = self.printer_sd**2 + sg * ca.DM(self._sgu) * ca.exp(-0.5 * d2 / self.length**2)
+            local = sg * ca.DM(self._sgu) * ca.exp(-0.5 * d2 / self.length**2)
+            c = self.printer_sd**2 * ca.DM(self.own) + local
             var, mu = var - ca.bilin(ca.DM(self._Kinv), c, c), mu + ca.dot(c, ca.DM(self._alpha))
         half = self.t95 * ca.sqrt(ca.fmax(var, self.noise**2))
         out = [ca.exp(mu), ca.exp(mu - half), ca.exp(mu + half)]
@@ -205,8 +218,8 @@ class CalibratedSurface(ResponseSurface):
 
     def printer_factor(self) -> Prediction:
         """The estimated printer/material factor exp(b) with its 95 % interval."""
-        b = self.printer_sd**2 * float(np.sum(self._alpha))
-        var = self.printer_sd**2 - self.printer_sd**4 * float(np.sum(self._Kinv))
+        b = self.printer_sd**2 * float(self.own @ self._alpha)
+        var = self.printer_sd**2 - self.printer_sd**4 * float(self.own @ self._Kinv @ self.own)
         half = 1.96 * np.sqrt(max(var, 0.0))
         return Prediction(float(np.exp(b)), float(np.exp(b - half)), float(np.exp(b + half)))
 
@@ -218,6 +231,7 @@ class CalibratedSurface(ResponseSurface):
             "wall": space.WALL_MM,
             "line": space.NOZZLE_MM,
             "runs": self._Zu.tolist(),
+            "own": self.own.tolist(),
             "sgu": self._sgu.tolist(),
             "kinv": self._Kinv.tolist(),
             "alpha": self._alpha.tolist(),
@@ -255,16 +269,46 @@ def _runs_table(runs: Any, surrogate: Surrogate) -> Any:
     return table
 
 
+def _study_runs(prior: Surrogate, response: str) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    X = {n: np.asarray(prior.training[n], dtype=float) for n in space.FACTOR_NAMES}
+    return X, np.asarray(prior.training[response], dtype=float)
+
+
+def _evidence(
+    prior: Surrogate, response: str, user: Mapping[str, np.ndarray], observed: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(designs (n, 6) as printed, measured values (n,), own (n,)): the study's runs (own 0: the
+    study's printer, no printer factor) and the user's (own 1), where the local correction is observed.
+    The study's runs observe it directly: each one's residual from the study's own prediction is the
+    model's error there (plus print scatter)."""
+    X, y = _study_runs(prior, response)
+    ok = np.isfinite(y)
+    parts = [({n: v[ok] for n, v in X.items()}, y[ok], 0.0), (user, observed, 1.0)]
+    designs, values, own = [], [], []
+    for X, y, u in parts:
+        printed = _as_printed(dict(X))
+        designs.append(np.column_stack([printed[n] for n in space.FACTOR_NAMES]).reshape(-1, 6))
+        values.append(np.asarray(y, dtype=float))
+        own.append(np.full(len(y), u))
+    return np.vstack(designs), np.concatenate(values), np.concatenate(own)
+
+
 def new_printer(surrogate: Surrogate, *, printer_sd: float = PRINTER_SD) -> Surrogate:
     """The study surrogate as a prior for a printer not measured yet: every response carries the
-    printer factor's uncertainty (no run, so no correction). What a user's first print should expect;
-    `calibrate` with runs continues from it."""
+    printer factor's uncertainty, and the local correction the study's own runs observe (no run of
+    the user's). What a user's first print should expect; `calibrate` with runs continues from it."""
     if surrogate.calibration is not None:
         return surrogate
     import pandas as pd
 
     models = {
-        r: CalibratedSurface.from_base(base, np.zeros((0, 6)), np.zeros(0), 1.0, noise_of(base), printer_sd)
+        r: CalibratedSurface.from_base(
+            base,
+            *_evidence(surrogate, r, {n: np.zeros(0) for n in space.FACTOR_NAMES}, np.zeros(0)),
+            _length_of(base, *_study_runs(surrogate, r), noise_of(base)),
+            noise_of(base),
+            printer_sd,
+        )
         for r, base in surrogate.models.items()
     }
     empty = pd.DataFrame(columns=list(space.FACTOR_NAMES) + surrogate.responses, dtype=float)
@@ -310,7 +354,6 @@ def calibrate(surrogate: Surrogate, runs: Any, *, printer_sd: float = PRINTER_SD
         table = pd.concat([surrogate.calibration["table"], table], ignore_index=True)
     if table.empty:
         return prior
-    X_study = {n: np.asarray(prior.training[n], dtype=float) for n in space.FACTOR_NAMES}
     models: dict[str, ResponseSurface] = {}
     for r, base in prior.models.items():
         rows = table[r].notna().to_numpy() if r in table.columns else np.zeros(len(table), bool)
@@ -318,11 +361,10 @@ def calibrate(surrogate: Surrogate, runs: Any, *, printer_sd: float = PRINTER_SD
             models[r] = base
             continue
         noise = noise_of(base)
-        length = _length_of(base, X_study, np.asarray(prior.training[r], dtype=float), noise)
-        printed = _as_printed({n: table.loc[rows, n].to_numpy(dtype=float) for n in space.FACTOR_NAMES})
-        designs = np.column_stack([printed[n] for n in space.FACTOR_NAMES])
-        observed = table.loc[rows, r].to_numpy(dtype=float)
-        models[r] = CalibratedSurface.from_base(base, designs, observed, length, noise, printer_sd)
+        length = _length_of(base, *_study_runs(prior, r), noise)
+        user = {n: table.loc[rows, n].to_numpy(dtype=float) for n in space.FACTOR_NAMES}
+        designs, observed, own = _evidence(prior, r, user, table.loc[rows, r].to_numpy(dtype=float))
+        models[r] = CalibratedSurface.from_base(base, designs, observed, own, length, noise, printer_sd)
     keep = list(space.FACTOR_NAMES) + [r for r in prior.responses if r in table.columns]
     return Surrogate(
         models=models,
@@ -358,8 +400,9 @@ def _statement(m: ResponseSurface, calibrated: ResponseSurface) -> str:
     if m.predictable:
         return (
             f"{m.response}: the study's {m.form} form times your printer's factor, corrected near the "
-            f"designs you printed (correlation length {calibrated.length:g} of a factor's half-range); "
-            "far from them the interval stays as wide as the study's plus the factor's uncertainty"
+            "designs you and the study printed (correlation length "
+            f"{calibrated.length:g} of a factor's half-range); far from them the interval stays as "
+            "wide as the study's plus the factor's uncertainty"
         )
     return (
         f"{m.response} is not predictable from the six factors (the study's nested Q2 "
@@ -391,7 +434,7 @@ def report(surrogate: Surrogate) -> dict[str, Any]:
         cal = isinstance(m, CalibratedSurface)
         out["responses"][r] = {
             "unit": m.unit,
-            "n_runs": len(m.runs) if cal else 0,
+            "n_runs": int(m.own.sum()) if cal else 0,
             "printer_factor": m.printer_factor().to_dict() if cal else None,
             "settings": m.settings() if cal else None,
             "loo_user": _user_loo(surrogate, r) if cal else None,

@@ -47,25 +47,43 @@ def test_zero_runs_return_the_study_surrogate(study, table):
         np.testing.assert_allclose(a.value, b.value, rtol=1e-12)
 
 
+def _log_sd(pred, t95):
+    return (np.log(pred.high) - np.log(pred.value)) / t95
+
+
 def test_one_run_at_a_study_design_moves_the_prediction_by_the_models_amount(study, table):
-    # the model (calibration.py's docstring): log y = mu0 + b + g + e, with b ~ N(0, tau^2), g of
-    # variance s0^2 - sigma_n^2 at the run, e ~ N(0, sigma_n^2): one run's residual d moves the
-    # prediction there by (tau^2 + sg^2) / (tau^2 + sg^2 + sigma_n^2) * d, in log space
+    """The model of calibration.py's docstring, written out here with numpy: log y = mu0 + u b + g + e,
+    b ~ N(0, tau^2) on the user's printer only (u = 1), g a Gaussian process of size
+    sg(x) = sqrt(max(s0^2 - sn^2, s0^2 / 4)) and squared-exponential correlation over the coded
+    settings, e ~ N(0, sn^2); observed at the study's 44 runs (u = 0) and the user's one run. The
+    prediction at the run moves by the conditional mean of b + g there, its scale is the conditional sd."""
     run = _rows(table, [12], scale=0.7)
     assert run["width"][0] > 2  # a hollow section: the design is predicted as given
-    base = study.model("k_x")
-    p0 = base.predict(run[FACTORS]).at(0)
-    s0 = (math.log(p0.high) - math.log(p0.value)) / base.t95
-    noise = noise_of(base)
-    sg2 = max(s0**2 - noise**2, 0.25 * s0**2)
-    d = math.log(run["k_x"][0]) - math.log(p0.value)
-    shrink = (0.3**2 + sg2) / (0.3**2 + sg2 + noise**2)
-    p1 = designer.calibrate(study, run).predict(run[FACTORS])["k_x"].at(0)
-    assert math.log(p1.value) - math.log(p0.value) == pytest.approx(shrink * d, rel=1e-9)
-    # and the interval there shrinks to about the print scatter
-    assert (math.log(p1.high) - math.log(p1.value)) / base.t95 == pytest.approx(
-        math.sqrt(s0**2 + 0.3**2 - (0.3**2 + sg2) ** 2 / (0.3**2 + sg2 + noise**2)), rel=1e-9
-    )
+    base, tau = study.model("k_x"), 0.3
+    cal = designer.calibrate(study, run)
+    length, noise = cal.model("k_x").length, noise_of(base)
+    X = pd.concat([table[FACTORS], run[FACTORS]], ignore_index=True)
+    from designer.calibration import coded
+
+    p = base.predict(X)
+    s0 = _log_sd(p, base.t95)
+    sg = np.sqrt(np.maximum(s0**2 - noise**2, 0.25 * s0**2))
+    u = np.r_[np.zeros(len(table)), 1.0]
+    Z = coded(X)
+    rho = np.exp(-0.5 * ((Z[:, None, :] - Z[None, :, :]) ** 2).sum(axis=2) / length**2)
+    K = tau**2 * np.outer(u, u) + np.outer(sg, sg) * rho + noise**2 * np.eye(len(u))
+    r = np.log(np.r_[table["k_x"], run["k_x"]]) - np.log(p.value)
+    c = tau**2 * u + sg[-1] * sg * rho[-1]
+    shift = c @ np.linalg.solve(K, r)
+    scale = math.sqrt(s0[-1] ** 2 + tau**2 - c @ np.linalg.solve(K, c))
+    p1 = cal.predict(run[FACTORS])["k_x"].at(0)
+    assert math.log(p1.value) - math.log(p.value[-1]) == pytest.approx(shift, rel=1e-9)
+    assert _log_sd(p1, base.t95) == pytest.approx(scale, rel=1e-9)
+    # the run sits on a study design measured at 1/0.7 of it: the factor comes out near 0.7 and the
+    # interval there shrinks to about the print scatter
+    factor = cal.model("k_x").printer_factor()
+    assert factor.low < 0.7 < factor.high and factor.high / factor.low < 1.25
+    assert scale < 2 * noise
 
 
 def test_printer_factor_of_one_half_is_recovered_within_its_interval(study, table):
@@ -76,9 +94,15 @@ def test_printer_factor_of_one_half_is_recovered_within_its_interval(study, tabl
 
 
 def test_interval_narrows_near_measured_designs_and_stays_wide_elsewhere(study, table):
+    from designer.calibration import coded
+
     runs = _rows(table, [3, 10, 20, 30])
     cal = designer.calibrate(study, runs)
-    near, far = table.iloc[[3]][FACTORS], table.iloc[[12]][FACTORS]
+    # near: a design the user printed; far: of the printable grid, the design farthest from every run
+    # the study or the user printed (so no run observes the local correction there)
+    grid = printers.grid(points=5)
+    gap = np.min(np.linalg.norm(coded(grid)[:, None, :] - coded(table)[None, :, :], axis=2), axis=1)
+    near, far = table.iloc[[3]][FACTORS], grid.iloc[[int(np.argmax(gap))]][FACTORS]
     width = {
         n: {
             s: float(np.log(p.high / p.low)[0])
@@ -187,16 +211,22 @@ def test_cli_calibrate_bad_input(tmp_path, capsys, content, words):
     assert not (tmp_path / "o.json").exists()
 
 
-def test_a_new_printer_widens_every_interval_by_the_printer_factor(study, table):
+def test_a_new_printer_carries_the_printer_factor_and_the_studys_own_runs(study, table):
     from designer.calibration import PRINTER_SD, new_printer
 
     fresh = new_printer(study)
-    X = table[FACTORS].iloc[:5]
+    X = table[FACTORS]
     a, b = study.predict(X)["k_x"], fresh.predict(X)["k_x"]
-    np.testing.assert_allclose(a.value, b.value, rtol=1e-12)
-    s_study = np.log(a.high / a.value) / study.model("k_x").t95
-    s_fresh = np.log(b.high / b.value) / study.model("k_x").t95
-    np.testing.assert_allclose(s_fresh**2, s_study**2 + PRINTER_SD**2, rtol=1e-9)
+    t95 = study.model("k_x").t95
+    s_study, s_fresh = _log_sd(a, t95), _log_sd(b, t95)
+    # the printer's factor is unknown: no interval narrower than it, none wider than study + factor
+    assert np.all(s_fresh >= PRINTER_SD * (1 - 1e-9))
+    assert np.all(s_fresh**2 <= s_study**2 + PRINTER_SD**2 + 1e-12)
+    # the study's runs observe the local correction: at its designs the prediction moves towards
+    # what the study measured
+    before = np.abs(np.log(table["k_x"] / a.value))
+    after = np.abs(np.log(table["k_x"] / b.value))
+    assert np.median(after) < 0.5 * np.median(before)
     # and calibrating it continues from the study, as calibrating the study does
     runs = _rows(table, [1, 2])
     np.testing.assert_allclose(

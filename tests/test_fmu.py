@@ -331,7 +331,12 @@ def test_missing_compiler_message_and_source_only(joint, tmp_path, monkeypatch):
     monkeypatch.setenv("CC", "no-such-compiler-xyz")
     monkeypatch.setattr(build, "zig_available", lambda: False)
     with pytest.raises(DesignerError, match="source_only=True"):
-        export_fmu(joint, tmp_path / "j.fmu")
+        export_fmu(joint, tmp_path / "j.fmu", platforms="host", rebuild=True)
+    with pytest.raises(DesignerError, match=r"flexjoint-designer\[build\]"):
+        export_fmu(joint, tmp_path / "j.fmu", platforms="x86_64-windows", rebuild=True)
+    # without a compiler the shipped binaries still export, for every platform
+    with zipfile.ZipFile(export_fmu(joint, tmp_path / "j.fmu")) as z:
+        assert len([n for n in z.namelist() if n.startswith("binaries/")]) == len(build.PLATFORMS)
     path = export_fmu(joint, tmp_path / "j.fmu", 3, source_only=True)
     with zipfile.ZipFile(path) as z:
         assert not any(n.startswith("binaries/") for n in z.namelist())

@@ -9,6 +9,7 @@ import sys
 import numpy as np
 import pytest
 
+from designer.export import build
 from designer.export.modelica import modelica_text
 from designer.joint import PRB_GAMMA, Joint
 
@@ -20,7 +21,11 @@ def run(*args, env=None):
 
     e = dict(os.environ, **(env or {}))
     if args[:2] == ("export", "fmu") and "--platforms" not in args:
-        args = (*args, "--platforms", "host")  # the default, all platforms, is tested in test_fmu_platforms
+        args = (
+            *args,
+            "--platforms",
+            "host",
+        )  # the default, all platforms, is tested below and in test_fmu_platforms
     return subprocess.run(
         [sys.executable, "-I", "-c", "from designer_cli.main import main; main()", *args],
         capture_output=True,
@@ -144,8 +149,15 @@ def test_cli_bad_input_is_one_line(tmp_path, cache_env, args, message):
 
 def test_cli_without_compiler_says_how_and_source_only_works(tmp_path, cache_env):
     env = dict(cache_env, CC="no-such-cc-xyz")
-    r = run("export", "fmu", "--k", "0.8", "--c", "2e-3", "-o", str(tmp_path / "j.fmu"), env=env)
+    out = str(tmp_path / "j.fmu")
+    r = run(
+        "export", "fmu", "--k", "0.8", "--c", "2e-3", "--build", "--platforms", "host", "-o", out, env=env
+    )
     assert r.returncode == 2 and "no-such-cc-xyz" in r.stderr and "--source-only" in r.stderr
+    assert "compiling the FMU binary for x86_64-linux (--build)" in r.stderr
+    r = run("export", "fmu", "--k", "0.8", "--c", "2e-3", "--platforms", "all", "--json", "-o", out, env=env)
+    assert r.returncode == 0 and "compiling" not in r.stderr, r.stderr
+    assert json.loads(r.stdout)["platforms"] == list(build.PLATFORMS)
     r = run(
         "export", "fmu", "--k", "0.8", "--c", "2e-3", "--source-only", "-o", str(tmp_path / "j.fmu"), env=env
     )

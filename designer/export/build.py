@@ -1,9 +1,12 @@
-"""Compile the FlexJoint FMU binary once per platform, cached by content hash.
+"""The FlexJoint FMU binary per platform: shipped prebuilt, or compiled once and cached by content hash.
 
-The binary is the same for every joint (the joint's numbers live in the FMU's resources), so an export
-after the first build copies a cached file: no compiler, milliseconds. The host's binary is built with
-the system C compiler; the other platforms (and the host when there is no system compiler) with the
-Zig toolchain from PyPI (`ziglang`, `python -m ziglang cc -target ...`) when it is installed.
+The binary is the same for every joint (the joint's numbers live in the FMU's resources), so the
+package ships the ten binaries (FMI 2 and 3, five platforms) built by `python -m
+designer.export.prebuilt` with Zig, beside a hash of the C sources and flags they were built from. An
+export copies them: no compiler. Only when the sources' hash differs (an edited checkout) or the caller
+asks (`rebuild=True`) is a binary compiled: the host's with the system C compiler, the other platforms
+(and the host when there is no system compiler) with the Zig toolchain from PyPI (`ziglang`, the
+`build` extra), then kept in a cache keyed by sources, compiler and flags.
 
 Platforms are named by their FMI 3 platform tuple. Binary folders: FMI 3 uses the tuple; FMI 2
 standardises only linux64, win64 and darwin64, meaning 64-bit x86 (FMI 2.0.4 section 2.3), and for any
@@ -28,28 +31,32 @@ from pathlib import Path
 from ..errors import DesignerError
 from ..files import atomic_path
 
+#: no fused multiply-add contraction: aarch64 would fuse a*b+c where x86_64 cannot, and a joint's
+#: numbers would then differ by platform (1e-12 after 300 steps, measured under qemu-user)
 FLAGS: tuple[str, ...] = (
     "-std=gnu99",
     "-O2",
+    "-ffp-contract=off",
     "-fPIC",
     "-shared",
     "-fvisibility=hidden",
     "-Werror=implicit-function-declaration",
 )
-#: FMI 3 platform tuples this module builds, and the Zig target of each
+#: FMI 3 platform tuples this module builds, and the Zig target of each: glibc 2.17 (RHEL 7 and every
+#: later Linux), macOS 10.15 on x86_64 and 11.0 (the first arm64 release) on aarch64
 PLATFORMS: dict[str, str] = {
-    "x86_64-linux": "x86_64-linux-gnu",
-    "aarch64-linux": "aarch64-linux-gnu",
+    "x86_64-linux": "x86_64-linux-gnu.2.17",
+    "aarch64-linux": "aarch64-linux-gnu.2.17",
     "x86_64-windows": "x86_64-windows-gnu",
-    "x86_64-darwin": "x86_64-macos",
-    "aarch64-darwin": "aarch64-macos",
+    "x86_64-darwin": "x86_64-macos.10.15",
+    "aarch64-darwin": "aarch64-macos.11.0",
 }
 _FMI2_FOLDERS = {"x86_64-linux": "linux64", "x86_64-windows": "win64", "x86_64-darwin": "darwin64"}
 #: Zig flags on top of FLAGS: strip (no debug paths in the binary) and a path-free macOS install name
 _ZIG_FLAGS = ("-s",)
 #: the C files of one FMI version's binary, as shipped flat in the FMU's sources/ folder
 _RUNTIME = ("runtime/instance.c", "runtime/state.c", "FlexJoint/model.c")
-_HEADERS = ("runtime/instance.h", "runtime/model.h", "FlexJoint/config.h")
+_HEADERS = ("runtime/instance.h", "runtime/model.h", "runtime/names.h", "FlexJoint/config.h")
 _FMI_HEADERS = {
     2: ("include/fmi2Functions.h", "include/fmi2FunctionTypes.h", "include/fmi2TypesPlatform.h"),
     3: ("include/fmi3Functions.h", "include/fmi3FunctionTypes.h", "include/fmi3PlatformTypes.h"),
@@ -114,7 +121,7 @@ def resolve_platforms(platforms: str | Sequence[str]) -> list[str]:
     """ "all", "host" or platform tuples (a list or a comma-separated string) as a list of tuples.
 
     Raises:
-        DesignerError: for an unknown tuple, or another platform than the host without ziglang.
+        DesignerError: for an unknown tuple.
     """
     if isinstance(platforms, str):
         platforms = [p.strip() for p in platforms.split(",") if p.strip()]
@@ -129,11 +136,6 @@ def resolve_platforms(platforms: str | Sequence[str]) -> list[str]:
         raise DesignerError(
             f"unknown platform(s) {', '.join(unknown) or '(none given)'}",
             f'use platforms="all", "host" or some of: {", ".join(PLATFORMS)}',
-        )
-    if not zig_available() and any(p != host_platform() for p in names):
-        raise DesignerError(
-            "building for other platforms than this machine needs the Zig toolchain",
-            'pip install ziglang, or use platforms="host"',
         )
     return sorted(set(names), key=list(PLATFORMS).index)
 
@@ -160,19 +162,33 @@ def find_compiler() -> list[str]:
     )
 
 
-def _compiler(platform: str) -> tuple[list[str], list[str]]:
+def zig_flags(platform: str) -> list[str]:
+    """The Zig flags on top of FLAGS for `platform`: strip, target, a path-free macOS install name."""
+    extra = [*_ZIG_FLAGS, "-target", PLATFORMS[platform]]
+    if platform.endswith("darwin"):
+        extra.append(f"-Wl,-install_name,{library_name(platform)}")
+    return extra
+
+
+def _compiler(platform: str, *, zig: bool = False) -> tuple[list[str], list[str]]:
     """The compiler command and its extra flags for `platform`: the system one for the host (Zig if
-    there is none and $CC names none), Zig for the others."""
-    if platform == host_platform():
+    there is none and $CC names none, or if `zig`), Zig for the others.
+
+    Raises:
+        DesignerError: if the platform needs Zig and the ziglang package is not installed.
+    """
+    if platform == host_platform() and not zig:
         try:
             return find_compiler(), []
         except DesignerError:
             if os.environ.get("CC", "").strip() or not zig_available():
                 raise
-    extra = [*_ZIG_FLAGS, "-target", PLATFORMS[platform]]
-    if platform.endswith("darwin"):
-        extra.append(f"-Wl,-install_name,{library_name(platform)}")
-    return [sys.executable, "-m", "ziglang", "cc"], extra
+    if not zig_available():
+        raise DesignerError(
+            f"compiling the FMU binary for {platform} needs the Zig toolchain, which is not installed",
+            'pip install "flexjoint-designer[build]" (or pip install ziglang), or use platforms="host"',
+        )
+    return [sys.executable, "-m", "ziglang", "cc"], zig_flags(platform)
 
 
 def cache_dir() -> Path:
@@ -197,42 +213,89 @@ def _build_key(fmi_version: int, compiler: list[str], extra: list[str], platform
     return h.hexdigest()[:24]
 
 
-def build_binary(fmi_version: int, platform: str | None = None) -> Path:
-    """The FlexJoint shared library for FMI `fmi_version` on `platform` (default: this machine),
-    compiled on first use.
+def sources_hash() -> str:
+    """SHA-256 of every C source and header of both FMI versions, the flags and the Zig targets: what
+    the shipped binaries were built from (`fmus/binaries/SOURCES.sha256`)."""
+    h = hashlib.sha256()
+    root = source_dir()
+    for rel in sorted({*source_files(2), *source_files(3)}):
+        h.update(rel.encode() + b"\0" + (root / rel).read_bytes() + b"\0")
+    for platform in PLATFORMS:
+        h.update(f"{platform}|{' '.join(FLAGS)}|{' '.join(zig_flags(platform))}\n".encode())
+    return h.hexdigest()
+
+
+def shipped_binary(fmi_version: int, platform: str) -> Path | None:
+    """The prebuilt binary the package ships for `platform`, or None when there is none or the C
+    sources were edited since it was built (their hash differs from the one recorded beside it)."""
+    folder = source_dir() / "binaries"
+    path = folder / f"fmi{fmi_version}" / platform / library_name(platform)
+    try:
+        recorded = (folder / "SOURCES.sha256").read_text().split()[0]
+    except (OSError, IndexError):
+        return None
+    return path if path.is_file() and recorded == sources_hash() else None
+
+
+def needs_compiling(fmi_version: int, platforms: str | Sequence[str], *, rebuild: bool = False) -> list[str]:
+    """The platforms among `platforms` whose binary an export would compile (no shipped binary matches
+    the sources, or `rebuild`) rather than copy; cached builds count as compiling."""
+    names = resolve_platforms(platforms)
+    return names if rebuild else [p for p in names if shipped_binary(fmi_version, p) is None]
+
+
+def build_binary(
+    fmi_version: int, platform: str | None = None, *, rebuild: bool = False, zig: bool = False
+) -> Path:
+    """The FlexJoint shared library for FMI `fmi_version` on `platform` (default: this machine): the
+    shipped prebuilt one, or compiled (and cached) when the sources changed or `rebuild` is set.
+    `zig` compiles the host's binary with Zig too, as the shipped ones are.
 
     Raises:
         DesignerError: if no compiler can build for the platform or the compilation fails.
     """
     platform = platform or host_platform()
-    compiler, extra = _compiler(platform)
+    shipped = None if rebuild else shipped_binary(fmi_version, platform)
+    if shipped is not None:
+        return shipped
+    compiler, extra = _compiler(platform, zig=zig)
     key = _build_key(fmi_version, compiler, extra, platform)
     target = cache_dir() / f"fmi{fmi_version}-{platform}-{key}" / library_name(platform)
     if target.is_file():
         return target
     target.parent.mkdir(parents=True, exist_ok=True)
-    root = source_dir()
-    includes = sorted({f"-I{root / Path(rel).parent}" for rel in source_files(fmi_version)})
-    with tempfile.TemporaryDirectory(prefix="designer-build-") as tmp, atomic_path(target) as out:
-        built = Path(tmp) / library_name(platform)  # Zig writes .lib/.pdb beside a DLL: keep them out
-        cmd = [*compiler, *FLAGS, *extra, *includes, *(str(root / c) for c in c_sources(fmi_version))]
-        libs = ["-lm"] if not platform.endswith(("windows", "darwin")) else []
-        _run([*cmd, "-o", str(built), *libs], compiler[0] if compiler[0] != sys.executable else "zig")
-        shutil.copyfile(built, out)
+    with atomic_path(target) as out:
+        compile_binary(fmi_version, platform, compiler, extra, out)
     return target
 
 
-def _run(cmd: list[str], name: str) -> None:
-    compile_c(cmd, name=name, what="the FMU binary", instead="export with source_only=True")
+def compile_binary(fmi_version: int, platform: str, compiler: list[str], extra: list[str], out: Path) -> None:
+    """Compile the FMI `fmi_version` binary for `platform` into `out`. The compiler runs in the source
+    folder on relative paths, so no path of this machine ends up in the binary."""
+    root = source_dir()
+    includes = sorted({f"-I{Path(rel).parent}" for rel in source_files(fmi_version)})
+    with tempfile.TemporaryDirectory(prefix="designer-build-") as tmp:
+        built = Path(tmp) / library_name(platform)  # Zig writes .lib/.pdb beside a DLL: keep them out
+        cmd = [*compiler, *FLAGS, *extra, *includes, *c_sources(fmi_version)]
+        libs = ["-lm"] if not platform.endswith(("windows", "darwin")) else []
+        name = compiler[0] if compiler[0] != sys.executable else "zig"
+        compile_c(
+            [*cmd, "-o", str(built), *libs],
+            name=name,
+            what="the FMU binary",
+            instead="export with source_only=True",
+            cwd=root,
+        )
+        shutil.copyfile(built, out)
 
 
-def compile_c(cmd: list[str], *, name: str, what: str, instead: str) -> None:
+def compile_c(cmd: list[str], *, name: str, what: str, instead: str, cwd: Path | None = None) -> None:
     """Run a compiler command building `what`; a failure is a DesignerError with the compiler's message.
 
     `instead` says what the caller can do without a compiler (e.g. "export with source_only=True").
     """
     try:
-        done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+        done = subprocess.run(cmd, capture_output=True, text=True, check=False, cwd=cwd)
     except OSError as exc:
         raise DesignerError(
             f"could not run the C compiler '{name}': {exc}", f"check $CC, or {instead}"

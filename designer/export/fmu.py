@@ -451,10 +451,12 @@ def archive_entries(
     fmi_version: int = 2,
     interface: str = "force",
     source_only: bool = False,
-    platforms: str | Sequence[str] = "host",
+    platforms: str | Sequence[str] = "all",
+    rebuild: bool = False,
 ) -> dict[str, bytes]:
     """The files of the FMU archive, by name in the archive; binaries for `platforms` (see
-    `build.resolve_platforms`: "all", "host" or FMI 3 platform tuples) unless `source_only`."""
+    `build.resolve_platforms`: "all", "host" or FMI 3 platform tuples) unless `source_only`, the
+    shipped ones unless the sources changed or `rebuild` (see `build.build_binary`)."""
     _check(joint, fmi_version, interface)
     variables = _variables(joint, interface)
     describe = _fmi2_description if fmi_version == 2 else _fmi3_description
@@ -483,7 +485,9 @@ def archive_entries(
     if not source_only:
         for platform in build.resolve_platforms(platforms):
             folder, name = build.platform_folder(fmi_version, platform), build.library_name(platform)
-            entries[f"binaries/{folder}/{name}"] = build.build_binary(fmi_version, platform).read_bytes()
+            entries[f"binaries/{folder}/{name}"] = build.build_binary(
+                fmi_version, platform, rebuild=rebuild
+            ).read_bytes()
     return entries
 
 
@@ -494,18 +498,22 @@ def export_fmu(
     interface: str = "force",
     source_only: bool = False,
     progress: Callable[[float], None] | None = None,
-    platforms: str | Sequence[str] = "host",
+    platforms: str | Sequence[str] = "all",
+    rebuild: bool = False,
 ) -> Path:
     """Write `joint` as an FMU at `path` (atomically); the same joint always gives the same bytes.
 
-    `platforms`: "host" (this machine, the default), "all" (linux, windows and macOS on x86_64 and
-    aarch64 as build.PLATFORMS lists; needs the ziglang package) or a list of FMI 3 platform tuples.
+    `platforms`: "all" (the default: linux, windows and macOS on x86_64 and aarch64 as build.PLATFORMS
+    lists), "host" (this machine) or a list of FMI 3 platform tuples. The package ships these binaries
+    prebuilt; they are compiled only when the C sources were edited or `rebuild` is set (the host's
+    with the system C compiler, the others with the `build` extra's Zig; build.needs_compiling says
+    which will be).
 
     Raises:
         DesignerError: bad arguments, or a binary that cannot be built.
     """
     path = check_suffix(path, (".fmu",), what="an FMU")
-    entries = archive_entries(joint, fmi_version, interface, source_only, platforms)
+    entries = archive_entries(joint, fmi_version, interface, source_only, platforms, rebuild)
     if progress:
         progress(0.5)
     with atomic_path(path) as tmp, zipfile.ZipFile(tmp, "w") as z:

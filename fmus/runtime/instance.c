@@ -7,8 +7,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
 #ifdef _WIN32
-#include <wchar.h>
+#define WIN32_LEAN_AND_MEAN
 #include <windows.h>
 #endif
 
@@ -72,36 +73,26 @@ static int hexValue(char c) {
     return -1;
 }
 
-/* a file path from an FMI 2 resource URI (file:///a%20b/) or an FMI 3 resource path (/a b/) */
-/* A file path from an FMI resource location (FMI 2.0.4 section 2.1.5, FMI 3 resourcePath): a plain
-   path, or a file URI in any form the standard allows: file:///C:/dir, file:/C:/dir, file://localhost/dir,
-   file://host/share (UNC), percent-encoded (UTF-8 bytes). On Windows the slash before a drive letter
-   is dropped (/C:/dir -> C:/dir). */
+/* The folder of the resource location: FMI 2 passes a file URI (FMI 2.0.4 section 2.1.5, RFC 8089:
+   file:///C:/a%20b/, file:/C:/a/, file://localhost/C:/a/, file://host/share/a/ for a network share),
+   FMI 3 a native path (/a b/, C:\a b\). Percent-escapes are decoded; the result is UTF-8. On Windows a
+   drive letter loses the URI's leading slash, a host becomes \\host\share, and '/' becomes '\'. */
 static char *pathFromLocation(const char *location) {
     const char *p = location;
     char *path, *out;
-    bool uri = strncmp(p, "file:", 5) == 0;
-    bool unc = false;
-    if (strncmp(p, "file://", 7) == 0) {
-        p += 7;
-        if (strncmp(p, "localhost/", 10) == 0) {
-            p += 9;
-        } else if (*p != '/') {
-            unc = true; /* file://host/share/dir: the authority is a server */
-        }
-    } else if (uri) {
+    bool uri = strncmp(p, "file:", 5) == 0, share = false;
+    if (uri) {
         p += 5;
+        if (strncmp(p, "//", 2) == 0) {
+            p += 2;
+            if (strncmp(p, "localhost/", 10) == 0) p += 9;
+            else share = *p != '/'; /* file://host/...: a network share */
+        }
     }
     path = malloc(strlen(p) + 3);
     if (!path) return NULL;
     out = path;
-    if (unc) {
-        *out++ = '/';
-        *out++ = '/';
-    }
-#ifdef _WIN32
-    if (p[0] == '/' && isalpha((unsigned char)p[1]) && (p[2] == ':' || p[2] == '|')) p++;
-#endif
+    if (share) *out++ = '/', *out++ = '/';
     for (; *p; p++) {
         if (uri && *p == '%' && hexValue(p[1]) >= 0 && hexValue(p[2]) >= 0) {
             *out++ = (char)(hexValue(p[1]) * 16 + hexValue(p[2]));
@@ -111,20 +102,22 @@ static char *pathFromLocation(const char *location) {
         }
     }
     *out = '\0';
+#ifdef _WIN32
+    if (path[0] == '/' && isalpha((unsigned char)path[1]) && (path[2] == ':' || path[2] == '|')) {
+        memmove(path, path + 1, strlen(path));
+        path[1] = ':'; /* file:///C|/ is the legacy form of file:///C:/ */
+    }
+    for (out = path; *out; out++)
+        if (*out == '/') *out = '\\';
+#endif
     return path;
 }
 
-/* fopen of a UTF-8 path: FMI strings are UTF-8; Windows' fopen takes the ANSI code page, so a folder
-   named for a user called Jürgen is opened through its wide-character name there. */
-static FILE *openUtf8(const char *path, const char *mode) {
+static bool isSeparator(char c) {
 #ifdef _WIN32
-    wchar_t wpath[4096], wmode[8];
-    if (MultiByteToWideChar(CP_UTF8, 0, path, -1, wpath, 4096) == 0) return NULL;
-    if (MultiByteToWideChar(CP_UTF8, 0, mode, -1, wmode, 8) == 0) return NULL;
-    return _wfopen(wpath, wmode);
-#else
-    return fopen(path, mode);
+    if (c == '\\') return true;
 #endif
+    return c == '/';
 }
 
 static char *startFilePath(const char *resourceDir) {
@@ -136,11 +129,30 @@ static char *startFilePath(const char *resourceDir) {
     file = malloc(n + sizeof(START_FILE) + 1);
     if (file) {
         memcpy(file, dir, n);
-        if (n == 0 || dir[n - 1] != '/') file[n++] = '/';
+#ifdef _WIN32
+        if (n == 0 || !isSeparator(dir[n - 1])) file[n++] = '\\';
+#else
+        if (n == 0 || !isSeparator(dir[n - 1])) file[n++] = '/';
+#endif
         memcpy(file + n, START_FILE, sizeof(START_FILE));
     }
     free(dir);
     return file;
+}
+
+/* open a UTF-8 path for reading: Windows' fopen takes the ANSI code page, so convert to UTF-16 */
+static FILE *openForReading(const char *path) {
+#ifdef _WIN32
+    FILE *file = NULL;
+    wchar_t *wide;
+    int n = MultiByteToWideChar(CP_UTF8, MB_ERR_INVALID_CHARS, path, -1, NULL, 0);
+    if (n <= 0 || !(wide = malloc((size_t)n * sizeof(wchar_t)))) return NULL;
+    if (MultiByteToWideChar(CP_UTF8, MB_ERR_INVALID_CHARS, path, -1, wide, n) == n) file = _wfopen(wide, L"r");
+    free(wide);
+    return file;
+#else
+    return fopen(path, "r");
+#endif
 }
 
 static char *trim(char *s) {
@@ -154,7 +166,7 @@ static char *trim(char *s) {
 /* zero the model data and apply the start-value file from the FMU's resources */
 static Status loadStartValues(ModelInstance *inst) {
     char line[MAX_LINE];
-    FILE *file = openUtf8(inst->startFile, "r");
+    FILE *file = openForReading(inst->startFile);
     bool tokenSeen = false;
     Status status = OK;
     int number = 0;

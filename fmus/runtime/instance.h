@@ -9,6 +9,7 @@
 #include <stddef.h>
 
 #include "config.h"
+#include "names.h"
 
 /* ---- defaults for the capabilities a model's config.h does not declare */
 #ifndef HAS_EVENT_MODE
