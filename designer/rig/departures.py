@@ -21,16 +21,20 @@ k that depends only on frequency looks like a drift; viscoelastic damping moves 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from .. import units
 from . import band as bandlib
-from .regress import Solution, chi2_sf, solve
+from .regress import Solution, solve
 
 #: |coefficient| / standard error beyond which a departure counts as present (two-sided p about 1e-5)
 Z_CRIT = 4.5
+#: the same level as a p-value, for the band tables' equality tests when no candidate is found (at
+#: their own 1 % they flag about one clean log in 40)
+P_CRIT = math.erfc(Z_CRIT / math.sqrt(2))
 #: departures whose model gives the headline m, c, k (the linear ones are then biased: friction
 #: doubles c, a drift takes a fake mass and moves k); a nonlinear spring or viscoelastic damping keeps
 #: the linear fit's k and c, the averages over this excitation that a linear joint model can carry
@@ -110,7 +114,7 @@ def test(
             value=beta * to_rig[name],
             se=se * to_rig[name],
             z=z,
-            p=chi2_sf(z * z, 1),
+            p=math.erfc(abs(z) / math.sqrt(2)),  # two-sided normal tail
             rss=sol.rss,
             solution=sol,
         )

@@ -432,7 +432,7 @@ def _warnings(fit: AxisFit, stable: bool, k_varies: bool, c_varies: bool, rate: 
         )
     if fit.departure is not None:
         out.append(fit.departure["text"])
-    if k_varies and fit.departure is None:
+    if k_varies and fit.departure is None and fit.k_amplitude["p_equal"] < departures.P_CRIT:
         rows = fit.k_amplitude["rows"]
         out.append(
             f"k depends on amplitude beyond its uncertainty ({rows[0]['k']:.4g} to {rows[-1]['k']:.4g} {ku} "
@@ -440,7 +440,7 @@ def _warnings(fit: AxisFit, stable: bool, k_varies: bool, c_varies: bool, rate: 
             "none of friction, a cubic spring, viscoelastic damping or a drift of k explains it; k is an "
             "amplitude average"
         )
-    if c_varies and fit.departure is None:
+    if c_varies and fit.departure is None and fit.c_frequency["p_equal"] < departures.P_CRIT:
         rows = fit.c_frequency["rows"]
         out.append(
             f"c depends on frequency beyond its uncertainty ({rows[0]['c']:.4g} to {rows[-1]['c']:.4g} {cu} "
