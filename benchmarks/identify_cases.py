@@ -61,7 +61,7 @@ def _said(res) -> str:
 
 def run_case(name: str, seeds: int, duration: float, rate: float) -> None:
     axes, log_kw, fit_kw = CASES[name]
-    k_err, c_err, k_se, c_se, said = [], [], [], [], Counter()
+    k_err, c_err, k_se, c_se, said, linear, texts = [], [], [], [], Counter(), [], []
     start = time.perf_counter()
     for seed in range(seeds):
         res = identify(make_log(axes, duration=duration, rate=rate, seed=1000 + seed, **log_kw), **fit_kw)[0]
@@ -72,9 +72,17 @@ def run_case(name: str, seeds: int, duration: float, rate: float) -> None:
             c_err.append(fit.c - X["c"])
             k_se.append(fit.k_se)
             c_se.append(fit.c_se)
+            if fit.departure is not None:
+                linear.append(
+                    (fit.departure["linear_k"] / X["k"] - 1, fit.departure["linear_c"] / X["c"] - 1)
+                )
+                texts.append(fit.departure["text"])
     k_err, c_err, k_se, c_se = map(np.array, (k_err, c_err, k_se, c_se))
     print(f"\n{name} ({seeds} seeds, {duration:g} s at {rate:g} Hz, {time.perf_counter() - start:.0f} s)")
     print("  said: " + ", ".join(f"{what} {n}" for what, n in said.most_common()))
+    if linear:
+        lk, lc = np.median(np.array(linear), axis=0)
+        print(f"  the linear fit: k {100 * lk:+.3g} %, c {100 * lc:+.3g} % (medians); first: {texts[0]}")
     if k_err.size:
         for q, err, se, truth in (("k", k_err, k_se, X["k"]), ("c", c_err, c_se, X["c"])):
             cover = np.mean(np.abs(err) <= 2 * se)
