@@ -313,6 +313,15 @@ def test_an_unknown_50_hz_filter_fails_the_log_naming_the_filter_and_200_hz_is_s
     assert abs(fit.c - X["c"]) <= 2 * fit.c_se
 
 
+def test_the_cli_names_its_flags_in_the_unknown_filter_warning(tmp_path):
+    path = tmp_path / "filtered.csv"
+    make_log({"x": X}, duration=20, rate=1000, seed=5, load_filter=(2, 200.0)).to_csv(path, index=False)
+    out = _cli("identify", path)
+    assert out.returncode == 0, out.stderr
+    text = " ".join(out.stdout.split())
+    assert "give the sensor's filter (--load-filter butter2:" in text and "load_filter=" not in text
+
+
 @pytest.mark.parametrize("seed", [1, 2])
 def test_coulomb_friction_is_named_and_c_is_not_doubled(seed):
     """Friction in the clamp at 2 % of the peak spring force made c +130 %; named, c within 5 %."""

@@ -177,4 +177,6 @@ def detect_lowpass(load: np.ndarray, bad: np.ndarray, rate: float, band: tuple[f
     mid = 2 * np.pi * np.mean(band)
     dw = 1e-3 * mid
     phase = np.angle(shape.response(np.array([mid + dw]))) - np.angle(shape.response(np.array([mid - dw])))
-    return LowpassEstimate(roll_off=roll_off, filter=shape, delay_s=float(-phase[0] / (2 * dw)))
+    # the cutoff to 3 digits: what the spectrum can tell, and what a user would type
+    shown = LoadFilter(shape.order, float(f"{shape.cutoff_hz:.3g}"))
+    return LowpassEstimate(roll_off=roll_off, filter=shown, delay_s=float(-phase[0] / (2 * dw)))
