@@ -313,6 +313,13 @@ def test_an_unknown_50_hz_filter_fails_the_log_naming_the_filter_and_200_hz_is_s
     assert abs(fit.c - X["c"]) <= 2 * fit.c_se
 
 
+def test_a_noise_free_load_is_not_taken_for_a_filtered_one():
+    """Without noise, what lies above the band is the window's leakage of the motion, which falls
+    with frequency like a low-pass would: a simulated log must not be told of a filter."""
+    res = _one(make_log({"x": X}, duration=30, rate=1000, seed=1, load_noise=0.0, position_noise=0.0))
+    assert res.axes["x"].load_lowpass is None and res.warnings == []
+
+
 def test_the_cli_names_its_flags_in_the_unknown_filter_warning(tmp_path):
     path = tmp_path / "filtered.csv"
     make_log({"x": X}, duration=20, rate=1000, seed=5, load_filter=(2, 200.0)).to_csv(path, index=False)

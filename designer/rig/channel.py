@@ -79,6 +79,9 @@ def correction(delay_s: float, load_filter: LoadFilter | None) -> Callable[[np.n
 ROLL_OFF = 0.6
 #: ... and its power near Nyquist under this fraction of its power in the middle of that range
 UPPER_ROLL_OFF = 0.8
+#: ... and its power in the first three frequency bins at most this multiple of that in the next three
+#: (noise: within 1.6 on 20 s logs; leakage of the motion: about 10)
+FLAT_START = 2.5
 #: samples per segment of the averaged periodogram (Welch) of the load
 WELCH_SEGMENT = 2048
 #: log-spaced frequency bins of the noise spectrum the filter is fitted to
@@ -169,7 +172,10 @@ def detect_lowpass(load: np.ndarray, bad: np.ndarray, rate: float, band: tuple[f
     still_falling = float(np.median(p[-3:]) / np.median(p[middle - 1 : middle + 2]))
     # a filter's roll-off goes on to Nyquist; harmonics of the motion (friction's square wave
     # falls as 1 / f^2) over a white floor fall in the lower half and flatten out in the upper
-    if roll_off >= ROLL_OFF or still_falling >= UPPER_ROLL_OFF:
+    # ... and begins flat: white noise below the cutoff. Without noise (a simulated log) what lies
+    # above the band is the window's leakage of the motion, which falls from the band on
+    flat_start = float(np.median(p[:3]) / np.median(p[3:6]))
+    if roll_off >= ROLL_OFF or still_falling >= UPPER_ROLL_OFF or flat_start > FLAT_START:
         return None
     shape = _fit_shape(f, p, rate)
     if shape is None:
