@@ -13,7 +13,11 @@ How, and why (see `band` and `regress` for the details):
   mass from geometry;
 - a known delay of the load channel is removed exactly (a phase in the frequency domain), and the
   change of c for one sample of skew is always reported (c shifts by about -k x delay);
-- k per amplitude band and c per frequency band test the linear model;
+- an unknown low-pass of the load channel is read from the load's noise spectrum (`channel`): warned
+  about with its size, which c's standard error then includes;
+- k per amplitude band and c per frequency band test the linear model, and four departures from
+  it (friction, a cubic spring, viscoelastic damping, a drift of k) are fitted and tested each on
+  its own; the one the log supports is named (`departures`), friction and drift corrected;
 - a log whose fit is impossible (k <= 0, c < 0, R2 < 0.5), or that cannot support a fit (too slow
   a sampling rate, too few cycles, a mostly missing channel, time not in seconds), is failed with
   its reason and never becomes a row of the coefficient table.
