@@ -396,3 +396,12 @@ def test_reversed_or_repeated_time_and_infinite_loads_exit_2_naming_them(tmp_pat
     out = _cli("identify", path)
     assert out.returncode == 2 and words in out.stderr, out.stderr
     assert out.stderr.count("\n") == 1 and "Traceback" not in out.stderr
+
+
+def test_friction_and_an_unknown_filter_together_are_both_named():
+    """Friction's harmonics are taken out before the noise spectrum is read; each is named."""
+    spec = dict(THETA, friction=0.02 * 330 * 0.3)
+    res = _one(make_log({"theta": spec}, duration=20, rate=1000, seed=3, load_filter=(2, 100.0)))
+    fit = res.axes["theta"]
+    assert fit.departure["name"] == "friction" and "a torque" in fit.departure["text"]
+    assert fit.load_lowpass is not None and abs(fit.c - THETA["c"]) <= 2 * fit.c_se

@@ -141,7 +141,8 @@ def describe(
     if found.name == "friction":
         share = 100 * abs(v) / spec.scale_f
         text = (
-            f"Coulomb friction: a force {v:.3g} +/- {se:.2g} {fu} against the motion ({share:.2g} % of "
+            f"Coulomb friction: a {'torque' if units.is_rotational(axis) else 'force'} {v:.3g} +/- "
+            f"{se:.2g} {fu} against the motion ({share:.2g} % of "
             f"the peak load); m, c, k are from the model with it (the linear fit took it for "
             f"c = {c_lin:.4g} {cu}); c's standard error there runs about a quarter small (on simulated "
             "logs 85 % of fits lie within two of the truth)"
