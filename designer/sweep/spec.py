@@ -212,9 +212,10 @@ def check(spec: Spec) -> Spec:
 
     Raises:
         DesignerError: a rig scenario with the engine path or limits, a case naming an unknown
-            joint, or a Monte Carlo sweep without its count.
+            joint, or a Monte Carlo sweep without its count; a bad scenario (Scenario.check).
     """
-    sc = spec.scenario
+    sc = spec.scenario if spec.scenario.checked else spec.scenario.check()
+    spec = dataclasses.replace(spec, scenario=sc)
     if sc.kind == "rig" and (spec.path != "fmu" or spec.limits):
         raise DesignerError(
             "a rig sweep identifies each case's virtual rig log through the FMU",
