@@ -157,6 +157,9 @@ def test_a_twenty_case_sweep_on_slurm_equals_the_local_one(slurm):
         "log_directory": str(jobs),
         "local_directory": str(jobs),
         "python": sys.executable,
+        # the jobs start in the folder sbatch ran in; from a checkout, `python -m` there would import
+        # the checkout's designer/ instead of the installed package
+        "job_extra_directives": [f"--chdir={jobs}"],
     }
     with executor(cluster={"slurm": settings}) as ex:
         on_slurm = sweep.run(spec, executor=ex).table
