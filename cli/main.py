@@ -17,6 +17,7 @@ import errno
 import os
 import signal
 import sys
+import threading
 import traceback
 import warnings
 from typing import Annotated
@@ -108,6 +109,24 @@ def _stop(signum: int, frame) -> None:
     raise Stopped(signum)
 
 
+def _unraisable(hook):
+    """sys.unraisablehook: a Stopped raised while Python ran a weakref callback, a __del__ or the
+    garbage collector is swallowed there ("Exception ignored in ..."), and the command would go on
+    to exit 0 with a traceback printed; instead the signal is delivered again, to the main flow."""
+
+    def handle(unraisable) -> None:
+        exc = unraisable.exc_value
+        if isinstance(exc, Stopped):
+            # sent again from another thread a moment later, when the main thread has left the
+            # callback (raised here, it would land in this hook and be swallowed again)
+            signal.signal(exc.signum, _stop)
+            threading.Timer(0.02, os.kill, (os.getpid(), exc.signum)).start()
+            return
+        hook(unraisable)
+
+    return handle
+
+
 def _signals() -> list[int]:
     return [getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n)]
 
@@ -156,11 +175,9 @@ def _run(args: list[str], debug: bool) -> int:
         code = chosen(args=args, prog_name="designer", standalone_mode=False)
         return code if isinstance(code, int) else 0
     except Stopped as exc:
-        print(f"stopped by {signal.Signals(exc.signum).name}; partial files removed", file=sys.stderr)
-        return 128 + exc.signum
+        return _stopped(exc.signum)
     except (KeyboardInterrupt, typer.Abort):
-        print("stopped by SIGINT; partial files removed", file=sys.stderr)
-        return 130
+        return _stopped(signal.SIGINT)
     except typer.Exit as exc:
         return exc.exit_code
     except _click_errors.ClickException as exc:
@@ -183,6 +200,11 @@ def _run(args: list[str], debug: bool) -> int:
         return _internal(exc, debug)
 
 
+def _stopped(signum: int) -> int:
+    print(f"stopped by {signal.Signals(signum).name}; partial files removed", file=sys.stderr)
+    return 128 + signum
+
+
 def _closed_stdout() -> int:
     """The reader of our output has gone (`designer ... | head`): a normal end for a command line, as
     with SIGPIPE's default action. Later writes and the exit flush go to /dev/null; exit 0."""
@@ -203,7 +225,15 @@ def main() -> None:
     """The console script: SIGTERM and SIGHUP stop the command like Ctrl-C; exit with run()'s code."""
     for s in _signals():
         signal.signal(s, _stop)
-    code = run()
+    sys.unraisablehook = _unraisable(sys.unraisablehook)
+    try:
+        code = run()
+    except Stopped as exc:  # landed just outside the command's own handling (before or after it)
+        code = _stopped(exc.signum)
+    # the command's work is over (its files complete, or removed): a signal arriving from here on,
+    # while the interpreter shuts down, would kill it with -signum; ignored, the exit code stands
+    for s in _signals():
+        signal.signal(s, signal.SIG_IGN)
     try:
         sys.stdout.flush()
     except BrokenPipeError:
