@@ -249,8 +249,9 @@ def _runs_table(runs: Any, surrogate: Surrogate) -> Any:
     the surrogate has; raise for a table that shares no response or no factor with it."""
     import pandas as pd
 
-    from .data import load_table
+    from .data import check_table_argument, load_table
 
+    check_table_argument(runs, "runs")
     if runs is None:
         return pd.DataFrame()
     if isinstance(runs, pd.DataFrame) and runs.empty:

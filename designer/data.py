@@ -9,6 +9,7 @@ suffixes (`density_pct`, `k_x_N_per_mm`, ...); a suffix naming another unit is r
 from __future__ import annotations
 
 import hashlib
+import os
 import re
 from importlib import resources
 from pathlib import Path
@@ -17,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from . import space, units
-from .errors import DesignerError
+from .errors import DesignerError, describe
 
 BUNDLED_NAME = "study_table3_x.csv"
 #: the widest a printed joint's coefficients can be, per (quantity, rotational), rig units: far
@@ -196,6 +197,7 @@ def load_table(source: str | Path | pd.DataFrame | None = None) -> pd.DataFrame:
         DesignerError: naming the first problem with its column and row (missing factor, no
             coefficient column, a value that is not a finite number, k <= 0, c < 0, an untested level).
     """
+    check_table_argument(source, "source")
     if isinstance(source, pd.DataFrame):
         return normalise(source, source="table")
     p = bundled_path() if source is None else Path(source)
@@ -210,6 +212,21 @@ def load_table(source: str | Path | pd.DataFrame | None = None) -> pd.DataFrame:
             f"cannot read {p}: {str(exc).splitlines()[0]}", "give a CSV or Parquet coefficient table"
         ) from None
     return normalise(raw, source=p.name)
+
+
+def check_table_argument(value: object, name: str) -> None:
+    """Raise unless `value` can be a table for `load_table`: a path, a DataFrame or None.
+
+    Raises:
+        DesignerError: naming the argument `name` (a numpy array, a list, a number...).
+    """
+    if value is None or isinstance(value, (str, os.PathLike, pd.DataFrame)):
+        return
+    raise DesignerError(
+        f"{name} is {describe(value)}, not a table",
+        f"give {name} as a pandas DataFrame with named columns (the six factors, then c_x, k_x...: "
+        "pd.DataFrame(array, columns=[...])) or the path of a CSV or Parquet file",
+    )
 
 
 def is_parquet(path: str | Path) -> bool:

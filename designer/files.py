@@ -25,7 +25,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import IO
 
-from .errors import DesignerError
+from .errors import DesignerError, path_argument
 
 # head room kept free on the target's disk beyond the estimated size (file system metadata, temp files)
 _SPARE_BYTES = 1 << 20
@@ -343,7 +343,7 @@ def check_suffix(path: str | Path, suffixes: tuple[str, ...], *, what: str) -> P
     Raises:
         DesignerError: naming the `path` argument, the format and the suffixes it takes.
     """
-    path = Path(path)
+    path = path_argument(path, "path", what=f"{what} file")
     if path.suffix.lower() not in suffixes:
         raise DesignerError(
             f"path={str(path)!r} does not name {what} file", f"give a path ending in {' or '.join(suffixes)}"

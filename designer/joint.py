@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from . import space, units
-from .errors import DesignerError
+from .errors import DesignerError, check_type, describe, number_argument, path_argument
 from .mass import specimen_mass
 
 if TYPE_CHECKING:
@@ -80,6 +80,7 @@ class Joint:
     def __post_init__(self) -> None:
         if not self.axes:
             raise DesignerError("a joint needs at least one axis", "give axes={'x': JointAxis(...)}")
+        check_type(self.name, str, "name", expected="a str", fix="give e.g. name='knee'")
         if not self.name.isidentifier():
             raise DesignerError(
                 f"joint name '{self.name}' is not an identifier",
@@ -97,6 +98,8 @@ class Joint:
         Raises:
             DesignerError: an unknown axis, a missing k or c, or a value that is not finite and positive.
         """
+        fix = "give coefficients={'x': {'k': 0.8, 'c': 2e-3}} in rig units"
+        check_type(coefficients, Mapping, "coefficients", expected="a mapping of axes", fix=fix)
         axes = {}
         for a, v in coefficients.items():
             if not isinstance(v, Mapping) or not {"k", "c"} <= set(v):
@@ -138,11 +141,15 @@ class Joint:
             DesignerError: a factor missing or out of its tested range (unless `allow_extrapolation`),
                 an axis the surrogate cannot give.
         """
+        if not hasattr(params, "items"):  # a Mapping or a pandas Series of the six factors
+            fix = "give params={'density': 60, 'length': 24, 'width': 4.5, ...} with all six factors"
+            raise DesignerError(f"params is {describe(params)}, not a mapping of factors", fix)
         params = space.check_design(params, allow_extrapolation)
-        if surrogate is None:
-            from .surrogate import Surrogate
+        from .surrogate import Surrogate, check_surrogate
 
+        if surrogate is None:
             surrogate = Surrogate.load()
+        check_surrogate(surrogate)
         pred = surrogate.predict({n: [v] for n, v in params.items()}, allow_extrapolation=True)
         base = {
             a: AxisCoefficients(
@@ -182,10 +189,11 @@ class Joint:
 
         where = "the suggestion"
         if not isinstance(suggestion, Suggestion):
-            where = f"suggestion {Path(suggestion).name}"
-            suggestion = Suggestion.load(suggestion)
+            path = path_argument(suggestion, "suggestion", what="a suggestion (designer suggest --json)")
+            where = f"suggestion {path.name}"
+            suggestion = Suggestion.load(path)
         n = len(suggestion.candidates)
-        if not 1 <= candidate <= n:
+        if not 1 <= number_argument(candidate, "candidate") <= n:
             raise DesignerError(
                 f"candidate {candidate} does not exist in {where}",
                 f"choose 1 to {n}" if n else "the suggestion has no candidates",
@@ -293,10 +301,23 @@ def _number(value: Any, where: str) -> float:
     return float(value)
 
 
+def check_joint(value: Any, name: str = "joint") -> None:
+    """Raise unless `value` is a Joint.
+
+    Raises:
+        DesignerError: naming the argument `name` (e.g. `export_fmu(None, ...)`).
+    """
+    fix = "make one with Joint.from_coefficients, Joint.from_design or Joint.from_suggestion"
+    check_type(value, Joint, name, expected="a Joint", fix=fix)
+
+
 def _axes_from(
     base: Mapping[str, AxisCoefficients], wanted: Sequence[str], length_mm: float
 ) -> dict[str, AxisCoefficients]:
     """The wanted axes from the predicted ones; a rotational axis not predicted comes from the PRB model."""
+    if isinstance(wanted, str):  # axes="theta": one axis
+        wanted = [wanted]
+    check_type(wanted, Sequence, "axes", expected="a list of axes", fix="give e.g. axes=['x', 'theta']")
     out: dict[str, AxisCoefficients] = {}
     for a in wanted:
         a = units.check_axis(a)

@@ -16,6 +16,7 @@ from __future__ import annotations
 import functools
 import itertools
 import math
+import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,8 +26,8 @@ import casadi as ca
 import numpy as np
 
 from . import space, units
-from .errors import DesignerError
-from .surrogate import Prediction, Surrogate
+from .errors import DesignerError, check_type, number_argument
+from .surrogate import Prediction, Surrogate, check_surrogate
 
 #: default tolerance around a target within which a printed joint counts as meeting it
 TOLERANCE = 0.10
@@ -210,7 +211,7 @@ def make_target(
         value = None
         lo, hi = (obs_lo if low is None else low), (obs_hi if high is None else high)
     else:
-        kind, value = "target", float(goal)
+        kind, value = "target", number_argument(goal, quantity)
         if not np.isfinite(value) or value <= 0:
             raise DesignerError(f"target {quantity} = {value:g} {unit} must be positive", "give a value > 0")
         if value > 1e6 * obs_hi:  # the desirability scale (bounds squared) would overflow
@@ -596,6 +597,9 @@ def suggest(
 
 def _check_request(surrogate: Surrogate, axis: str, no_goal: bool, top: int, tolerance: float) -> None:
     """Raise DesignerError for an axis the surrogate lacks, no goal, top < 1 or a tolerance not in (0, 1)."""
+    check_surrogate(surrogate)
+    check_type(top, numbers.Integral, "top", expected="a whole number", fix="give e.g. top=5")
+    number_argument(tolerance, "tolerance")
     units.check_axis(axis)
     if axis not in surrogate.axes:
         raise DesignerError(

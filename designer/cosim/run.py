@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .. import units
-from ..errors import DesignerError
+from ..errors import DesignerError, check_type, path_argument
 from ..files import atomic_folder, atomic_path, atomic_write
 from .fmu import FmuSystem, read_parameters
 from .kernel import run_master
@@ -292,6 +292,8 @@ def run(
     def part(offset: float, scale: float) -> Progress:
         return None if progress is None else (lambda f: progress(offset + scale * f))
 
+    fix = "read one with designer.cosim.load(path)"
+    check_type(scenario, Scenario, "scenario", expected="a Scenario", fix=fix)
     sc = scenario
     with joint_fmus(sc) as fmus:
         if sc.kind == "rig":
@@ -351,7 +353,8 @@ def write_outputs(
     Raises:
         DesignerError: `folder` is a file or cannot be created or written.
     """
-    out = Path(folder)
+    check_type(result, Result, "result", expected="a Result", fix="give what designer.cosim.run returns")
+    out = path_argument(folder, "folder", what="a folder")
     if out.exists() and not out.is_dir():
         raise DesignerError(f"folder={str(out)!r} is a file", "give a folder for the results")
     switches = result.scenario.outputs

@@ -20,7 +20,7 @@ from xml.sax.saxutils import quoteattr
 from .. import __version__, units
 from ..errors import DesignerError
 from ..files import atomic_path, check_suffix
-from ..joint import AxisCoefficients, Joint
+from ..joint import AxisCoefficients, Joint, check_joint
 from . import build
 from .layout import layout
 
@@ -513,6 +513,7 @@ def export_fmu(
         DesignerError: bad arguments, or a binary that cannot be built.
     """
     path = check_suffix(path, (".fmu",), what="an FMU")
+    check_joint(joint)
     entries = archive_entries(joint, fmi_version, interface, source_only, platforms, rebuild)
     if progress:
         progress(0.5)

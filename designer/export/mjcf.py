@@ -12,7 +12,7 @@ from pathlib import Path
 from .. import units
 from ..errors import DesignerError
 from ..files import atomic_write, check_suffix
-from ..joint import Joint
+from ..joint import Joint, check_joint
 from . import robot
 from .mjcf_into import into_parallel, into_series
 from .stability import StepAdvice, step_advice
@@ -139,6 +139,7 @@ def export_mjcf(
         DesignerError: a wrong suffix, unknown form, missing mass, or an `into` problem.
     """
     path = check_suffix(path, (".xml", ".mjcf"), what="an MJCF")
+    check_joint(joint)
     if form not in FORMS:
         raise DesignerError(f"form={form!r} is not a form", f"use one of: {', '.join(FORMS)}")
     if into is not None:

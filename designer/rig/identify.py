@@ -31,7 +31,7 @@ import numpy as np
 import pandas as pd
 
 from .. import space, units
-from ..errors import DesignerError
+from ..errors import DesignerError, describe
 from ..mass import specimen_mass
 from . import band as bandlib
 from . import channel
@@ -439,7 +439,13 @@ def identify(
         DesignerError: a log cannot be read or validated (names the column and row), axes names an
             axis not in a log, or load_delay_s is not finite.
     """
-    sources = [logs] if isinstance(logs, (str, Path, pd.DataFrame, RigLog)) else list(logs)
+    one = (str, os.PathLike, pd.DataFrame, RigLog)
+    if not isinstance(logs, (*one, Iterable)) or isinstance(logs, np.ndarray):
+        raise DesignerError(
+            f"logs is {describe(logs)}, not a log or a list of logs",
+            "give paths of rig logs (CSV or Parquet), DataFrames in the log schema, or a list of them",
+        )
+    sources = [logs] if isinstance(logs, one) else list(logs)
     out = []
     for i, source in enumerate(sources):
         out.append(identify_log(source, axes=axes, load_delay_s=load_delay_s, load_filter=load_filter))

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from ..cosim.scenario import Scenario
-from ..errors import DesignerError
+from ..errors import DesignerError, check_type
 from ..keys import read_toml
 from .limits import Limit, parse_limit
 
@@ -216,8 +216,9 @@ def check(spec: Spec) -> Spec:
 
     Raises:
         DesignerError: a rig scenario with the engine path or limits, a case naming an unknown
-            joint, or a Monte Carlo sweep without its count.
+            joint, or a Monte Carlo sweep without its count; `spec` not a Spec.
     """
+    check_type(spec, Spec, "spec", expected="a sweep Spec", fix="read one with designer.sweep.load(path)")
     sc = spec.scenario
     if sc.kind == "rig" and (spec.path != "fmu" or spec.limits):
         raise DesignerError(
