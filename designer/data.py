@@ -139,8 +139,14 @@ def normalise(raw: pd.DataFrame, source: str = "table") -> pd.DataFrame:
         bad = values.isna() | ~np.isfinite(values.to_numpy(dtype=float, na_value=np.nan))
         if bad.any():
             row = int(np.flatnonzero(bad.to_numpy())[0])
+            cell = out[col].iloc[row]
+            if isinstance(cell, str) and re.fullmatch(r"\s*[-+]?\d*,\d+\s*", cell):
+                raise DesignerError(
+                    f"{source}: column '{col}' row {row + 1} is '{cell}': a decimal comma",
+                    "save the table with a decimal point (0.8, not 0,8) and commas between columns",
+                )
             raise DesignerError(
-                f"{source}: column '{col}' row {row + 1} is '{out[col].iloc[row]}', not a finite number",
+                f"{source}: column '{col}' row {row + 1} is '{cell}', not a finite number",
                 "fix or remove that row (designer clean drops runs with missing sensor data)",
             )
         out[col] = values.astype(float)

@@ -310,10 +310,17 @@ def check_table_file(path: str | Path, *, parquet: bool) -> None:
     if parquet:
         return
     line = head.splitlines()[0] if head.splitlines() else head
+    if head.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise DesignerError(f"cannot read {p}: it is UTF-16 text", "save it as UTF-8 comma-separated CSV")
     try:
         text = line.decode("utf-8-sig")
     except UnicodeDecodeError:
-        text = "\0"
+        text = "\0" if b"\0" in head else ""
+        if not text:
+            raise DesignerError(
+                f"cannot read {p}: it is not UTF-8 text (Latin-1 or Windows-1252, from an old spreadsheet?)",
+                "save it as UTF-8 comma-separated CSV",
+            ) from None
     if "\0" in text or b"\0" in head:
         raise DesignerError(
             f"cannot read {p}: it is not a text CSV file (it holds binary data)",
