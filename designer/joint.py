@@ -27,6 +27,9 @@ PRB_GAMMA = 0.85
 #: largest m, c or k in rig units a joint may have (1e9 N/mm is 1e12 N/m, stiffer than a 10 mm steel
 #: cube, ~2e9 N/m); above it a number is a unit mistake, and squared in a simulation it overflows
 MAX_COEFFICIENT = 1e9
+#: smallest non-zero m, c or k in rig units (as for coefficient tables): below it, a subnormal such as
+#: 5e-324 is a typing or unit mistake, not a joint (its natural frequency and time step underflow)
+MIN_COEFFICIENT = 1e-12
 
 
 @dataclass(frozen=True)
@@ -52,6 +55,14 @@ class AxisCoefficients:
                 raise DesignerError(
                     f"{q} on axis {self.axis} = {v:g} {units.rig_unit(q, self.axis)} is not a valid value",
                     f"give a finite, {'non-negative' if q == 'c' else 'positive'} number",
+                )
+            object.__setattr__(self, q, v + 0.0)  # -0.0 is 0: never written as "-0" into an FMU
+            if 0 < v < MIN_COEFFICIENT:
+                unit = units.rig_unit(q, self.axis)
+                raise DesignerError(
+                    f"{q} on axis {self.axis} = {v:g} {unit} is below any physical joint",
+                    f"give it in rig units, at least {MIN_COEFFICIENT:g} {unit}"
+                    + (" (or 0 for no damping)" if q == "c" else ""),
                 )
             if v > MAX_COEFFICIENT:
                 unit = units.rig_unit(q, self.axis)

@@ -43,6 +43,6 @@ def read_toml(path: str | Path, *, what: str) -> tuple[Path, dict[str, Any]]:
     if not path.is_file():
         raise DesignerError(f"{what} file {path} does not exist", f"give the path of a .toml {what} file")
     try:
-        return path, tomllib.loads(path.read_text())
+        return path, tomllib.loads(path.read_text(encoding="utf-8-sig"))  # a BOM (Windows editors) is fine
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise DesignerError(f"{path.name} is not valid TOML: {exc}", "fix the syntax") from None

@@ -26,7 +26,7 @@ import casadi as ca
 import numpy as np
 
 from . import space, units
-from .errors import DesignerError, check_type, number_argument
+from .errors import DesignerError, check_type, describe, number_argument
 from .surrogate import Prediction, Surrogate, check_surrogate
 
 #: default tolerance around a target within which a printed joint counts as meeting it
@@ -372,7 +372,7 @@ class Suggestion:
 
         path = Path(path)
         try:
-            data = json.loads(path.read_text())
+            data = json.loads(path.read_text(encoding="utf-8-sig"))  # a BOM (Windows editors) is fine
         except (OSError, ValueError) as exc:
             raise DesignerError(
                 f"cannot read a suggestion from path={str(path)!r}: {exc}",
@@ -408,12 +408,55 @@ def _check_schema(d: Any, where: str) -> None:
         absent = ", ".join(map(repr, missing))
         raise DesignerError(f"{where} is not a suggestion: no {absent} (it has {has})", fix)
     check_keys(d, _SUGGESTION_KEYS, where=where)
+    _check_types(d, _SUGGESTION_TYPES, where, fix)
     if not isinstance(d["candidates"], list) or not d["candidates"]:
         raise DesignerError(f"{where}: 'candidates' is not a non-empty list", fix)
     for i, c in enumerate(d["candidates"], 1):
         if not isinstance(c, Mapping) or "params" not in c or "predicted" not in c:
             raise DesignerError(f"{where}: candidate {i} has no 'params' and 'predicted'", fix)
         check_keys(c, _CANDIDATE_KEYS, where=f"candidate {i} of {where}")
+        _check_types(c, _CANDIDATE_TYPES, f"candidate {i} of {where}", fix)
+        for name, v in c["params"].items():  # float() would take "60" and true (1 %) silently
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                raise DesignerError(
+                    f"candidate {i} of {where}: {name} = {json_text(v)} is {describe(v)}, not a number",
+                    "write the number without quotes, e.g. 60",
+                )
+
+
+#: the JSON types of a suggestion's entries (hand-edited files: "targets": [0.8], "axis": 3)
+_SUGGESTION_TYPES = {
+    "axis": str, "units": dict, "targets": dict, "goals": dict, "tolerance": (int, float), "fixed": dict,
+    "reachable": bool, "statements": list, "predictability": dict, "ranges": dict, "nearest_runs": list,
+    "surrogate_id": str, "candidates": list,
+}  # fmt: skip
+_CANDIDATE_TYPES = {
+    "params": dict, "any": list, "predicted": dict, "p_within": (int, float, type(None)),
+    "probability": dict, "desirability": (int, float, type(None)), "rel_error": dict,
+    "extrapolated": (list, bool), "notes": list,
+}  # fmt: skip
+_JSON_NAMES = {str: "a string", dict: "an object", list: "a list", bool: "true or false", int: "a number"}
+
+
+def _check_types(d: Mapping[str, Any], types: Mapping[str, Any], where: str, fix: str) -> None:
+    """Raise for the first entry of `d` whose JSON type is not the one `types` gives."""
+    for key, want in types.items():
+        if key not in d:
+            continue
+        v = d[key]
+        wants = want if isinstance(want, tuple) else (want,)
+        numeric = float in wants or int in wants
+        if not isinstance(v, wants) or (isinstance(v, bool) and bool not in wants and numeric):
+            expected = " or ".join(dict.fromkeys(_JSON_NAMES.get(t, "null") for t in wants))
+            raise DesignerError(f"{where}: '{key}' is {json_text(v)}, not {expected}", fix)
+
+
+def json_text(v: Any) -> str:
+    """A JSON value as written in the file, shortened: 3, "x", [0.8], {...}."""
+    import json
+
+    text = json.dumps(v, default=str)
+    return text if len(text) <= 40 else text[:37] + "..."
 
 
 class _Problem:
