@@ -248,6 +248,20 @@ def _locked(folder: Path) -> Iterator[None]:
 
 
 @contextlib.contextmanager
+def private_tempdir(prefix: str) -> Iterator[Path]:
+    """A temporary folder, removed whole at the end, that is also where third-party code makes its
+    temporary files meanwhile (tempfile.tempdir): fmpy's extract and simulate_fmu remove their folders
+    only when they succeed, so an error or an interrupt inside them left unpacked FMUs in /tmp."""
+    with tempfile.TemporaryDirectory(prefix=prefix) as tmp:
+        old = tempfile.tempdir
+        tempfile.tempdir = tmp
+        try:
+            yield Path(tmp)
+        finally:
+            tempfile.tempdir = old
+
+
+@contextlib.contextmanager
 def cache_entry(target: str | Path) -> Iterator[Path]:
     """A path to build the cached file `target` at, in a staging folder that becomes `target`'s folder
     (named for the cache key) in one rename when the block succeeds: the entry exists whole or not at

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import contextlib
 import json
-import tempfile
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -18,7 +17,7 @@ import numpy as np
 
 from .. import units
 from ..errors import DesignerError, check_type, path_argument
-from ..files import atomic_folder, atomic_path, atomic_write
+from ..files import atomic_folder, atomic_path, atomic_write, private_tempdir
 from .fmu import FmuSystem, read_parameters
 from .kernel import run_master
 from .master import Master, Trace
@@ -91,7 +90,7 @@ class Result:
 def joint_fmus(sc: Scenario) -> Iterator[dict[str, Path]]:
     """The FMU file of every joint (key "rig" for the rig), exporting the others into a temporary folder."""
     sources = {"rig": sc.rig_joint} if sc.kind == "rig" else sc.joints
-    with tempfile.TemporaryDirectory(prefix="designer-cosim-") as tmp:
+    with private_tempdir("designer-cosim-") as tmp:  # the FMUs' unpacked folders go in there too
         paths = {}
         for name, src in sources.items():
             if src.fmu is not None:
