@@ -161,6 +161,10 @@ def space_cmd(
     console.print(
         f"{resp} from {view.value_range[0]:.4g} to {view.value_range[1]:.4g} {view.unit} (held: {held})"
     )
+    if not sur.model(resp).predictable:
+        from designer.suggestions import predictability
+
+        console.print(predictability(sur, axis)[response]["statement"])
     if target is not None:
         console.print(
             f"target {target:g} {view.unit} lies inside the 95 % PI over {view.target_in_pi:.0%} of the plot"
@@ -191,15 +195,27 @@ def loo_cmd(
             f"the surrogate has no response on axis {axis}", f"it has {', '.join(sur.responses)}"
         )
     path = common.save_figure(loo.plot_loo(sur, responses=responses), output)
-    metrics = {r: dict(sur.model(r).loo, form=sur.model(r).form) for r in responses}
+    # the figures the plot shows: nested leave-one-out (the form chosen again without each run) where
+    # the surrogate has it; the selected form's own leave-one-out, optimistic, only as a second figure
+    metrics = {
+        r: {
+            "form": sur.model(r).form,
+            "nested": bool(sur.model(r).loo_nested),
+            **sur.model(r).accuracy,
+            "selected_form": dict(sur.model(r).loo),
+        }
+        for r in responses
+    }
     if as_json:
         print_json({"figure": str(path), "loo": metrics})
         return
     for r, m in metrics.items():
         unit = sur.model(r).unit
+        kind = "nested leave-one-out" if m["nested"] else "leave-one-out of the selected form (optimistic)"
+        tail = f" (selected form alone: Q2 {m['selected_form']['q2']:.2f}, optimistic)" if m["nested"] else ""
         console.print(
-            f"{r}: {m['form']}, Q2 {m['q2']:.2f}, RMSE {m['rmse']:.3g} {unit}, "
-            f"95 % PI coverage {m['coverage95']:.0%}"
+            f"{r}: {m['form']}, {kind} Q2 {m['q2']:.2f}, RMSE {m['rmse']:.3g} {unit}, "
+            f"95 % PI coverage {m['coverage95']:.0%}{tail}"
         )
     _saved(path)
 
@@ -328,8 +344,10 @@ def profile_cmd(
 ) -> None:
     """An interactive prediction profiler: one self-contained HTML page (no server, no network).
 
-    Sliders per factor, per response the prediction and its 95 % PI against each factor, targets with
-    the probability of meeting them, suggestions to click.
+    Sliders per factor, per response the prediction and its 95 % PI against each factor; goals
+    (target, min, max) with the probability of meeting them; locks and "maximize" (the search of
+    designer suggest, in the page); a print-noise simulator; remembered settings copied as export
+    commands; suggestions to click.
 
     Example: designer profile --target k=0.8 -o profiler.html
     """

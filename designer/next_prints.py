@@ -190,6 +190,54 @@ def _predictable_targets(sug: Any) -> dict[str, float]:
     }
 
 
+def _check_arguments(n: int, stop: float) -> None:
+    if not 1 <= number_argument(n, "n") <= 10 or int(n) != n:
+        raise DesignerError(f"n={n} is not a whole number from 1 to 10", "give a whole number such as 3")
+    if not 0 < number_argument(stop, "stop") <= 1:
+        raise DesignerError(f"stop={stop} is not in (0, 1]", "give a probability such as 0.9")
+
+
+def _pool(candidates: list[Any]) -> dict[str, np.ndarray]:
+    """The search's near-target designs as factor columns: where the best design after a print is sought."""
+    return {name: np.array([c.params[name] for c in candidates]) for name in space.FACTOR_NAMES}
+
+
+def _greedy_batch(
+    surrogate: Surrogate,
+    scorer: _Scorer,
+    candidates: list[Any],
+    best: Any,
+    n: int,
+    progress: Callable[[float], None] | None,
+) -> list[NextPrint]:
+    """Up to `n` distinct prints, each the candidate of highest value given the ones before it
+    (those taken as measured at their predicted values)."""
+    pool = _pool(candidates)
+    spans = {f.name: f.high - f.low for f in space.CONTINUOUS}
+    chosen: list[NextPrint] = []
+    known: list[dict[str, float]] = []
+    for step in range(n):
+        if progress is not None:
+            progress(step / (n + 1))
+        free = [c for c in candidates if all(_distance(c.params, p.params, spans) > DISTINCT for p in chosen)]
+        if not free:
+            break
+        scores = [_expected_best(surrogate, scorer, c.params, known, pool) for c in free]
+        i = int(np.argmax(scores))
+        pick = free[i]
+        recommended = pick is best
+        reason = (
+            "the current recommendation: measuring it tests the answer where it matters"
+            if recommended
+            else "tests the model where another near-target design may do better than the current one"
+        )
+        chosen.append(NextPrint(pick.params, pick.predicted, float(scores[i]), recommended, reason))
+        base = _with_runs(surrogate, known)
+        predicted = {r: float(np.exp(_log_predictive(base, r, pick.params)[0])) for r in scorer.measured}
+        known.append(_run(pick.params, predicted))
+    return chosen
+
+
 def next_prints(
     surrogate: Surrogate,
     *,
@@ -225,10 +273,7 @@ def next_prints(
             error: the result has `reachable` False, the reason in `statements`, and no print.
     """
     check_surrogate(surrogate)
-    if not 1 <= number_argument(n, "n") <= 10 or int(n) != n:
-        raise DesignerError(f"n={n} is not a whole number from 1 to 10", "give a whole number such as 3")
-    if not 0 < number_argument(stop, "stop") <= 1:
-        raise DesignerError(f"stop={stop} is not in (0, 1]", "give a probability such as 0.9")
+    _check_arguments(n, stop)
     statements = []
     if surrogate.calibration is None:
         surrogate = new_printer(surrogate)
@@ -258,38 +303,10 @@ def next_prints(
             f"(>= {stop:g}); no other print is expected to do better first"
         )
         return NextPrints(axis, goals, tolerance, best, p_now, True, [], p_now, statements + [text])
-    pool_designs = [c.params for c in sug.candidates]
-    pool = {name: np.array([d[name] for d in pool_designs]) for name in space.FACTOR_NAMES}
-    spans = {f.name: f.high - f.low for f in space.CONTINUOUS}
-    chosen: list[NextPrint] = []
-    known: list[dict[str, float]] = []
-    for step in range(int(n)):
-        if progress is not None:
-            progress(step / (n + 1))
-        free = [
-            c for c in sug.candidates if all(_distance(c.params, p.params, spans) > DISTINCT for p in chosen)
-        ]
-        if not free:
-            break
-        scores = [_expected_best(surrogate, scorer, c.params, known, pool) for c in free]
-        i = int(np.argmax(scores))
-        pick = free[i]
-        recommended = pick is best
-        reason = (
-            "the current recommendation: measuring it tests the answer where it matters"
-            if recommended
-            else "tests the model where another near-target design may do better than the current one"
-        )
-        chosen.append(NextPrint(pick.params, pick.predicted, float(scores[i]), recommended, reason))
-        base = _with_runs(surrogate, known)
-        known.append(
-            _run(
-                pick.params,
-                {r: float(np.exp(_log_predictive(base, r, pick.params)[0])) for r in scorer.measured},
-            )
-        )
+    chosen = _greedy_batch(surrogate, scorer, sug.candidates, best, int(n), progress)
     if progress is not None:
         progress(n / (n + 1))
+    pool = _pool(sug.candidates)
     p_after = _batch_p(surrogate, scorer, [p.params for p in chosen], pool)
     if progress is not None:
         progress(1.0)

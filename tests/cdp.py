@@ -180,6 +180,25 @@ class Page:
         for kind in ("rawKeyDown", "keyUp"):
             self.call("Input.dispatchKeyEvent", type=kind, key=key, code=key, windowsVirtualKeyCode=code)
 
+    def type_text(self, text: str) -> None:
+        """Type text into the focused element as a keyboard would (one input event)."""
+        self.call("Input.insertText", text=text)
+
+    def viewport(self, width: int, height: int, *, mobile: bool = False) -> None:
+        """Emulate a screen of width x height CSS pixels (a phone's when `mobile`)."""
+        self.call(
+            "Emulation.setDeviceMetricsOverride",
+            width=width,
+            height=height,
+            deviceScaleFactor=1,
+            mobile=mobile,
+        )
+
+    def ax_tree(self) -> list[dict[str, Any]]:
+        """The browser's accessibility tree, flat: what a screen reader is given (role, name, ...)."""
+        self.call("Accessibility.enable")
+        return self.call("Accessibility.getFullAXTree")["nodes"]
+
     def screenshot(self, path: Path) -> Path:
         data = self.call("Page.captureScreenshot", format="png", captureBeyondViewport=True)["data"]
         path.write_bytes(base64.b64decode(data))

@@ -117,6 +117,21 @@ def test_library_messages_name_python_arguments_and_the_library_never_prints():
     assert not found, found
 
 
+def test_no_function_of_the_library_or_the_cli_is_over_80_lines():
+    """The style rule (small functions that say what they do), kept by a scan of the installed code."""
+    import designer_cli
+
+    long = []
+    for root in (LIBRARY, Path(designer_cli.__file__).parent):
+        for path in sorted(root.rglob("*.py")):
+            for node in ast.walk(ast.parse(path.read_text())):
+                if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                    lines = node.end_lineno - node.lineno + 1
+                    if lines > 80:
+                        long.append(f"{path.name}:{node.lineno} {node.name} ({lines} lines)")
+    assert not long, long
+
+
 def test_the_api_tour_runs_with_public_names_only(tmp_path):
     import subprocess
     import sys

@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 from imagecheck import assert_picture
 
@@ -148,6 +150,100 @@ def test_timeseries_png_with_reference(tmp_path):
         plot_timeseries(frame, time="time")
 
 
+def _cosim_frame() -> pd.DataFrame:
+    """Columns as `designer cosim` writes them for a two-joint arm (hinges, torques in N.m)."""
+    t = np.linspace(0, 2, 300)
+    cols = {"t": t}
+    for i, j in enumerate(("j1", "j2"), start=1):
+        cols |= {
+            f"robot.{j}.q": np.sin(i * t),
+            f"robot.{j}.motor": 0.9 * np.sin(i * t),
+            f"robot.{j}.s": 0.1 * np.sin(i * t),
+            f"robot.{j}.v": 0.1 * i * np.cos(i * t),
+            f"{j}.theta.f": -0.03 * np.sin(i * t),
+        }
+    return pd.DataFrame(cols)
+
+
+def test_plot_loo_prints_the_figures_it_draws(tmp_path):
+    """The terminal and the figure give the nested leave-one-out Q2 (0.32 for k_x, not the selected
+    form's optimistic 0.43), and the legend sits below the data."""
+    from designer.plots import loo
+    from designer.surrogate import Surrogate
+
+    sur = Surrogate.load()
+    nested = sur.model("k_x").accuracy["q2"]
+    run = designer("plot", "loo", "-o", "loo.png", cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    line = next(ln for ln in run.stdout.splitlines() if ln.startswith("k_x"))
+    assert f"nested leave-one-out Q2 {nested:.2f}" in line
+    fig = loo.plot_loo(sur, responses=["k_x"])
+    assert f"nested Q2 {nested:.2f}" in fig.axes[0].get_title()
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    assert (
+        fig.axes[0].get_legend().get_window_extent(renderer).y1 <= fig.axes[0].get_window_extent(renderer).y0
+    )
+    assert_inside(fig)
+
+
+def test_signal_units_follow_the_axis():
+    from designer.plots.timeseries import signal_unit
+
+    assert signal_unit("j1.theta.f") == "N.m" and signal_unit("joint.x.f") == "N"
+    assert signal_unit("robot.j1.q") == "rad" and signal_unit("robot.j2.v") == "rad/s"
+    assert signal_unit("joint.x.s") == "m" and signal_unit("joint.x.a") == "m/s²"
+    assert signal_unit("hub.f", ["t", "joint.x.s", "hub.f"]) == "N"
+    assert signal_unit("hub.q", ["t", "joint.theta.s", "hub.q"]) == "rad"
+    assert signal_unit("analytic") == "SI"
+
+
+def test_timeseries_titles_units_legend_outside_colour_per_joint(tmp_path):
+    from designer.plots.timeseries import plot_timeseries
+
+    fig = plot_timeseries(_cosim_frame())
+    assert_inside(fig)
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    labels = {ax.get_ylabel(): ax.get_title(loc="left") for ax in fig.axes}
+    assert labels == {
+        "q (rad)": "angle q",
+        "motor (rad)": "motor angle",
+        "s (rad)": "deflection s",
+        "v (rad/s)": "deflection rate v",
+        "f (N.m)": "torque f",
+    }
+    for ax in fig.axes:  # the legend stands right of the data, not on it
+        assert ax.get_legend().get_window_extent(renderer).x0 >= ax.get_window_extent(renderer).x1
+    # the cosim plot's panels (angles of several kinds together): a colour per joint, a style per signal
+    frame = _cosim_frame()
+    angles = [c for c in frame.columns if c.endswith((".q", ".motor", ".s"))]
+    fig = plot_timeseries(frame, panels={"angle (rad)": angles})
+    lines = {ln.get_label(): ln for ln in fig.axes[0].get_lines()}
+    colour = {c: lines[c].get_color() for c in angles}
+    style = {c: lines[c].get_linestyle() for c in angles}
+    assert colour["robot.j1.q"] == colour["robot.j1.motor"] == colour["robot.j1.s"] != colour["robot.j2.q"]
+    assert style["robot.j1.q"] == style["robot.j2.q"] != style["robot.j1.motor"] != style["robot.j1.s"]
+    assert style["robot.j1.q"] != style["robot.j1.s"]
+    assert fig.axes[0].get_title(loc="left") == "angle q, motor angle, deflection s"
+    assert_picture(common.save_figure(fig, tmp_path / "angles.png"), min_size=(800, 200))
+
+
+def test_coinciding_curves_all_show():
+    """Five solutions equal to 1e-9 (the report's FMU step figure): each its own colour and style,
+    the first widest, so every curve is visible on top of the others."""
+    from designer.plots.timeseries import plot_timeseries
+
+    t = np.linspace(0, 1, 50)
+    names = ["analytic", "FMI 2 CS", "FMI 2 ME", "FMI 3 CS", "FMI 3 ME"]
+    frame = pd.DataFrame({"t": t} | {n: np.sin(t) for n in names})
+    fig = plot_timeseries(frame, panels={"x.s (m)": names})
+    lines = fig.axes[0].get_lines()
+    assert len({(ln.get_color(), str(ln.get_linestyle())) for ln in lines}) == 5
+    widths = [ln.get_linewidth() for ln in lines]
+    assert widths == sorted(widths, reverse=True) and widths[0] > widths[-1]
+
+
 def test_importing_and_plotting_leave_the_process_alone(tmp_path):
     """No backend switch, no pyplot, no environment edits: on import, on plotting, on rendering 3D.
 
@@ -177,3 +273,26 @@ def test_importing_and_plotting_leave_the_process_alone(tmp_path):
         [sys.executable, "-I", "-c", code, str(tmp_path / "e.png")], capture_output=True, text=True, env=env
     )
     assert run.returncode == 0 and "clean" in run.stdout, run.stderr
+
+
+def test_readme_shows_one_picture_of_each_figure_command():
+    """Every `designer plot` command of README's table has its picture beside it, and each exists."""
+    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+    pictures = re.findall(r"!\[[^\]]*\]\((docs/figures/[^)]+\.png)\)", readme)
+    root = Path(__file__).resolve().parent.parent
+    for rel in pictures:
+        assert_picture(root / rel)
+    commands = set(re.findall(r"`designer plot (\w+)", readme))
+    assert commands == {"effects", "heatmap", "loo", "space", "timeseries"}
+    for name in (
+        "effects",
+        "heatmap",
+        "loo",
+        "space",
+        "volume",
+        "space_c",
+        "timeseries",
+        "cosim_plot",
+        "profiler",
+    ):
+        assert f"docs/figures/{name}.png" in pictures, name

@@ -99,7 +99,16 @@ def test_bad_requests_name_the_argument(sur, tmp_path):
         profile.write_profiler(profile.build_profiler(sur), tmp_path / "p.png")
     far = dict(profile.DEFAULT_DESIGN, width=9.0)
     strip = profile.build_profiler(sur, suggestion={"candidates": [{"params": far}]}).data["suggestions"]
-    assert strip == [{"rank": 1, "params": far, "inside": False, "any": []}]
+    assert strip == [
+        {
+            "rank": 1,
+            "params": far,
+            "inside": False,
+            "outside": ["width 9 mm outside 2 to 7 mm"],  # the page shows this reason in visible text
+            "any": [],
+            "p_within": None,
+        }
+    ]
     any_density = {"candidates": [{"params": profile.DEFAULT_DESIGN, "any": ["density"]}]}
     assert profile.build_profiler(sur, suggestion=any_density).data["suggestions"][0]["any"] == ["density"]
 

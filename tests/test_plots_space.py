@@ -30,15 +30,15 @@ def assert_margins_clear(rgb: np.ndarray, px: int = 4) -> None:
         assert (strip > 0.9).all(), f"something is drawn at the {name} edge"
 
 
-def axis_labels(plotter, axis: int) -> list[str]:
-    labels = plotter.renderer.cube_axes_actor.GetAxisLabels(axis)
-    return [labels.GetValue(i) for i in range(labels.GetNumberOfValues())]
+def axis_labels(view, axis: int) -> list[str]:
+    """The tick labels `render` draws on an axis of the cube (0 x, 1 y, 2 z)."""
+    return [text for _, text in space.axis_ticks(view.scene)[axis]]
 
 
 def test_surface_png_and_html(sur, tmp_path):
     view = space.surface_view(sur, "k_x", x="width", y="height", target=0.8)
     plotter = space.render(view)
-    assert all(axis_labels(plotter, 2))
+    assert all(axis_labels(view, 2))
     space.save_screenshot(plotter, tmp_path / "s.png")
     plotter.close()
     assert_margins_clear(assert_picture(tmp_path / "s.png", size=space.WINDOW))
@@ -66,7 +66,7 @@ def test_small_values_get_readable_ticks(sur, tmp_path):
     """c in N.s/mm: distinct z ticks with their digits (0.00172), never a column of "0.0"."""
     view = space.surface_view(sur, "c_x", resolution=9)
     plotter = space.render(view, window=(600, 450))
-    z = axis_labels(plotter, 2)
+    z = axis_labels(view, 2)
     cube = plotter.renderer.cube_axes_actor
     sizes = [cube.GetLabelTextProperty(i).GetFontSize() for i in range(3)]
     sizes += [cube.GetTitleTextProperty(i).GetFontSize() for i in range(3)]
@@ -94,10 +94,49 @@ def test_surface_follows_the_surrogate(sur):
             "raster": 45.0,
         }
     )
-    value = sur.model("k_x").predict(corners).value
+    value = sur.predict(corners, responses=["k_x"])["k_x"].value  # as printed: solid at 2 mm
     assert view.value_range[0] == pytest.approx(min(value), rel=1e-6)
     assert view.value_range[1] == pytest.approx(max(value), rel=1e-6)
     assert json.loads(json.dumps(view.to_dict()))["response"] == "k_x"
+
+
+def test_ticks_are_round_and_clear_of_the_corners(sur):
+    """Round tick values (1, 2, 2.5 or 5 times a power of ten apart), none where two axes' labels
+    meet at a corner of the cube; the colour scale's ends round too."""
+    for response in ("k_x", "c_x"):
+        view = space.surface_view(sur, response, x="width", y="height", resolution=9)
+        for i, ticks in enumerate(space.axis_ticks(view.scene)):
+            lo, hi = view.scene.axis_ranges[i]
+            values = [v for v, _ in ticks]
+            assert len(values) >= 2, (response, i)
+            step = values[1] - values[0]
+            mantissa = step / 10 ** np.floor(np.log10(step))
+            assert any(np.isclose(mantissa, m) for m in (1, 2, 2.5, 5)), (response, i, values)
+            assert all(np.isclose(v / step, round(v / step)) for v in values)
+            assert all(space.CORNER <= (v - lo) / (hi - lo) for v in values)
+            if i < 2:
+                assert all((v - lo) / (hi - lo) <= 1 - space.CORNER for v in values)
+            assert all(float(text) == pytest.approx(v) for v, text in ticks)
+    assert space.colour_limits(0.4429, 1.055) == pytest.approx((0.4, 1.2, 5))
+
+
+def test_target_plane_when_no_design_reaches_the_target(sur, tmp_path):
+    """c_x is flat (not predictable): a target gets a plane at its level, and the CLI says why."""
+    view = space.surface_view(sur, "c_x", target=2e-3, resolution=9)
+    plane = [layer for layer in view.scene.layers if layer.name.startswith("target 0.002 N.s/mm (plane")]
+    assert len(plane) == 1
+    lo, hi = view.scene.axis_ranges[2]
+    assert plane[0].mesh.points[:, 2] == pytest.approx((2e-3 - lo) / (hi - lo))
+    # a target the surface crosses gets its contour line, no plane
+    view = space.surface_view(sur, "k_x", target=0.8, resolution=9)
+    names = [layer.name for layer in view.scene.layers]
+    assert "target 0.8 N/mm" in names and not any("plane" in n for n in names)
+    from clitools import run_process
+
+    run = run_process(["plot", "space", "--response", "c", "--target", "2e-3", "-o", "c.png"], tmp_path)
+    assert run.returncode == 0, run.stderr
+    assert "c_x is not predictable from the six factors" in run.stdout
+    assert_picture(tmp_path / "c.png", size=space.WINDOW)
 
 
 def test_volume_png(sur, tmp_path):

@@ -80,7 +80,7 @@ def _design(page) -> dict[str, float]:
     """The six factors as the page's controls show them: slider values and the pressed level buttons."""
     return page.js(
         "(() => { const d = {}; for (const f of D.factors) {"
-        "  const on = document.querySelector('button.on[data-factor=\"' + f.name + '\"]');"
+        "  const on = document.querySelector('button[aria-pressed=true][data-factor=\"' + f.name + '\"]');"
         "  const slider = document.getElementById('s-' + f.name);"
         "  d[f.name] = f.categorical ? +on.dataset.level : parseFloat(slider.value);"
         " } return d; })()"
@@ -112,7 +112,8 @@ def _check(page, sur) -> dict[str, float]:
             want[2], rel=6e-3
         )
     # targets: probability within 10 % from scipy's Student t (in the form's fit space, log for k),
-    # desirability as suggest's Target says; the composite over the predictable responses (k only)
+    # desirability as suggest's Target says, for the predictable response only (k); c, which no
+    # form predicts, gets its probability in a sentence and no desirability score
     for q, goal in (("k", 0.8), ("c", 2e-3)):
         m, p = sur.model(f"{q}_x"), lib[f"{q}_x"]
         tr = np.log if m.transform == "log" else (lambda v: v)
@@ -120,6 +121,10 @@ def _check(page, sur) -> dict[str, float]:
         scale = (tr(p.high[0]) - mean) / m.t95
         cdf = [stats.t.cdf((tr(goal * f) - mean) / scale, m.dof) for f in (1.1, 0.9)]
         assert float(shown[f"{q}_x"]["p"]) == pytest.approx(cdf[0] - cdf[1], abs=1e-9), q
+        if q == "c":
+            assert shown["c_x"].get("d") is None
+            assert "any design lands within" in page.js("document.getElementById('tgt-c_x').textContent")
+            continue
         d = make_target(sur, q, "x", goal).desirability(float(p.value[0]))
         assert float(shown[f"{q}_x"]["d"]) == pytest.approx(d, abs=1e-12), q
         if q == "k":

@@ -50,3 +50,28 @@ def test_page_of_a_calibrated_surrogate_matches_the_library(calibrated):
         for level in (0.12, 0.2):
             page.click(f'button[data-factor="layer"][data-level="{level:g}"]')
             _check(page, sur)
+
+
+def test_maximize_on_a_calibrated_page_agrees_with_suggest(calibrated):
+    """The page's maximize searches the calibrated model as `designer suggest --surrogate` does."""
+    import json
+
+    from test_profile_browser import _design
+
+    exe = cdp.find_browser()
+    if exe is None:
+        pytest.skip("no headless Chromium on this machine")
+    with cdp.Browser(exe) as browser:
+        page = browser.new_page()
+        page.goto((calibrated / "p.html").resolve().as_uri())
+        page.click("#lock-height")
+        held = _design(page)["height"]
+        page.click("#maximize")
+        status = page.js("Object.assign({}, document.getElementById('max-status').dataset)")
+    cli = Path(sys.executable).with_name("designer")
+    args = ["suggest", "--surrogate", "mine.json", "--k", "0.8", "--fix", f"height={held!r}", "--json"]
+    run = subprocess.run([str(cli), *args], capture_output=True, text=True, cwd=calibrated)
+    assert run.returncode in (0, 1), run.stderr
+    want = json.loads(run.stdout)["candidates"][0]
+    assert json.loads(status["design"]) == pytest.approx(want["params"], abs=1e-9)
+    assert float(status["p"]) == pytest.approx(want["p_within"], rel=1e-9)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import base64
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -9,10 +11,12 @@ from pathlib import Path
 import pytest
 from imagecheck import assert_picture, chromium, dump_dom
 
+import designer
 from designer import checks, report
-from designer.data import load_table
+from designer.data import load_table, table_hash
 from designer.data_checks import check_dataset
 from designer.stats_checks import check_main_effects
+from designer.surrogate import Surrogate
 
 
 def test_validate_writes_a_passing_report(tmp_path):
@@ -30,6 +34,29 @@ def test_validate_writes_a_passing_report(tmp_path):
         assert (out / "figures" / f"{name}.png").is_file()
     for title in ("Table 4", "validate_fmu", "libcosimpy", "Identification closed loop", "convergence"):
         assert title in md
+    # who, when, on what: the header a colleague needs to trust the report
+    about = dict(line[2:].split(": ", 1) for line in md.splitlines() if line.startswith("- "))
+    assert set(about) == {"date", "tool", "code", "platform", "surrogate", "data"}
+    assert re.fullmatch(r"\d{4}-\d\d-\d\d \d\d:\d\d UTC", about["date"])
+    assert about["tool"] == f"flexjoint designer {designer.__version__}"
+    assert re.fullmatch(
+        r"(commit [0-9a-f]{12}( with uncommitted changes)?|package sha256 [0-9a-f]{12})", about["code"]
+    )
+    assert about["surrogate"] == Surrogate.load().id
+    assert about["data"] == f"bundled study table, 44 runs, sha256 {table_hash(load_table())[:12]}"
+    # human column names with units, no raw names or 'nan' cells
+    page = (out / "report.html").read_text()
+    for raw in ("F_paper", "max_error_same_step", "| nan |", ">nan<"):
+        assert raw not in md + page, raw
+    assert "macro step (s)" in md and "F, paper" in page
+    # one file travels: every figure inside the page as a data URI, with a caption; a phone viewport
+    assert "name='viewport'" in page
+    sources = re.findall(r"<img src='([^']*)'", page)
+    pngs = sorted((out / "figures").glob("*.png"))
+    assert len(sources) == len(pngs) and all(s.startswith("data:image/png;base64,") for s in sources)
+    embedded = {base64.b64decode(s.split(",", 1)[1]) for s in sources}
+    assert embedded == {p.read_bytes() for p in pngs}
+    assert page.count("<figcaption>") == len(pngs) and "fmu_step_response.png)</figcaption>" in page
     exe = chromium()
     if exe is None:
         pytest.skip("no headless Chromium on this machine")

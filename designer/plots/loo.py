@@ -69,5 +69,5 @@ def plot_loo(surrogate, *, responses: list[str] | None = None, fig: Figure | Non
         ax.yaxis.set_major_formatter(value_formatter())
         ax.tick_params(labelsize=9)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=8, loc="upper left")
+        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncols=3, frameon=False)
     return fig

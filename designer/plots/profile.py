@@ -4,7 +4,11 @@ As JMP's Profiler and Minitab's Response Optimizer do it: a slider per continuou
 buttons for the categorical ones; per response a row of panels with the prediction and its 95 %
 prediction interval against each factor, the others held at the sliders; targets, desirability and
 the probability of landing within a tolerance of the target; a strip of `designer suggest`
-candidates that set the sliders when clicked.
+candidates that set the sliders when clicked. As a design console: goals set on the page, a lock
+per factor and "maximize", which runs `designer suggest`'s search (its cost, starts, rounding and
+ranking; `_search_data` exports what it needs) over the unlocked factors; a simulator propagating
+print-process noise (`PRINT_NOISE`, `MC_DRAWS`) to a defect rate; remembered settings copied as a
+`designer export` command line or as JSON for `--from`.
 
 The page evaluates the surrogate itself, from the exported coefficients: each response's feature
 columns are exported as expression trees recorded by running the surrogate's own feature code
@@ -46,6 +50,11 @@ TOLERANCE = 0.10
 PRINTABLE_MIN_MM = 2 * space.WALL_MM + space.NOZZLE_MM
 #: points per continuous factor where the y range of each response's panels is sampled
 _RANGE_POINTS = 5
+#: the simulator's default print-process noise, one standard deviation per continuous factor
+#: (rig units: an FDM printer holds a dimension to about +-0.1 mm; the slicer sets the infill exactly)
+PRINT_NOISE: dict[str, float] = {"density": 0.0, "length": 0.1, "width": 0.1, "height": 0.1}
+#: the simulator's Monte Carlo size (draws of the print noise)
+MC_DRAWS = 4000
 
 
 class _Expr:
@@ -137,15 +146,15 @@ def _value_range(model: ResponseSurface, observed: np.ndarray, target: float | N
     return [max(lo - pad, 0.0) if lo >= 0 else lo - pad, hi + pad]
 
 
-def _target(surrogate: Surrogate, quantity: str, axis: str, value: float) -> dict[str, float]:
-    """A target with its desirability bounds, as `designer suggest` sets them."""
+def _target(surrogate: Surrogate, quantity: str, axis: str, goal: float | str) -> dict[str, Any]:
+    """A goal (a target value, "min" or "max") with its desirability bounds, as `designer suggest`
+    sets them."""
     from ..suggestions import make_target
 
-    t = make_target(surrogate, quantity, axis, value)
-    return {"value": t.value, "low": t.low, "high": t.high, "importance": t.importance}
+    return make_target(surrogate, quantity, axis, goal).to_dict()
 
 
-def _response(surrogate: Surrogate, name: str, statement: str, target: float | None) -> dict[str, Any]:
+def _response(surrogate: Surrogate, name: str, statement: str, target: float | str | None) -> dict[str, Any]:
     model = surrogate.model(name)
     observed = np.asarray(surrogate.training[name], float)
     return {
@@ -165,7 +174,8 @@ def _response(surrogate: Surrogate, name: str, statement: str, target: float | N
         "predictable": bool(model.predictable),
         "statement": statement,
         "accuracy": _accuracy(model),
-        "range": _value_range(model, observed, target),
+        "range": _value_range(model, observed, target if isinstance(target, float | int) else None),
+        "observed": [float(v) for v in model.observed_range],
         "target": None if target is None else _target(surrogate, model.quantity, model.axis, target),
     }
 
@@ -202,15 +212,45 @@ def _suggestions(suggestion: Any) -> list[dict[str, Any]]:
                 f"suggestion candidate {i} does not give all six factors",
                 "pass a Suggestion, its to_dict() or such a JSON file",
             ) from None
-        try:
-            space.check_design(params)
-            inside = True
-        except DesignerError:
-            inside = False  # extrapolated: listed, but the sliders cannot reach it
+        # outside the tested ranges: listed with the reason, but the sliders cannot reach it
+        outside = [
+            f"{f.name} {params[f.name]:g} {f.unit} outside {f.describe_range()}"
+            for f in space.FACTORS
+            if not _within(f, params[f.name])
+        ]
         # factors without effect on this design (suggest's "any", e.g. density at 2 mm width)
         free = [n for n in c.get("any", []) if n in space.FACTOR_NAMES]
-        out.append({"rank": i, "params": params, "inside": inside, "any": free})
+        p = c.get("p_within")
+        out.append(
+            {
+                "rank": i,
+                "params": params,
+                "inside": not outside,
+                "outside": outside,
+                "any": free,
+                "p_within": None if p is None else float(p),
+            }
+        )
     return out
+
+
+def _within(f: space.Factor, v: float) -> bool:
+    """Whether a value lies in a factor's tested range (one of its levels when categorical)."""
+    if f.categorical:
+        return any(abs(v - lv) <= 1e-9 for lv in f.levels)
+    return f.low - 1e-9 <= v <= f.high + 1e-9
+
+
+def _search_data() -> dict[str, Any]:
+    """What the page's "maximize" needs to run `designer suggest`'s search: its starts and weights."""
+    from ..suggestions import DISTINCT, N_STARTS, PI_WEIGHT, _starts
+
+    return {
+        "starts": _starts(N_STARTS, len(space.CONTINUOUS)).tolist(),
+        "n_starts": N_STARTS,
+        "pi_weight": PI_WEIGHT,
+        "distinct": DISTINCT,
+    }
 
 
 @dataclass
@@ -241,7 +281,7 @@ def build_profiler(
     Args:
         surrogate: the fitted surrogate whose coefficients the page evaluates.
         axis: the axis of the responses (x y z theta phi psi).
-        targets: target values by quantity in rig units, e.g. {"k": 0.8} (N/mm).
+        targets: goals by quantity: a target in rig units, e.g. {"k": 0.8} (N/mm), or "min" or "max".
         tolerance: relative tolerance of "meeting the target" (0.1: within 10 %).
         suggestion: a `Suggestion`, its `to_dict()` or the path of a JSON file of it (what the
             suggest command writes with its JSON option).
@@ -295,6 +335,9 @@ def build_profiler(
             "suggestions": _suggestions(suggestion),
             "wall_mm": space.WALL_MM,
             "nozzle_mm": space.NOZZLE_MM,
+            "search": _search_data(),
+            "noise": PRINT_NOISE,
+            "mc_draws": MC_DRAWS,
         }
     )
 

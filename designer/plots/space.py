@@ -119,25 +119,86 @@ def _headless() -> Iterator[None]:
         os.environ.pop("VTK_DEFAULT_OPENGL_WINDOW", None)
 
 
+def round_ticks(lo: float, hi: float, n: int = 5) -> list[float]:
+    """Round tick values within [lo, hi] (1, 2, 2.5 or 5 times a power of ten apart)."""
+    from matplotlib.ticker import MaxNLocator
+
+    tol = 1e-9 * (hi - lo)
+    ticks = MaxNLocator(nbins=n, steps=[1, 2, 2.5, 5, 10]).tick_values(lo, hi)
+    return [float(v) for v in ticks if lo - tol <= v <= hi + tol]
+
+
+#: tick labels closer than this share of an axis to its ends are left out: the ends are the cube's
+#: corners, where two axes' labels would print on top of each other
+CORNER = 0.07
+#: where each axis's tick labels stand (unit cube, for the fixed camera of `render`): along the
+#: front edges of the floor for x and y, up the left vertical edge for z, each pushed off its edge
+_TICK_EDGES = {
+    0: lambda u: (u, -0.07, 0.0),
+    1: lambda u: (1.07, u, 0.0),
+    2: lambda u: (-0.06, -0.06, u),
+}
+
+
+def colour_limits(lo: float, hi: float) -> tuple[float, float, int]:
+    """The colour scale's ends at round values just outside [lo, hi] and its number of labels, so
+    every label of the scale is a round number."""
+    from matplotlib.ticker import MaxNLocator
+
+    if hi - lo <= 1e-12 * max(abs(hi), 1e-300):
+        return lo, hi, 2
+    ticks = MaxNLocator(nbins=5, steps=[1, 2, 2.5, 5, 10]).tick_values(lo, hi)
+    ticks = ticks[(ticks >= ticks[ticks <= lo].max()) & (ticks <= ticks[ticks >= hi].min())]
+    return float(ticks[0]), float(ticks[-1]), len(ticks)
+
+
 def _axes(plotter, scene: Scene) -> None:
-    """Bounds with the factors' real ranges; ticks with 3 significant digits (c reads 0.00226, not 0.0)."""
+    """The cube's edges and axis titles, and tick labels at round values (not at the corners)."""
     plotter.show_bounds(
         bounds=[0, 1, 0, 1, 0, 1],
         axes_ranges=[v for r in scene.axis_ranges for v in r],
         xtitle=scene.axis_labels[0],
         ytitle=scene.axis_labels[1],
-        ztitle=scene.axis_labels[2],
+        ztitle=" ",  # written upright beside the axis by `render`, clear of the tick labels
         color="black",
         font_size=15,
-        fmt="%.3g",
-        n_xlabels=3,
-        n_ylabels=3,
-        n_zlabels=5,
+        show_xlabels=False,
+        show_ylabels=False,
+        show_zlabels=False,
         location="outer",
     )
+    for i, ticks in enumerate(axis_ticks(scene)):
+        if not ticks:
+            continue
+        lo, hi = scene.axis_ranges[i]
+        plotter.add_point_labels(
+            np.array([_TICK_EDGES[i]((v - lo) / (hi - lo)) for v, _ in ticks]),
+            [text for _, text in ticks],
+            show_points=False,
+            shape=None,
+            font_size=15,
+            text_color="black",
+            always_visible=True,
+            justification_horizontal="center",
+            justification_vertical="center",
+        )
 
 
-def _colorbar(plotter, response: str, lo: float, hi: float) -> None:
+def axis_ticks(scene: Scene) -> list[list[tuple[float, str]]]:
+    """Per axis of the cube (x, y, z): the ticks `render` labels, (value, text), at round values and
+    none within `CORNER` of a shared corner (the z axis keeps its top end)."""
+    from .common import decimals_for
+
+    out = []
+    for i, (lo, hi) in enumerate(scene.axis_ranges):
+        ticks = round_ticks(lo, hi, 5 if i == 2 else 4)
+        ticks = [v for v in ticks if CORNER <= (v - lo) / (hi - lo) <= 1 - (0 if i == 2 else CORNER)]
+        d = decimals_for(tuple(ticks)) if ticks else 0
+        out.append([(v, f"{v:.{d}f}" if d < 7 else f"{v:.2g}") for v in ticks])
+    return out
+
+
+def _colorbar(plotter, response: str, lo: float, hi: float, n_labels: int) -> None:
     """The colour scale of the response (an invisible mesh carrying its range), right of the scene."""
     import pyvista as pv
 
@@ -155,7 +216,7 @@ def _colorbar(plotter, response: str, lo: float, hi: float) -> None:
             "color": "black",
             "vertical": True,
             "fmt": "%.3g",
-            "n_labels": 5,
+            "n_labels": n_labels,
             "title_font_size": 16,
             "label_font_size": 14,
             "position_x": 0.86,
@@ -197,12 +258,19 @@ def render(view: SpaceView, *, window: tuple[int, int] = WINDOW):
     lo, hi = view.value_range
     if hi - lo <= 1e-9 * abs(hi):  # a constant response: the scale spans the plotted PI instead
         lo, hi = view.scene.axis_ranges[2]
-    _colorbar(plotter, view.response, lo, hi)
+    _colorbar(plotter, view.response, *colour_limits(lo, hi))
     left = min(0.68 * window[0], window[0] - 24 - 13 * max(len(layer.name) for layer in layers))
     for i, layer in enumerate(layers):  # the legend: each name in its layer's colour, fixed size
         pos = (int(left), int(window[1] - 64 - 24 * i))
         plotter.add_text(layer.name, position=pos, font_size=12, color=layer.color)
     _axes(plotter, view.scene)
+    plotter.add_text(
+        view.scene.axis_labels[2],
+        position=(28, int(0.42 * window[1])),
+        font_size=11,
+        color="black",
+        orientation=90,
+    )
     title = view.scene.title
     plotter.add_text(title, font_size=11 if len(title) <= 90 else 9, color="black", position="upper_edge")
     plotter.camera_position = [(2.75, -2.0, 1.95), (0.62, 0.42, 0.5), (0, 0, 1)]
@@ -247,6 +315,28 @@ def _run_layers(points: np.ndarray, near: np.ndarray) -> list[Layer]:
     return layers
 
 
+def _target_layers(
+    surface, values: np.ndarray, target: float, unit: str, zrange: tuple[float, float]
+) -> list[Layer]:
+    """The target on a predicted surface: its contour line and that line projected on the floor, or,
+    when the surface never reaches it (a flat or distant response), a plane at its level."""
+    import pyvista as pv
+
+    surface.point_data["value"] = values
+    line = surface.contour([target], scalars="value")
+    if line.n_points:
+        floor = line.copy()
+        floor.points[:, 2] = 0.0
+        return [
+            Layer(f"target {target:g} {unit}", line, color=TARGET_COLOR, size=2.5),
+            Layer("target, projected", floor, color=TARGET_COLOR, size=1.5, opacity=0.6),
+        ]
+    level = float(_unit(target, *zrange))
+    plane = pv.Plane(center=(0.5, 0.5, level), direction=(0, 0, 1), i_size=1, j_size=1)
+    name = f"target {target:g} {unit} (plane: no design reaches it)"
+    return [Layer(name, plane.triangulate(), color=TARGET_COLOR, opacity=0.35)]
+
+
 def surface_view(
     surrogate,
     response: str,
@@ -277,7 +367,7 @@ def surface_view(
     gx, gy = np.meshgrid(np.linspace(fx.low, fx.high, resolution), np.linspace(fy.low, fy.high, resolution))
     X = pd.DataFrame({n: np.full(gx.size, held.get(n, 0.0)) for n in space.FACTOR_NAMES})
     X[x], X[y] = gx.ravel(), gy.ravel()
-    pred = model.predict(X)
+    pred = surrogate.predict(X, responses=[response])[response]  # as printed (solid at 2 mm)
     observed = table[response].to_numpy(float)
     zlo = float(min(pred.low.min(), observed.min(), target if target is not None else np.inf))
     zhi = float(max(pred.high.max(), observed.max(), target if target is not None else -np.inf))
@@ -295,7 +385,7 @@ def surface_view(
         Layer(
             f"{response} predicted",
             mid,
-            rgb=_rgb(pred.value, vlo, vhi),
+            rgb=_rgb(pred.value, *colour_limits(vlo, vhi)[:2]),
             color=tuple(_rgb(np.array([0.5]), 0, 1)[0]),
         ),
         Layer("95 % PI lower", grid(pred.low), color=PI_COLOR, opacity=0.25),
@@ -307,13 +397,7 @@ def surface_view(
     layers += _run_layers(runs, _runs_near(table, held))
     share = None
     if target is not None:
-        mid.point_data["value"] = pred.value
-        line = mid.contour([target], scalars="value")
-        if line.n_points:
-            layers.append(Layer(f"target {target:g} {model.unit}", line, color=TARGET_COLOR, size=2.5))
-            floor = line.copy()
-            floor.points[:, 2] = 0.0
-            layers.append(Layer("target, projected", floor, color=TARGET_COLOR, size=1.5, opacity=0.6))
+        layers += _target_layers(mid, pred.value, target, model.unit, (zlo, zhi))
         share = float(np.mean((pred.low <= target) & (target <= pred.high)))
     held_txt = ", ".join(f"{k} {v:g} {space.factor(k).unit}" for k, v in held.items())
     title = f"{response_label(response)} over {x} and {y}; held: {held_txt}"
@@ -357,7 +441,7 @@ def volume_view(
     X = pd.DataFrame({n: np.full(mesh[0].size, held.get(n, 0.0)) for n in space.FACTOR_NAMES})
     for f, m in zip(fs, mesh, strict=True):
         X[f.name] = m.ravel(order="F")
-    pred = model.predict(X)
+    pred = surrogate.predict(X, responses=[response])[response]  # as printed (solid at 2 mm)
     vol = pv.ImageData(dimensions=(resolution,) * 3, spacing=(1 / (resolution - 1),) * 3)
     vol.point_data["value"] = pred.value
     vlo, vhi = float(pred.value.min()), float(pred.value.max())
@@ -365,7 +449,7 @@ def volume_view(
     for v in np.linspace(vlo, vhi, levels + 2)[1:-1]:
         iso = vol.contour([v], scalars="value")
         if iso.n_points:
-            color = tuple(_rgb(np.array([v]), vlo, vhi)[0])
+            color = tuple(_rgb(np.array([v]), *colour_limits(vlo, vhi)[:2])[0])
             layers.append(Layer(f"{response} = {v:.3g} {model.unit}", iso, color=color, opacity=0.5))
     share = None
     if target is not None:
@@ -379,7 +463,7 @@ def volume_view(
         Layer(
             f"measured runs ({len(table)}), coloured by {response}",
             pv.PolyData(pts),
-            rgb=_rgb(observed, vlo, vhi),
+            rgb=_rgb(observed, *colour_limits(vlo, vhi)[:2]),
             color=(0.4, 0.4, 0.4),
             size=3,
         )
