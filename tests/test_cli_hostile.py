@@ -16,6 +16,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from clitools import assert_clean_failure, bundled_table, run_inprocess, snapshot
+from test_cli_campaign import SIX, K
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -415,21 +416,6 @@ def test_hand_edited_sweep(name, workdir, inputs, capsys):
 
 # --- aliasing, unreachable targets, degenerate tables ---------------------------------------------
 
-K = ["--k", "0.8", "--c", "2e-3"]
-SIX = [
-    "--density",
-    "60",
-    "--length",
-    "24",
-    "--width",
-    "4.5",
-    "--height",
-    "9",
-    "--layer",
-    "0.16",
-    "--raster",
-    "0",
-]
 IMPOSSIBLE = [
     ["rig", "simulate", *K, *SIX, "--f1", "900", "-o", "l.csv"],
     ["rig", "simulate", *K, *SIX, "--f1", "500", "-o", "l.csv"],

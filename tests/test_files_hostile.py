@@ -20,11 +20,10 @@ import zipfile
 from pathlib import Path
 
 import pytest
-from clitools import CLI, assert_clean_failure, run_process, snapshot
+from clitools import CLI, assert_clean_failure, run_process, snapshot, tmpfs
+from test_cli_campaign import SIX
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-SIX = ["--density", "60", "--length", "24", "--width", "4.5", "--height", "9", "--layer", "0.16"]
-SIX += ["--raster", "0"]
 
 
 def _rig_scenario(folder: Path, k: float, duration: float = 2.0) -> Path:
@@ -40,60 +39,15 @@ def _rig_scenario(folder: Path, k: float, duration: float = 2.0) -> Path:
 
 # --- concurrent writers ---------------------------------------------------------------------------
 
+
+def _simulate(k: str, c: str, seed: str) -> list[str]:
+    return ["rig", "simulate", "--k", k, "--c", c, "--duration", "30", "--seed", seed, *SIX, "-o", "{out}"]
+
+
 #: writers of one output file: two command lines that write different contents to `out`
 CONCURRENT = {
-    "rig simulate csv": (
-        [
-            "rig",
-            "simulate",
-            "--k",
-            "0.8",
-            "--c",
-            "2e-3",
-            "--duration",
-            "30",
-            "--seed",
-            "1",
-            *SIX,
-            "-o",
-            "{out}",
-        ],
-        [
-            "rig",
-            "simulate",
-            "--k",
-            "1.6",
-            "--c",
-            "4e-3",
-            "--duration",
-            "30",
-            "--seed",
-            "1",
-            *SIX,
-            "-o",
-            "{out}",
-        ],
-        "log.csv",
-    ),
-    "rig simulate parquet": (
-        ["rig", "simulate", "--k", "0.8", "--c", "2e-3", "--duration", "30", *SIX, "-o", "{out}"],
-        [
-            "rig",
-            "simulate",
-            "--k",
-            "0.8",
-            "--c",
-            "2e-3",
-            "--duration",
-            "30",
-            "--seed",
-            "7",
-            *SIX,
-            "-o",
-            "{out}",
-        ],
-        "log.parquet",
-    ),
+    "rig simulate csv": (_simulate("0.8", "2e-3", "1"), _simulate("1.6", "4e-3", "1"), "log.csv"),
+    "rig simulate parquet": (_simulate("0.8", "2e-3", "1"), _simulate("0.8", "2e-3", "7"), "log.parquet"),
     "doe": (["doe", "--seed", "1", "-o", "{out}"], ["doe", "--seed", "2", "-o", "{out}"], "plan.csv"),
     "export mjcf": (
         ["export", "mjcf", *SIX, "-o", "{out}"],
@@ -250,13 +204,8 @@ def test_an_unwritable_symlink_target_is_one_line(name, tmp_path):
 @pytest.fixture()
 def small_disk(tmp_path):
     """A 24 MiB tmpfs mounted for the test (root only; skipped with the reason otherwise)."""
-    mnt = tmp_path / "disk"
-    mnt.mkdir()
-    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=24m", "tmpfs", str(mnt)], capture_output=True)
-    if r.returncode != 0:
-        pytest.skip(f"cannot mount a tmpfs here (needs root): {r.stderr.decode().strip()}")
-    yield mnt
-    subprocess.run(["umount", "--lazy", str(mnt)], check=True)
+    with tmpfs(tmp_path / "disk", "24m") as mnt:
+        yield mnt
 
 
 def _fill(folder: Path, leave: int) -> None:
