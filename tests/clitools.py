@@ -49,6 +49,14 @@ def tmpfs(folder: Path, size: str):
         subprocess.run(["umount", "--lazy", str(folder)], check=True)
 
 
+def enter_workdir(tmp_path: Path, inputs: Path, monkeypatch) -> Path:
+    """`tmp_path` as the working folder, the campaign's inputs linked in as in/, a private build cache."""
+    (tmp_path / "in").symlink_to(inputs, target_is_directory=True)
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path.parent / "cache"))
+    return tmp_path
+
+
 def snapshot(*folders: Path) -> dict[str, tuple[int, float]]:
     """Every file and folder (hidden ones too) under `folders`, with size and modification time."""
     seen = {}

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from clitools import assert_clean_failure, bundled_table, run_inprocess, snapshot
+from clitools import assert_clean_failure, bundled_table, enter_workdir, run_inprocess, snapshot
 from test_cli_campaign import SIX, K
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -92,10 +92,7 @@ def inputs(tmp_path_factory):
 
 @pytest.fixture()
 def workdir(tmp_path, inputs, monkeypatch):
-    (tmp_path / "in").symlink_to(inputs, target_is_directory=True)
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path.parent / "cache"))
-    return tmp_path
+    return enter_workdir(tmp_path, inputs, monkeypatch)
 
 
 def _bad(args, workdir, inputs, capsys, allowed=(1, 2)) -> str:
