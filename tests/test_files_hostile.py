@@ -125,6 +125,34 @@ def test_two_cosims_into_one_folder_leave_one_runs_complete_set(tmp_path):
     assert not [p for p in tmp_path.rglob(".*")], "staging folders left"
 
 
+def test_moving_results_in_waits_for_another_writers_lock_on_the_parent(tmp_path):
+    """The protocol the folder writers share: the move-in happens under flock on the parent folder,
+    so a second writer cannot interleave its files with the first's (the test holds the lock)."""
+    fcntl = pytest.importorskip("fcntl")
+    target = tmp_path / "res"
+    target.mkdir()
+    (target / "a.txt").write_text("old")
+    code = (
+        "import sys\nfrom designer.files import atomic_folder\n"
+        "with atomic_folder(sys.argv[1]) as stage:\n    (stage / 'a.txt').write_text('new')\n"
+    )
+    fd = os.open(tmp_path, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        proc = subprocess.Popen([*CLI[:2], "-c", code, str(target)], stderr=subprocess.PIPE, text=True)
+        deadline = time.monotonic() + 60
+        while not [p for p in tmp_path.iterdir() if p.name.startswith(".res.") and (p / "a.txt").exists()]:
+            assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+            time.sleep(0.01)
+        time.sleep(0.5)  # staged: it now waits for the lock
+        assert proc.poll() is None and (target / "a.txt").read_text() == "old"
+    finally:
+        os.close(fd)  # releases the lock
+    assert proc.wait(timeout=60) == 0, proc.stderr.read()
+    assert (target / "a.txt").read_text() == "new"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["res"]
+
+
 # --- outputs through symbolic links ----------------------------------------------------------------
 
 SYMLINKED = {
@@ -265,4 +293,4 @@ def test_disk_full_before_the_work_is_refused_up_front(small_disk):
     assert sorted(p.name for p in small_disk.iterdir()) == ["filler"]
 
 
-CASE_COUNT = len(CONCURRENT) + 1 + len(SYMLINKED) + 1 + len(BAD_LINKS) + 3
+CASE_COUNT = len(CONCURRENT) + 2 + len(SYMLINKED) + 1 + len(BAD_LINKS) + 3
