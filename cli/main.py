@@ -221,11 +221,16 @@ def _internal(exc: BaseException, debug: bool) -> int:
     return _fail(f"internal error: {type(exc).__name__}: {first}", REPORT_HINT, 3)
 
 
-def main() -> None:
-    """The console script: SIGTERM and SIGHUP stop the command like Ctrl-C; exit with run()'s code."""
+def install_signal_handlers() -> None:
+    """SIGINT, SIGTERM and SIGHUP raise Stopped in the main thread, also when they land in a finaliser."""
     for s in _signals():
         signal.signal(s, _stop)
     sys.unraisablehook = _unraisable(sys.unraisablehook)
+
+
+def main() -> None:
+    """The console script: SIGTERM and SIGHUP stop the command like Ctrl-C; exit with run()'s code."""
+    install_signal_handlers()
     try:
         code = run()
     except Stopped as exc:  # landed just outside the command's own handling (before or after it)

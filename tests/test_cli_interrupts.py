@@ -48,7 +48,7 @@ COMMANDS = {
 }
 SEEDS = {"cosim": 3, "sweep": 3, "tune": 3, "validate": 2, "export": 4}
 RUNS = [(name, seed) for name, n in SEEDS.items() for seed in range(n)]
-CASE_COUNT = len(RUNS) + 2  # + the sweep resumed after a stop, + a signal landing in a finaliser
+CASE_COUNT = len(RUNS) + 3  # + the compiler running, a sweep resumed after a stop, a finaliser
 
 
 def _env(tmp_path: Path) -> dict[str, str]:
@@ -57,10 +57,13 @@ def _env(tmp_path: Path) -> dict[str, str]:
     return dict(os.environ, TMPDIR=str(tmp_path / "tmp"), XDG_CACHE_HOME=str(tmp_path / "cache"))
 
 
+def _start(args: list[str], cwd: Path, env: dict) -> subprocess.Popen:
+    pipe = subprocess.PIPE
+    return subprocess.Popen([*CLI, *args], cwd=cwd, env=env, stdout=pipe, stderr=pipe, text=True)
+
+
 def _stop_at(args: list[str], cwd: Path, env: dict, after: float) -> subprocess.CompletedProcess:
-    proc = subprocess.Popen(
-        [*CLI, *args], cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
-    )
+    proc = _start(args, cwd, env)
     time.sleep(after)
     if proc.poll() is None:
         proc.send_signal(signal.SIGTERM)
@@ -134,14 +137,40 @@ def test_sigterm_at_a_random_moment_leaves_nothing(name, seed, tmp_path):
         _check_finished(name, cwd)
 
 
+def _children(pid: int) -> list[str]:
+    try:
+        return Path(f"/proc/{pid}/task/{pid}/children").read_text().split()
+    except OSError:
+        return []
+
+
+def test_sigterm_while_the_compiler_runs_leaves_no_compiler_files(tmp_path):
+    """The moment a random one rarely hits: the C compiler of a cold-cache export is running (gcc's
+    cc*.s and cc*.o in the temporary folder, the cache entry half made)."""
+    if not Path("/proc/self/task").is_dir() or not (shutil.which("cc") or shutil.which("gcc")):
+        pytest.skip("needs Linux's /proc and a C compiler")
+    env = _env(tmp_path)
+    args = COMMANDS["export"][0]
+    proc = _start(args, tmp_path / "cwd", env)
+    deadline = time.monotonic() + 120
+    while not _children(proc.pid):
+        assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+        time.sleep(0.001)
+    time.sleep(0.05)  # the compiler has started writing its files
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 143 and err.splitlines()[-1] == STOPPED, err
+    assert not list((tmp_path / "tmp").iterdir()), "the compiler's temporary files were left"
+    assert not list((tmp_path / "cwd").iterdir())
+    _check_cache(tmp_path / "cache")
+
+
 def test_a_stopped_sweep_resumes_from_its_journal(tmp_path):
     env = _env(tmp_path)
     cwd = tmp_path / "cwd"
     args = ["sweep", str(EXAMPLES / "sweep_arm.toml"), "-o", "sw", "--workers", "1", "--json"]
     journal = cwd / "sw" / "cases.jsonl"
-    proc = subprocess.Popen(
-        [*CLI, *args], cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
-    )
+    proc = _start(args, cwd, env)
     deadline = time.monotonic() + 120
     while not (journal.is_file() and journal.read_bytes().count(b"\n") >= 20):
         assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
@@ -164,9 +193,7 @@ def test_a_signal_landing_in_a_finaliser_still_stops_the_command():
     code = """
 import signal, sys, time
 from designer_cli import main as m
-for s in m._signals():
-    signal.signal(s, m._stop)
-sys.unraisablehook = m._unraisable(sys.unraisablehook)
+m.install_signal_handlers()  # as main() does
 
 class Finaliser:
     def __del__(self):
