@@ -338,6 +338,7 @@ def _write_scenarios(folder: Path) -> None:
 
 
 SWEEP = 'scenario = "{scenario}"\n{body}'
+MC = '[cases]\ntype = "montecarlo"\nn = 2\n'
 SWEEPS = {
     "scenario_number": 'scenario = 3\n[cases]\ntype = "montecarlo"\nn = 2\n',
     "scenario_table": '[scenario]\nfile = "sc_good.toml"\n[cases]\ntype = "montecarlo"\nn = 2\n',
@@ -373,6 +374,12 @@ SWEEPS = {
     ),
     "workers_text": SWEEP.format(
         scenario="sc_good.toml", body='[sweep]\nworkers = "2"\n[cases]\ntype = "montecarlo"\nn = 2\n'
+    ),
+    "typo_top": SWEEP.format(scenario="sc_good.toml", body='[case]\ntype = "montecarlo"\nn = 2\n'),
+    "typo_sweep": SWEEP.format(scenario="sc_good.toml", body=f'[sweep]\nlimts = ["overshoot<=5%"]\n{MC}'),
+    "typo_cases": SWEEP.format(scenario="sc_good.toml", body=f"{MC}sed = 3\n"),
+    "typo_cluster": SWEEP.format(
+        scenario="sc_good.toml", body='[cases]\ntype = "montecarlo"\nn = 2\n[cluster]\nworker = 2\n'
     ),
     "aliased_rig": SWEEP.format(scenario="sc_rig_f1_1e6.toml", body='[cases]\ntype = "montecarlo"\nn = 2\n'),
 }

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..cosim.scenario import Scenario
 from ..errors import DesignerError, check_type
-from ..keys import read_toml
+from ..keys import check_keys, read_toml
 from .limits import Limit, parse_limit
 
 CASE_TYPES = ("grid", "suggestion", "montecarlo")
@@ -173,6 +173,7 @@ def load(path: str | Path) -> Spec:
     from .. import cosim
 
     path, doc = read_toml(path, what="sweep")
+    _check_sweep_keys(doc, path)
     if not isinstance(doc.get("scenario"), str):
         raise DesignerError(f"{path.name} names no scenario", 'add scenario = "arm.toml" at the top')
     scenario = cosim.load((path.parent / doc["scenario"]).resolve())
@@ -201,6 +202,23 @@ def load(path: str | Path) -> Spec:
         source=path,
     )
     return check(spec)
+
+
+#: the keys a sweep file may have, per table (a misspelt one, e.g. `limts`, was ignored silently)
+SWEEP_KEYS = {
+    "": ("scenario", "sweep", "cases", "cluster"),
+    "sweep": ("path", "check", "duration", "limits", "surrogate", "workers", "batch"),
+    "cases": ("type", "joints", "designs", "n", "seed", "file", "candidates"),
+    "cluster": ("scheduler", "workers", "slurm"),
+}
+
+
+def _check_sweep_keys(doc: dict, path: Path) -> None:
+    """Raise for an unknown key (with the nearest valid one) in the file or one of its tables."""
+    check_keys(doc, SWEEP_KEYS[""], where=path.name)
+    for table in ("sweep", "cases", "cluster"):
+        if isinstance(doc.get(table), dict):
+            check_keys(doc[table], SWEEP_KEYS[table], where=f"[{table}] of {path.name}")
 
 
 def with_duration(scenario: Scenario, duration: Any) -> Scenario:
