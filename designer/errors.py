@@ -51,13 +51,13 @@ def path_argument(value: Any, name: str, *, what: str = "a file") -> Path:
     return Path(value)
 
 
-def number_argument(value: Any, name: str) -> float:
+def number_argument(value: Any, name: str, *, example: str = "0.8") -> float:
     """`value` (a real number, not a bool; numpy scalars too) as a float.
 
     Raises:
         DesignerError: naming the argument `name` when `value` is a list, an array, a str, None...
     """
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        fix = f"give {name} as one number, e.g. 0.8"
+        fix = f"give {name} as one number, e.g. {example}"
         raise DesignerError(f"{name} is {describe(value)}, not a number", fix)
     return float(value)

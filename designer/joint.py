@@ -156,11 +156,13 @@ class Joint:
             fix = "give params={'density': 60, 'length': 24, 'width': 4.5, ...} with all six factors"
             raise DesignerError(f"params is {describe(params)}, not a mapping of factors", fix)
         params = space.check_design(params, allow_extrapolation)
-        from .surrogate import Surrogate, check_surrogate
+        from .surrogate import Surrogate
 
         if surrogate is None:
             surrogate = Surrogate.load()
-        check_surrogate(surrogate)
+        if not callable(getattr(surrogate, "predict", None)):  # any object with Surrogate's interface
+            fix = "give Surrogate.load() (the shipped one) or Surrogate().fit(table)"
+            raise DesignerError(f"surrogate is {describe(surrogate)}, not a Surrogate", fix)
         pred = surrogate.predict({n: [v] for n, v in params.items()}, allow_extrapolation=True)
         base = {
             a: AxisCoefficients(
@@ -204,7 +206,7 @@ class Joint:
             where = f"suggestion {path.name}"
             suggestion = Suggestion.load(path)
         n = len(suggestion.candidates)
-        if not 1 <= number_argument(candidate, "candidate") <= n:
+        if not 1 <= number_argument(candidate, "candidate", example="1 (the best)") <= n:
             raise DesignerError(
                 f"candidate {candidate} does not exist in {where}",
                 f"choose 1 to {n}" if n else "the suggestion has no candidates",

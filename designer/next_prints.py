@@ -191,9 +191,9 @@ def _predictable_targets(sug: Any) -> dict[str, float]:
 
 
 def _check_arguments(n: int, stop: float) -> None:
-    if not 1 <= number_argument(n, "n") <= 10 or int(n) != n:
+    if not 1 <= number_argument(n, "n", example="3") <= 10 or int(n) != n:
         raise DesignerError(f"n={n} is not a whole number from 1 to 10", "give a whole number such as 3")
-    if not 0 < number_argument(stop, "stop") <= 1:
+    if not 0 < number_argument(stop, "stop", example="0.9") <= 1:
         raise DesignerError(f"stop={stop} is not in (0, 1]", "give a probability such as 0.9")
 
 

@@ -604,6 +604,10 @@ def suggest(
             tolerance not in (0, 1).
     """
     _check_request(surrogate, axis, k is None and c is None, top, tolerance)
+    for name, value in (("fixed", fixed), ("importance", importance), ("bounds", bounds), ("weight", weight)):
+        if value is not None:
+            fix = f"give {name} as a dict, e.g. {name}={MAPPING_EXAMPLES[name]}"
+            check_type(value, Mapping, name, expected="a mapping", fix=fix)
     importance, bounds, weight = importance or {}, bounds or {}, weight or {}
     targets = {
         q: make_target(
@@ -638,11 +642,19 @@ def suggest(
     return sug
 
 
+MAPPING_EXAMPLES = {
+    "fixed": "{'width': 3.0}",
+    "importance": "{'k': 2.0}",
+    "bounds": "{'k': (0.5, 1.2)}",
+    "weight": "{'k': 1.0}",
+}
+
+
 def _check_request(surrogate: Surrogate, axis: str, no_goal: bool, top: int, tolerance: float) -> None:
     """Raise DesignerError for an axis the surrogate lacks, no goal, top < 1 or a tolerance not in (0, 1)."""
     check_surrogate(surrogate)
     check_type(top, numbers.Integral, "top", expected="a whole number", fix="give e.g. top=5")
-    number_argument(tolerance, "tolerance")
+    number_argument(tolerance, "tolerance", example="0.1")
     units.check_axis(axis)
     if axis not in surrogate.axes:
         raise DesignerError(

@@ -546,6 +546,21 @@ def _api_cases():
         "sweep.load(None)": ("path", lambda: designer.sweep.load(None)),
         "sweep.run(None)": ("spec", lambda: designer.sweep.run(None)),
         "sweep.run(path)": ("spec", lambda: designer.sweep.run(str(EXAMPLES / "sweep_arm.toml"))),
+        "sweep.run(executor=str)": (
+            "executor",
+            lambda: designer.sweep.run(designer.sweep.load(EXAMPLES / "sweep_arm.toml"), executor="local"),
+        ),
+        "export_fmu(platforms=[3])": (
+            "platforms",
+            lambda: designer.export_fmu(joint, "j.fmu", platforms=[3]),
+        ),
+        "suggest(fixed=list)": ("fixed", lambda: designer.suggest(sur, k=0.8, fixed=[("width", 3)])),
+        "suggest(importance=list)": ("importance", lambda: designer.suggest(sur, k=0.8, importance=[1])),
+        "suggest(bounds=str)": ("bounds", lambda: designer.suggest(sur, k=0.8, bounds="0.5:1")),
+        "Joint.from_suggestion(candidate=str)": (
+            "candidate",
+            lambda: designer.Joint.from_suggestion(EXAMPLES / "suggestion.json", candidate="1"),
+        ),
     }
 
 

@@ -28,7 +28,7 @@ from collections.abc import Sequence
 from importlib import resources
 from pathlib import Path
 
-from ..errors import DesignerError
+from ..errors import DesignerError, check_type
 from ..files import cache_entry
 
 #: no fused multiply-add contraction: aarch64 would fuse a*b+c where x86_64 cannot, and a joint's
@@ -125,6 +125,10 @@ def resolve_platforms(platforms: str | Sequence[str]) -> list[str]:
     """
     if isinstance(platforms, str):
         platforms = [p.strip() for p in platforms.split(",") if p.strip()]
+    fix = f'give platforms="all", "host" or a list of: {", ".join(PLATFORMS)}'
+    check_type(platforms, (list, tuple), "platforms", expected="a str or a list of str", fix=fix)
+    for p in platforms:
+        check_type(p, str, "platforms", expected="a list of str", fix=fix)
     if list(platforms) == ["all"]:
         names = list(PLATFORMS)
     elif list(platforms) == ["host"]:
