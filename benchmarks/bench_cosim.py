@@ -23,7 +23,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import ctypes
-import importlib
 import os
 import shutil
 import statistics
@@ -36,11 +35,11 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from designer.cosim import kernel, load
+from designer.cosim import kernel, load, prepare
 from designer.cosim.master import Master
 from designer.cosim.robot import Robot, SpringDamper, load_spec
+from designer.export.fmu import export_fmu
 
-cosim_run = importlib.import_module("designer.cosim.run")
 STEP = 1e-3
 SCENARIO = Path(__file__).resolve().parent.parent / "examples" / "two_link_arm.toml"
 LINKS = (1, 2, 4, 8, 16)
@@ -52,9 +51,10 @@ def cpu(fn) -> float:
     return time.process_time() - start
 
 
-def loop_cpu(sc, fmus, duration: float, engine: str) -> float:
-    """CPU seconds of the co-simulation loop alone: robot_run with the engine's run timed inside."""
-    owner = kernel if engine == "kernel" else Master
+def loop_cpu(session, duration: float, engine: str) -> float:
+    """CPU seconds of the co-simulation loop alone: a prepared Session's run with the engine's loop
+    timed inside."""
+    owner = kernel.Bound if engine == "kernel" else Master
     inner, spent = owner.run, []
 
     def timed(*args, **kwargs):
@@ -65,7 +65,7 @@ def loop_cpu(sc, fmus, duration: float, engine: str) -> float:
 
     owner.run = timed
     try:
-        cosim_run.robot_run(sc, fmus, STEP, duration, sc.algorithm, engine=engine)
+        session.trace(step=STEP, duration=duration, engine=engine)
     finally:
         owner.run = inner
     return spent[0]
@@ -183,27 +183,25 @@ def main() -> None:
 
     with contextlib.ExitStack() as stack:
         folder = Path(stack.enter_context(tempfile.TemporaryDirectory()))
-        fmus = stack.enter_context(cosim_run.joint_fmus(sc))
-        laws = {j: cosim_run.law(src, fmus[j]) for j, src in sc.joints.items()}
+        session = stack.enter_context(prepare(sc))
+        laws = session.laws(session.parameters(None))
+        fmus = {j: export_fmu(src.joint, folder / f"{j}.fmu") for j, src in sc.joints.items() if src.joint}
         arms = {n: n_link(folder, n) for n in LINKS}
-        arm_fmus = {n: stack.enter_context(cosim_run.joint_fmus(arm)) for n, arm in arms.items()}
-        arm_laws = {
-            n: {j: cosim_run.law(src, arm_fmus[n][j]) for j, src in arm.joints.items()}
-            for n, arm in arms.items()
-        }
+        arm_sessions = {n: stack.enter_context(prepare(arm)) for n, arm in arms.items()}
+        arm_laws = {n: s.laws(s.parameters(None)) for n, s in arm_sessions.items()}
         command = [designer, "cosim", str(command_folder(folder)), "-o", str(folder / "out")]
-        loop_cpu(sc, fmus, 0.1, "kernel")  # build the kernel, warm the caches
+        loop_cpu(session, 0.1, "kernel")  # build the kernel, warm the caches
         child_cpu(command, folder)
         d = args.duration
         for _ in range(args.rounds):
-            add("kernel", loop_cpu(sc, fmus, d, "kernel") / (d / STEP))
+            add("kernel", loop_cpu(session, d, "kernel") / (d / STEP))
             add("floor", floor_cpu(sc, laws, d) / (d / STEP))
             add("floor0", floor_cpu(sc, laws, d, timer=False) / (d / STEP))
             add("bare", bare_cpu(sc, laws, d) / (d / STEP))
             add("libcosim", None if (c := libcosim_cpu(fmus, d)) is None else c / (d / STEP))
-            add("python", loop_cpu(sc, fmus, 10.0, "python") / 1e4)
+            add("python", loop_cpu(session, 10.0, "python") / 1e4)
             for n, arm in arms.items():
-                add(f"kernel{n}", loop_cpu(arm, arm_fmus[n], 10.0, "kernel") / 1e4)
+                add(f"kernel{n}", loop_cpu(arm_sessions[n], 10.0, "kernel") / 1e4)
                 add(f"floor{n}", floor_cpu(arm, arm_laws[n], 10.0) / 1e4)
                 add(f"floor0{n}", floor_cpu(arm, arm_laws[n], 10.0, timer=False) / 1e4)
             add("command", child_cpu(command, folder))

@@ -332,14 +332,49 @@ FMU_OPTIONS = (
 )
 
 
-def _ssp(joint: Joint, output: Path, suggestion: Source, *, interface: str) -> Path:
+def _ssp(joint: Joint, output: Path, suggestion: Source, *, interface: str, system_connectors: bool) -> Path:
     """The SSP archive; from a suggestion, every candidate becomes an SSV parameter set."""
     from designer.export.ssp import candidate_sets, export_ssp
 
     sets = None
     if suggestion is not None:
         sets = {joint.name: candidate_sets(suggestion[0], axes=list(joint.axes), name=joint.name)}
-    return export_ssp(joint, output, alternatives=sets, interface=interface)
+    return export_ssp(
+        joint, output, alternatives=sets, interface=interface, system_connectors=system_connectors
+    )
+
+
+#: the options of `export mjcf` beyond the joint's: where it goes in a robot and how
+MJCF_OPTIONS = (
+    INTO,
+    ROBOT_JOINT,
+    REST,
+    AXIS_PICK,
+    _option("form", Annotated[str, typer.Option(help="parallel or series (motor -> flexure)")], "parallel"),
+    _option("motor_inertia", Annotated[float | None, typer.Option(help="series: SI")], None),  # noqa: UP007
+    _option("motor_bandwidth", Annotated[float | None, typer.Option(help="series: servo Hz")], None),  # noqa: UP007
+    _option(
+        "allow_outside_range",
+        Annotated[bool, typer.Option(help="accept a --rest outside the robot joint's range")],
+        False,
+    ),
+)
+#: the options of `export ssp` beyond the joint's
+SSP_OPTIONS = (
+    _option("interface", Annotated[str, typer.Option(help="body (load in) or force")], "body"),
+    _option(
+        "system_connectors",
+        Annotated[
+            bool,
+            typer.Option(
+                "--system-connectors",
+                help="also wire each joint's inputs and outputs to the system's connectors (for "
+                "fmpy.ssp; libcosim cannot load such connections)",
+            ),
+        ],
+        False,
+    ),
+)
 
 
 def _formats(snippet: Callable[..., None]) -> None:
@@ -369,22 +404,7 @@ def _formats(snippet: Callable[..., None]) -> None:
         _mjcf,
         "designer export mjcf --k 50 --c 0.5 --m 1e-5 --axis theta --into robot.xml --joint elbow "
         "-o robot_flex.xml",
-        (
-            INTO,
-            ROBOT_JOINT,
-            REST,
-            AXIS_PICK,
-            _option(
-                "form", Annotated[str, typer.Option(help="parallel or series (motor -> flexure)")], "parallel"
-            ),
-            _option("motor_inertia", Annotated[float | None, typer.Option(help="series: SI")], None),  # noqa: UP007
-            _option("motor_bandwidth", Annotated[float | None, typer.Option(help="series: servo Hz")], None),  # noqa: UP007
-            _option(
-                "allow_outside_range",
-                Annotated[bool, typer.Option(help="accept a --rest outside the robot joint's range")],
-                False,
-            ),
-        ),
+        MJCF_OPTIONS,
     )
     snippet(
         "urdf",
@@ -407,5 +427,5 @@ def _formats(snippet: Callable[..., None]) -> None:
         "an SSP archive (SSD, FMI 2 FMU, SSV parameter sets in SI; --from: one set per candidate)",
         _ssp,
         "designer export ssp --from suggestion.json -o joint.ssp",
-        (_option("interface", Annotated[str, typer.Option(help="body (load in) or force")], "body"),),
+        SSP_OPTIONS,
     )

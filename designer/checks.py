@@ -72,6 +72,8 @@ CHECKS: tuple[tuple[str, str], ...] = (
     ("designer.stats_checks", "check_main_effects"),
     ("designer.surrogate_checks", "check_surrogate_loo"),
     ("designer.export.checks", "check_fmus"),
+    ("designer.export.checks", "check_mjcf_into"),
+    ("designer.export.checks", "check_ssp"),
     ("designer.rig.checks", "check_identification"),
     ("designer.cosim.checks", "check_cosim"),
 )

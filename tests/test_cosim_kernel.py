@@ -6,12 +6,13 @@ import shutil
 import subprocess
 import sys
 import textwrap
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from designer.cosim import kernel
+from designer.cosim import binding, kernel, prepare
 from designer.cosim.master import Master
 from designer.cosim.references import Chirp, Sine, Step, Trajectory
 from designer.cosim.robot import Robot, SpringDamper, load_spec
@@ -61,13 +62,11 @@ class Spring(Fmi2Slave):
 
 
 def both(sc, algorithm=None, step=None, duration=None):
-    """The scenario run by the Python master and by the kernel."""
-    algorithm = algorithm or sc.algorithm
-    with cosim_run.joint_fmus(sc) as fmus:
-        return [
-            cosim_run.robot_run(sc, fmus, step or sc.step, duration or sc.duration, algorithm, engine=engine)
-            for engine in ("python", "kernel")
-        ]
+    """The scenario run by the Python master and by the kernel, in one prepared Session (so the
+    kernel's run also checks that a reset gives back the first run's start)."""
+    sc = replace(sc, algorithm=algorithm or sc.algorithm)
+    with prepare(sc) as session:
+        return [session.trace(step=step, duration=duration, engine=e) for e in ("python", "kernel")]
 
 
 def assert_same(py, ker):
@@ -118,24 +117,18 @@ def test_n_link_arms_bit_identical(tmp_path, n, algorithm, fmi3):
 
 
 def test_rig_bit_identical():
-    sc = load(EXAMPLE.parent / "rig.toml")
-    with cosim_run.joint_fmus(sc) as fmus:
-        law = cosim_run.law(sc.rig_joint, fmus["rig"])
-        py, ker = (
-            cosim_run.rig_run(sc, fmus["rig"], law, sc.step, 2.0, None, engine)
-            for engine in ("python", "kernel")
-        )
+    py, ker = both(load(EXAMPLE.parent / "rig.toml"), duration=2.0)
     assert_same(py, ker)
     assert np.ptp(ker.column("hub.f")) > 0
 
 
 def test_divergence_is_found_at_the_same_instant():
-    sc = load(EXAMPLE)
+    sc = replace(load(EXAMPLE), algorithm="jacobi")
     errors = []
-    with cosim_run.joint_fmus(sc) as fmus:
+    with prepare(sc) as session:
         for engine in ("python", "kernel"):
             with pytest.raises(DesignerError, match="diverged") as info:
-                cosim_run.robot_run(sc, fmus, 5e-3, 1.0, "jacobi", engine=engine)
+                session.trace(step=5e-3, duration=1.0, engine=engine)
             errors.append(str(info.value))
     assert errors[0] == errors[1] and "t = 0.135 s" in errors[0]
 
@@ -152,7 +145,7 @@ def test_kernel_references_match_python(tmp_path):
     lib = kernel.library()
     for ref in refs:
         keep = []
-        struct = kernel.reference(ref, keep)
+        struct = binding.reference(ref, keep)
         q, v = kernel.ctypes.c_double(), kernel.ctypes.c_double()
         for t in times:
             lib.ks_reference_eval(kernel.ctypes.byref(struct), float(t), q, v)
@@ -210,10 +203,10 @@ def test_third_party_fmu_bit_identical(tmp_path, spring_fmu):
 def test_fmu_error_status_comes_with_the_fmus_log(tmp_path, spring_fmu):
     sc = spring_arm(tmp_path, spring_fmu, parameters='parameters = { "theta.m" = -1.0 }')
     messages = []
-    with cosim_run.joint_fmus(sc) as fmus:
+    with prepare(sc) as session:
         for engine in ("python", "kernel"):
             with pytest.raises(DesignerError) as info:
-                cosim_run.robot_run(sc, fmus, sc.step, sc.duration, sc.algorithm, engine=engine)
+                session.trace(engine=engine)
             messages.append(str(info.value))
     assert messages[0] == messages[1]
     assert "FMU j2: fmi2DoStep returned Discard at t = 0.101 s" in messages[0]
@@ -222,15 +215,15 @@ def test_fmu_error_status_comes_with_the_fmus_log(tmp_path, spring_fmu):
 
 def test_auto_falls_back_to_python_without_a_compiler(tmp_path, monkeypatch):
     sc = load(EXAMPLE)
-    with cosim_run.joint_fmus(sc) as fmus:
+    with prepare(sc) as session:
         monkeypatch.setenv("CC", str(tmp_path / "no-such-cc"))
         monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
         kernel.library.cache_clear()
         try:
-            res = cosim_run.robot_run(sc, fmus, sc.step, 0.05, sc.algorithm)
+            res = session.trace(duration=0.05)
             assert res.engine == "python"
             with pytest.raises(DesignerError, match="no-such-cc"):
-                cosim_run.robot_run(sc, fmus, sc.step, 0.05, sc.algorithm, engine="kernel")
+                session.trace(duration=0.05, engine="kernel")
         finally:
             kernel.library.cache_clear()
 
@@ -286,7 +279,7 @@ def asking_fmus(monkeypatch, every=250, fail_at=None):
     from designer.cosim import fmu as fmu_module
 
     proto = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p)
-    original_init, real_function = fmu_module.FmuSystem.__init__, kernel._function
+    original_init, real_function = fmu_module.FmuSystem.__init__, fmu_module.fmi_function
     events, fakes, keep = [], {}, []
 
     def asking(fmu):
@@ -305,7 +298,7 @@ def asking_fmus(monkeypatch, every=250, fail_at=None):
         fake = asking(self.fmu)
         keep.append(fake)
         fakes[id(self.fmu)] = ctypes.cast(fake, ctypes.c_void_p).value
-        self._needs_cis = True
+        self.needs_completed_step = True
 
         def python_completed():
             enter, stop = ctypes.c_int(0), ctypes.c_int(0)
@@ -322,7 +315,7 @@ def asking_fmus(monkeypatch, every=250, fail_at=None):
         return fakes[id(fmu)] if name.endswith("CompletedIntegratorStep") else real_function(fmu, name)
 
     monkeypatch.setattr(fmu_module.FmuSystem, "__init__", init)
-    monkeypatch.setattr(kernel, "_function", function)
+    monkeypatch.setattr(fmu_module, "fmi_function", function)
     return events
 
 
@@ -333,18 +326,20 @@ def test_model_exchange_completed_steps_and_events_match(monkeypatch):
     py, ker = both(load(EXAMPLE), duration=1.0)
     assert_same(py, ker)
     half = len(events) // 2
-    assert half == 8 and events[:half] == events[half:], events
+    # per run: each joint's event iteration after initialisation (its reset, at step 0), then the
+    # ones it asks for every 250 steps
+    assert half == 10 and events[:half] == events[half:], events
+    assert events[:2] == [("j1", 0), ("j2", 0)] and events[2:4] == [("j1", 250), ("j2", 250)]
 
 
 def test_model_exchange_error_status_is_reported_alike(monkeypatch):
     asking_fmus(monkeypatch, fail_at=300)
     sc = load(EXAMPLE)
     messages = []
-    with cosim_run.joint_fmus(sc) as fmus:
-        for engine in ("python", "kernel"):
-            with pytest.raises(DesignerError) as info:
-                cosim_run.robot_run(sc, fmus, sc.step, 1.0, sc.algorithm, engine=engine)
-            messages.append(str(info.value))
+    for engine in ("python", "kernel"):  # a session each: the fake counts its calls per instance
+        with prepare(sc) as session, pytest.raises(DesignerError) as info:
+            session.trace(duration=1.0, engine=engine)
+        messages.append(str(info.value))
     assert messages[0] == messages[1]
     assert "FMU j1: fmi2CompletedIntegratorStep returned Error at t = 0.3 s" in messages[0]
 
@@ -385,15 +380,15 @@ def test_runs_in_threads_agree_and_mujoco_keeps_its_clock():
     hook = ctypes.c_void_p.in_dll(ctypes.CDLL(str(mujoco_paths()[1])), "mjcb_time")
     before = hook.value
     sc = load(EXAMPLE)
-    with cosim_run.joint_fmus(sc) as fmus:
 
-        def one(_):
-            return cosim_run.robot_run(sc, fmus, sc.step, 2.0, sc.algorithm, engine="kernel").values
+    def one(_):
+        with prepare(sc) as session:  # a session per thread: its own FMU instances and MjData
+            return session.trace(duration=2.0, engine="kernel").values
 
-        with ThreadPoolExecutor(3) as pool:
-            results = list(pool.map(one, range(3)))
-        with pytest.raises(DesignerError, match="diverged"):
-            cosim_run.robot_run(sc, fmus, 5e-3, 1.0, "jacobi", engine="kernel")
+    with ThreadPoolExecutor(3) as pool:
+        results = list(pool.map(one, range(3)))
+    with prepare(replace(sc, algorithm="jacobi")) as session, pytest.raises(DesignerError, match="diverged"):
+        session.trace(step=5e-3, duration=1.0, engine="kernel")
     assert all(np.array_equal(results[0], r) for r in results[1:])
     assert hook.value == before
 
@@ -402,11 +397,10 @@ def test_each_fmu_keeps_its_own_log_and_closes_after_an_error():
     from designer.cosim.fmu import _LOGS, FmuSystem
 
     sc = load(EXAMPLE)
-    with cosim_run.joint_fmus(sc) as fmus:
-        first, second = (FmuSystem(fmus[j], ["theta"], name=j) for j in ("j1", "j2"))
+    with prepare(sc) as session:
+        first, second = (session.systems[j] for j in ("j1", "j2"))
+        assert isinstance(first, FmuSystem)
         with pytest.raises(DesignerError, match=r"(?s)FMU j1: fmi2SetReal returned Error.*not a finite"):
             first.set(np.array([np.nan, 0.0]))
         assert len(first.log) == 1 and not second.log
-        first.close()
-        second.close()
     assert not _LOGS

@@ -10,11 +10,12 @@ import pytest
 import typer
 from typer.testing import CliRunner
 
-from designer.cosim import load, run, write_outputs
+from designer.cosim import load, prepare, run, write_outputs
 from designer.errors import DesignerError
 
 # the module, not the function `designer.cosim.run` that shadows it as an attribute of the package
 cosim_run = importlib.import_module("designer.cosim.run")
+cosim_session = importlib.import_module("designer.cosim.session")
 
 ARM = """
 [simulation]
@@ -59,10 +60,10 @@ def arm(tmp_path, duration=10.0, step=1e-3, joint2=J2):
 
 def test_two_link_arm_through_fmus_matches_in_engine_reference(tmp_path):
     sc = load(arm(tmp_path))
-    with cosim_run.joint_fmus(sc) as fmus:
-        laws = {j: cosim_run.law(src, fmus[j]) for j, src in sc.joints.items()}
-        res = cosim_run.robot_run(sc, fmus, sc.step, sc.duration, "gauss-seidel")
-        ref = cosim_run.robot_reference(sc, laws, sc.step, sc.duration, "euler")
+    with prepare(sc) as session:
+        laws = session.laws(session.parameters(None))
+        res = session.trace()
+    ref = cosim_run.robot_reference(sc, laws, sc.step, sc.duration, "euler")
     assert laws["j1"]["k"] == pytest.approx(0.33) and laws["j1"]["c"] == pytest.approx(8.3e-4)
     for j in sc.joints:
         assert np.abs(res.column(f"robot.{j}.q") - ref.column(f"robot.{j}.q")).max() <= 1e-6
@@ -145,7 +146,7 @@ def test_interrupted_run_leaves_complete_files_or_none(tmp_path, monkeypatch):
         "timeseries.csv",
         "timeseries.parquet",
     ]
-    monkeypatch.setattr(cosim_run, "run_master", interrupt)
+    monkeypatch.setattr(cosim_session, "run_master", interrupt)
     with pytest.raises(KeyboardInterrupt):
         write_outputs(run(sc), tmp_path / "none")
     assert not (tmp_path / "none").exists()
@@ -191,12 +192,12 @@ def test_joints_from_a_design_and_a_suggestion_run_through_the_surrogate(tmp_pat
     # the suggestion's k on x (N/mm) taken to theta with the PRB model: K = k (0.85 L)^2
     k2 = doc["candidates"][1]["predicted"]["k"]["value"] * (0.85 * 24) ** 2
     assert expect["j2"].k == pytest.approx(k2, rel=1e-9) and 250 < k2 < 420
-    with cosim_run.joint_fmus(sc) as fmus:
-        for j, src in sc.joints.items():
-            law = cosim_run.law(src, fmus[j])
-            assert law["k"] == pytest.approx(expect[j].k * 1e-3, rel=1e-9)  # N.mm/rad -> N.m/rad
-            assert law["c"] == pytest.approx(expect[j].c * 1e-3, rel=1e-9)
-        res = cosim_run.robot_run(sc, fmus, sc.step, sc.duration, "gauss-seidel")
+    with prepare(sc) as session:
+        laws = session.laws(session.parameters(None))
+        for j in sc.joints:
+            assert laws[j]["k"] == pytest.approx(expect[j].k * 1e-3, rel=1e-9)  # N.mm/rad -> N.m/rad
+            assert laws[j]["c"] == pytest.approx(expect[j].c * 1e-3, rel=1e-9)
+        res = session.trace()
     assert np.abs(res.column("robot.j2.s")).max() > 0.01
     assert sc.joints["j2"].joint.provenance["source"] == "suggestion s.json, candidate 2"
 
@@ -251,7 +252,7 @@ def _coded(**changes):
 
 def test_scenario_built_in_code_runs_in_memory_and_writes_nothing(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    sc = _coded()
+    sc = _coded().check()
     assert sc.kind == "robot" and sc.outputs == {"csv": True, "parquet": True, "plot": True}
     result = run(sc)
     frame = result.to_frame()
@@ -280,8 +281,11 @@ def test_scenario_built_in_code_runs_in_memory_and_writes_nothing(tmp_path, monk
     ],
 )
 def test_invalid_scenario_built_in_code_is_refused_naming_the_field(changes, message):
+    sc = _coded(**changes)  # building stores; checking (by load, prepare, run) refuses
     with pytest.raises(DesignerError, match=message):
-        _coded(**changes)
+        sc.check()
+    with pytest.raises(DesignerError, match=message):
+        run(sc)
 
 
 def test_joint_source_checks_its_fields():
@@ -290,11 +294,11 @@ def test_joint_source_checks_its_fields():
 
     joint = Joint.from_coefficients({"theta": {"k": 330, "c": 0.83}})
     with pytest.raises(DesignerError, match="exactly one of fmu= or joint="):
-        JointSource()
+        JointSource().check()
     with pytest.raises(DesignerError, match="has no axis 'x'"):
-        JointSource(axis="x", joint=joint)
+        JointSource(axis="x", joint=joint).check()
     with pytest.raises(DesignerError, match="'theta.stiffness' is not a parameter"):
-        JointSource(joint=joint, parameters={"theta.stiffness": 1.0})
+        JointSource(joint=joint, parameters={"theta.stiffness": 1.0}).check()
 
 
 @pytest.mark.parametrize(

@@ -235,8 +235,14 @@ def test_urdf_loads_in_mujoco_with_real_links_and_the_gazebo_spring(tmp_path):
     gz = root.find("gazebo[@reference='FlexJoint_theta']")
     k, rest = float(gz.find("springStiffness").text), float(gz.find("springReference").text)
     assert (k, rest) == (0.05, 0.0)
-    masses = [float(e.get("value")) for e in root.iter("mass")]
-    assert masses[0] == 0.0 and masses[1] > 1e-3, "a fixed base and a real moving link"
+    masses = {
+        link.get("name"): float(link.find("inertial/mass").get("value"))
+        for link in root.iter("link")
+        if link.find("inertial") is not None
+    }
+    assert set(masses) == {"FlexJoint_base", "FlexJoint_theta_link"}, "world alone has no inertial"
+    assert min(masses.values()) > 1e-3, "no link of mass 0 (Gazebo's converter drops it and all after it)"
+    assert root.find("joint[@name='FlexJoint_fixed']/parent").get("link") == "world"
     from designer.export.urdf_inertia import moved_inertia
 
     assert moved_inertia(root, "FlexJoint_theta") == pytest.approx(out.advice["FlexJoint_theta"].inertia)
@@ -256,18 +262,20 @@ def test_urdf_steps_in_pybullet_with_default_flags(tmp_path):
     client = p.connect(p.DIRECT)
     try:
         body = p.loadURDF(str(out.path), useFixedBase=True, physicsClientId=client)
-        info = p.getDynamicsInfo(body, 0, physicsClientId=client)
+        names = [p.getJointInfo(body, i, physicsClientId=client)[1] for i in range(p.getNumJoints(body))]
+        j = names.index(b"FlexJoint_theta")  # after FlexJoint_fixed (world -> base)
+        info = p.getDynamicsInfo(body, j, physicsClientId=client)
         mass = 1e-5 / (0.85 * 0.024) ** 2  # m / (gamma L)^2 at the middle tested length
         assert info[0] == pytest.approx(mass, rel=1e-9) and info[2] == pytest.approx((1e-5,) * 3)
         p.setTimeStep(1e-4, physicsClientId=client)
         # pybullet's default velocity motor would hold the joint; URDF damping it applies itself
-        p.setJointMotorControl2(body, 0, p.VELOCITY_CONTROL, force=0, physicsClientId=client)
+        p.setJointMotorControl2(body, j, p.VELOCITY_CONTROL, force=0, physicsClientId=client)
         q = np.empty(5000)
         for i in range(5000):
-            s = p.getJointState(body, 0, physicsClientId=client)[0]
-            p.setJointMotorControl2(body, 0, p.TORQUE_CONTROL, force=0.01 - k * s, physicsClientId=client)
+            s = p.getJointState(body, j, physicsClientId=client)[0]
+            p.setJointMotorControl2(body, j, p.TORQUE_CONTROL, force=0.01 - k * s, physicsClientId=client)
             p.stepSimulation(physicsClientId=client)
-            q[i] = p.getJointState(body, 0, physicsClientId=client)[0]
+            q[i] = p.getJointState(body, j, physicsClientId=client)[0]
     finally:
         p.disconnect(client)
     ref = step_response(1e-5, 5e-4, 0.05, 0.01, 1e-4 * np.arange(1, 5001))
@@ -292,7 +300,8 @@ def test_urdf_into_a_robot_sets_damping_and_the_spring_extension(tmp_path):
 
 
 def test_urdf_into_a_robot_others_wrote_loads_in_pybullet(tmp_path):
-    """Franka Panda (pybullet's copy, meshes beside it): two text edits, pybullet reads the damping."""
+    """Franka Panda (pybullet's copy, meshes beside it): text edits only (damping, Gazebo and Drake
+    extensions, Drake's namespace on <robot>), pybullet reads the damping."""
     import difflib
     import shutil
 
@@ -306,10 +315,13 @@ def test_urdf_into_a_robot_others_wrote_loads_in_pybullet(tmp_path):
         joint_name="panda_joint4",
     )
     before, after = (f.read_text().splitlines() for f in (folder / "panda.urdf", out.path))
+    robot_tag = next(line for line in before if line.lstrip().startswith("<robot"))
+    declared = robot_tag.replace(">", ' xmlns:drake="http://drake.mit.edu">', 1)
     added = [line[2:].strip() for line in difflib.ndiff(before, after) if line.startswith("+ ")]
-    assert added[0] == '<dynamics damping="0.0005"/>' and "<springStiffness>0.05</springStiffness>" in added
-    removed = [line for line in difflib.ndiff(before, after) if line.startswith("- ")]
-    assert all(not line[2:].strip() for line in removed), "nothing of the host is lost"
+    assert added[0] == declared.strip() and added[1] == '<dynamics damping="0.0005"/>'
+    assert "<springStiffness>0.05</springStiffness>" in added and "<drake:linear_bushing_rpy>" in added
+    removed = [line[2:] for line in difflib.ndiff(before, after) if line.startswith("- ")]
+    assert all(not line.strip() or line == robot_tag for line in removed), "nothing of the host is lost"
     client = p.connect(p.DIRECT)
     try:
         body = p.loadURDF(str(out.path), useFixedBase=True, physicsClientId=client)
@@ -333,6 +345,21 @@ def test_urdf_into_a_robot_others_wrote_loads_in_pybullet(tmp_path):
     assert info[6] == 5e-4  # jointDamping
     k = movable.index(b"panda_joint4")
     assert out.advice["panda_joint4"].inertia == pytest.approx(mass_matrix[k, k], rel=1e-12)
+
+
+def test_urdf_spring_reaches_drake_through_its_bushing(tmp_path):
+    """A standalone URDF chain (hinge then slide, rest 0.2): Drake's joint forces are -k (q - rest)."""
+    pytest.importorskip("pydrake", reason="pydrake (Drake) is not installed: pip install drake")
+    from test_robot_hosts import drake_joint_torque
+
+    joint = Joint.from_coefficients({**THETA, "x": {"k": 0.8, "c": 2e-3, "m": 0.01}})
+    out = export_urdf(joint, tmp_path / "j.urdf", rest=0.2)
+    for name, k, positions in (
+        ("FlexJoint_theta", 0.05, [-2.8, 0.2, 3.0]),
+        ("FlexJoint_x", 800.0, [0.1, 0.2, 0.25]),
+    ):
+        got = drake_joint_torque(out.path, name, positions, prismatic=name.endswith("x"))
+        assert got == pytest.approx([-k * (q - 0.2) for q in positions], rel=1e-9, abs=1e-15), name
 
 
 def test_sdf_spring_becomes_a_drake_revolute_spring(tmp_path):
@@ -464,7 +491,9 @@ def test_urdf_into_a_ros_robot_with_transmissions(tmp_path, robot, joint):
     assert float(gazebo.text) == pytest.approx(0.33)
     for j_before, j_after in zip(before.iter("joint"), after.iter("joint"), strict=True):
         if not (j_after.get("name") == joint and j_after.getparent() is after):
-            assert etree.tostring(j_before) == etree.tostring(j_after)
+            # exclusive c14n: the namespaces declared on <robot> (Drake's is added) are not the joint's
+            c14n = {"method": "c14n", "exclusive": True}
+            assert etree.tostring(j_before, **c14n) == etree.tostring(j_after, **c14n)
 
 
 TENDON_HOST = """<mujoco model="knees">

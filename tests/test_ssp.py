@@ -10,11 +10,13 @@ import pytest
 
 from designer import Joint
 from designer.errors import DesignerError
-from designer.export.checks import step_response
+from designer.export.checks import libcosim_ssp_run, ssp_with_value, step_response
 from designer.export.ssp import export_ssp, read_ssv
 
 JOINT = Joint.from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}})
 STIFFER = Joint.from_coefficients({"x": {"k": 1.6, "c": 4e-3, "m": 0.01}})
+#: the SSV the SSD binds to the joint's component
+SSV = "resources/FlexJoint.ssv"
 
 
 def constant(value: float):
@@ -30,7 +32,10 @@ def test_ssd_runs_in_fmpy_like_the_fmus_and_alternatives_are_parameter_sets(tmp_
 
     wrist = Joint.from_coefficients({"theta": {"k": 50.0, "c": 0.5, "m": 1e-5}}, name="Wrist")
     path = export_ssp(
-        [JOINT, wrist], tmp_path / "joints.ssp", alternatives={"FlexJoint": {"stiffer": STIFFER}}
+        [JOINT, wrist],
+        tmp_path / "joints.ssp",
+        alternatives={"FlexJoint": {"stiffer": STIFFER}},
+        system_connectors=True,
     )
     ssd = read_ssd(str(path))  # validates against the normative SSP 1.0 schemas FMPy ships
     bound = {c.name: c.parameterBindings[0].source for c in ssd.system.elements}
@@ -76,6 +81,40 @@ def test_ssd_runs_in_fmpy_like_the_fmus_and_alternatives_are_parameter_sets(tmp_
     assert np.max(np.abs(x - step_response(0.01, 2.0, 800.0, 2.0, t))) < 1e-9
     assert np.max(np.abs(runs["bound"]["Wrist_theta.s"] - step_response(1e-5, 5e-4, 0.05, 0.01, t))) < 1e-9
     assert np.max(np.abs(runs["stiffer"]["FlexJoint_x.s"] - step_response(0.01, 4.0, 1600.0, 2.0, t))) < 1e-9
+
+
+def test_doubling_k_in_the_ssv_halves_the_deflection_in_fmpy_and_libcosim(tmp_path):
+    """Both SSP runners apply the SSD's parameter binding: k edited in the SSV alone changes the run."""
+    pytest.importorskip("libcosimpy")
+    from fmpy.ssp.simulation import simulate_ssp
+
+    from designer.export.ssp import bound_parameters, fmpy_parameter_set
+
+    load, k = 2.0, 800.0  # N, N/m: 2.5 mm static deflection
+    default = export_ssp(JOINT, tmp_path / "j.ssp")
+    stiff = ssp_with_value(default, tmp_path / "stiff.ssp", ssv=SSV, parameter="x.k", value=2 * k)
+    assert bound_parameters(stiff)["FlexJoint.x.k"] == 2 * k
+    # libcosim: every connection needs startElement and endElement, so the default SSD has none
+    assert b"<ssd:Connection " not in zipfile.ZipFile(default).read("SystemStructure.ssd")
+    got = [
+        libcosim_ssp_run(p, element="FlexJoint", load=("x.f", load), output="x.s")[-1]
+        for p in (default, stiff)
+    ]
+    assert got == pytest.approx([load / k, load / (2 * k)], rel=1e-9)
+    # fmpy.ssp drives the system's connectors (system_connectors=True) and applies the set it is given
+    wired = export_ssp(JOINT, tmp_path / "w.ssp", system_connectors=True)
+    stiff_wired = ssp_with_value(wired, tmp_path / "stiff_w.ssp", ssv=SSV, parameter="x.k", value=2 * k)
+    runs = [
+        simulate_ssp(
+            str(p),
+            stop_time=0.5,
+            step_size=1e-3,
+            parameter_set=fmpy_parameter_set(p),
+            input={"FlexJoint_x.f": constant(load)},
+        )["FlexJoint_x.s"][-1]
+        for p in (wired, stiff_wired)
+    ]
+    assert runs == pytest.approx([load / k, load / (2 * k)], rel=1e-9)
 
 
 def test_ssp_refuses_wrong_suffix_and_foreign_alternatives(tmp_path):

@@ -2,6 +2,8 @@
 
 sc = designer.cosim.load("examples/two_link_arm.toml")    # or designer.cosim.Scenario(...)
 result = designer.cosim.run(sc)                           # in memory, nothing written
+with designer.cosim.prepare(sc) as session:               # set-up once, then many runs
+    results = [session.run({"j1": {"theta.k": k}}) for k in (0.2, 0.3)]  # SI parameters
 frame = result.to_frame()                                 # t [s], then system.variable in SI
 designer.cosim.write_outputs(result, "results/")          # time series, metrics.json, plot.png
 """
@@ -11,6 +13,7 @@ from .references import Chirp, Sine, Step, Trajectory
 from .robot import Robot, SpringDamper, load_spec, planar_arm_xml
 from .run import Result, plot_result, run, write_outputs
 from .scenario import JointSource, Scenario, load
+from .session import Session, prepare
 
 __all__ = [
     "Chirp",
@@ -19,6 +22,7 @@ __all__ = [
     "Result",
     "Robot",
     "Scenario",
+    "Session",
     "Sine",
     "SpringDamper",
     "Step",
@@ -27,6 +31,7 @@ __all__ = [
     "load",
     "load_spec",
     "planar_arm_xml",
+    "prepare",
     "plot_result",
     "run",
     "write_outputs",

@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DesignerError
+from . import binding as kb
 
 PARAMETERS = ("m", "c", "k", "offset")
 STATUS = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
@@ -72,39 +73,73 @@ def _axes_of(md) -> set[str]:
     return {v.name.split(".")[0] for v in md.modelVariables if "." in v.name}
 
 
+class FmuDescription:
+    """An FMU's modelDescription.xml, read once: what a run needs from it.
+
+    `path` the archive (or the folder of an unpacked one), `md` fmpy's ModelDescription, `version`
+    2 or 3, `interface` "force" or "body" (of `axes`), `refs` variable name -> value reference,
+    `starts` variable name -> start value (as written), `axes` the axes the FMU has.
+
+    Raises:
+        DesignerError: the file is missing, not a readable FMU, without co-simulation, or lacks an axis.
+    """
+
+    def __init__(self, path: str | Path, axes: Sequence[str]) -> None:
+        from fmpy import read_model_description
+
+        path = Path(path)
+        if not path.exists():
+            raise DesignerError(
+                f"FMU {path} does not exist", "export one with `designer export fmu` or fix the path"
+            )
+        try:
+            md = read_model_description(str(path))
+        except Exception as exc:  # fmpy raises several types for a broken archive
+            raise DesignerError(
+                f"{path} is not a readable FMU: {exc}", "give an FMU exported by designer"
+            ) from None
+        if md.coSimulation is None:
+            raise DesignerError(f"FMU {path} has no co-simulation interface", "export it with co-simulation")
+        self.path, self.md = path, md
+        self.axes = sorted(_axes_of(md))
+        missing = [a for a in axes if a not in self.axes]
+        if missing:
+            raise DesignerError(
+                f"FMU {path} has no axis {', '.join(missing)}", f"it has: {', '.join(self.axes)}"
+            )
+        self.version = 3 if md.fmiVersion.startswith("3") else 2
+        self.refs = {v.name: v.valueReference for v in md.modelVariables}
+        self.starts = {v.name: v.start for v in md.modelVariables}
+        causality = {v.name: v.causality for v in md.modelVariables}
+        self.interface = "force" if causality.get(f"{axes[0]}.f") == "output" else "body"
+
+    def parameters(self, axis: str) -> dict[str, float]:
+        """The start values of the parameters m, c, k, offset on `axis` (SI), those it declares."""
+        starts = self.starts
+        return {p: float(starts[f"{axis}.{p}"]) for p in PARAMETERS if starts.get(f"{axis}.{p}") is not None}
+
+
 def read_parameters(path: str | Path, axis: str) -> dict[str, float]:
     """The start values of an FMU's parameters m, c, k, offset on `axis` (SI)."""
-    from fmpy import read_model_description
-
-    md = read_model_description(str(path))
-    starts = {v.name: v.start for v in md.modelVariables}
-    return {p: float(starts[f"{axis}.{p}"]) for p in PARAMETERS if starts.get(f"{axis}.{p}") is not None}
+    return FmuDescription(path, [axis]).parameters(axis)
 
 
 def check_fmu(path: str | Path, axes: Sequence[str]) -> str:
     """Raise a DesignerError unless `path` is a co-simulation FMU with these axes; return its interface."""
-    from fmpy import read_model_description
+    return FmuDescription(path, axes).interface
 
-    path = Path(path)
-    if not path.is_file():
-        raise DesignerError(
-            f"FMU {path} does not exist", "export one with `designer export fmu` or fix the path"
-        )
-    try:
-        md = read_model_description(str(path))
-    except Exception as exc:  # fmpy raises several types for a broken archive
-        raise DesignerError(
-            f"{path} is not a readable FMU: {exc}", "give an FMU exported by designer"
-        ) from None
-    if md.coSimulation is None:
-        raise DesignerError(f"FMU {path} has no co-simulation interface", "export it with co-simulation")
-    missing = [a for a in axes if a not in _axes_of(md)]
-    if missing:
-        raise DesignerError(
-            f"FMU {path} has no axis {', '.join(missing)}", f"it has: {', '.join(sorted(_axes_of(md)))}"
-        )
-    causality = {v.name: v.causality for v in md.modelVariables}
-    return "force" if causality.get(f"{axes[0]}.f") == "output" else "body"
+
+def unpack(path: str | Path, folder: str | Path) -> Path:
+    """Extract what an importer loads from an FMU (binaries/ and resources/, as FMPy's simulate_fmu
+    does) into `folder`: not the sources or documentation."""
+    from fmpy import extract
+
+    return Path(extract(str(path), str(folder), include=lambda n: n.startswith(("binaries/", "resources/"))))
+
+
+def fmi_function(fmu, name: str) -> int:
+    """The address of FMI function `name` in an fmpy FMU's loaded library."""
+    return ctypes.cast(getattr(fmu.dll, name), ctypes.c_void_p).value
 
 
 def _same_instant_capable(md) -> bool:
@@ -127,17 +162,26 @@ class FmuSystem:
 
     def __init__(
         self,
-        path: str | Path,
+        fmu: str | Path | FmuDescription,
         axes: Sequence[str],
         name: str = "joint",
         parameters: Mapping[str, float] | None = None,
+        *,
+        folder: str | Path | None = None,
     ) -> None:
-        from fmpy import extract, read_model_description
+        """Instantiate `fmu` (a path, or its description read once), set `parameters` (SI, keyed
+        "axis.field"), initialise it; unpacked into `folder` (kept by its owner) or a temporary
+        folder removed by `close` (an FMU already unpacked, a folder, is used where it is).
 
-        self.interface = check_fmu(path, axes)
-        md = read_model_description(str(path))
-        self.version = 3 if md.fmiVersion.startswith("3") else 2
-        me = self.interface == "force" and _same_instant_capable(md)
+        Raises:
+            DesignerError: not a usable FMU, an unknown parameter, or the FMU refused to start.
+        """
+        import tempfile
+
+        md = fmu if isinstance(fmu, FmuDescription) else FmuDescription(fmu, axes)
+        self.description, self.name = md, name
+        self.interface, self.version = md.interface, md.version
+        me = self.interface == "force" and _same_instant_capable(md.md)
         self.kind = "model-exchange" if me else "co-simulation"
         self.feedthrough = me
         self.delay = None
@@ -152,21 +196,52 @@ class FmuSystem:
         else:
             self.inputs = [f"{a}.f" for a in axes]
             self.outputs = [f"{a}.{v}" for a in axes for v in ("s", "v", "a")]
-        self._needs_cis = me and md.modelExchange.needsCompletedIntegratorStep
-        self._dir = extract(str(path))
+        self.needs_completed_step = bool(me and md.md.modelExchange.needsCompletedIntegratorStep)
+        self.parameters = dict(parameters or {})
+        unpacked = md.path.is_dir()
+        self._owned = folder is None and not unpacked
+        if unpacked:
+            self._dir = str(md.path)
+        else:
+            self._dir = tempfile.mkdtemp(prefix="designer-fmu-") if folder is None else str(folder)
         self.log: deque[str] = deque(maxlen=LOG_LINES)
         try:
-            self.fmu = self._instantiate(md, name, me)
-            refs = {v.name: v.valueReference for v in md.modelVariables}
-            for key, value in (parameters or {}).items():
-                if key not in refs:
-                    raise DesignerError(f"FMU {path} has no parameter '{key}'", "use names such as theta.k")
-                self._set_scalar(refs[key], float(value))
-            self._initialize(me)
-            self._bind(refs)
+            if not unpacked:
+                unpack(md.path, self._dir)
+            self.fmu = self._instantiate(md.md, name, me)
+            self._start(self.parameters)
+            self._bind(md.refs)
         except BaseException as exc:  # a half-built instance frees what it holds, then reports
             self._abandon()
-            self._refused(exc, name, parameters or {})
+            self._refused(exc, name, self.parameters)
+            raise
+
+    def _start(self, parameters: Mapping[str, float]) -> None:
+        """Set `parameters` and initialise (the instance is in its Instantiated state)."""
+        refs = self.description.refs
+        for key, value in parameters.items():
+            if key not in refs:
+                raise DesignerError(
+                    f"FMU {self.description.path} has no parameter '{key}'", "use names such as theta.k"
+                )
+            self._set_scalar(refs[key], float(value))
+        self._initialize(self.kind == "model-exchange")
+
+    def reset(self, parameters: Mapping[str, float] | None = None) -> None:
+        """Back to t = 0 for a new run: FMI Reset, the constructor's parameters updated with
+        `parameters` (SI, "axis.field"), initialised again; counters cleared.
+
+        Raises:
+            DesignerError: an unknown parameter, or the FMU refused the values (naming them).
+        """
+        given = self.parameters | dict(parameters or {})
+        self.log.clear()
+        self._steps, self._h = 0, 0.0
+        try:
+            self.fmu.reset()
+            self._start(given)
+        except Exception as exc:
+            self._refused(exc, self.name, given)
             raise
 
     def _refused(self, exc: BaseException, name: str, parameters: Mapping[str, float]) -> None:
@@ -189,7 +264,8 @@ class FmuSystem:
             with contextlib.suppress(Exception):
                 fmu.freeInstance()
         _LOGS.pop(getattr(self, "_token", None), None)
-        shutil.rmtree(self._dir, ignore_errors=True)
+        if self._owned:
+            shutil.rmtree(self._dir, ignore_errors=True)
 
     def _instantiate(self, md, name: str, me: bool):
         """An fmpy FMU2/FMU3 Model (me) or Slave, instantiated."""
@@ -228,7 +304,7 @@ class FmuSystem:
         for _ in range(1000):
             more, terminate, *_ = update()
             if terminate:
-                raise self._terminated()
+                raise self.terminated()
             if not more:
                 break
         else:
@@ -312,7 +388,7 @@ class FmuSystem:
                 return
             self._steps += 1
             self.fmu.setTime(self._steps * h)
-            if self._needs_cis:
+            if self.needs_completed_step:
                 self.completed(*self.fmu.completedIntegratorStep())
         except Exception as exc:
             self._surface(exc)
@@ -342,12 +418,52 @@ class FmuSystem:
             DesignerError: the FMU asked to terminate the simulation.
         """
         if terminate:
-            raise self._terminated()
+            raise self.terminated()
         if enter:
             self.fmu.enterEventMode()
             self._event_iteration()
 
-    def _terminated(self) -> DesignerError:
+    def binding(self) -> kb.Binding:
+        """The instance for the compiled kernel (see designer.cosim.binding): its FMI functions,
+        co-simulation (DoStep) or Model Exchange without states (SetTime, and
+        CompletedIntegratorStep when the FMU needs it), as `do_step` drives it."""
+        v, fmu = self.version, self.fmu
+        names = {
+            "set": "SetFloat64" if v == 3 else "SetReal",
+            "get": "GetFloat64" if v == 3 else "GetReal",
+            "step": "DoStep",
+            "time": "SetTime",
+            "completed": "CompletedIntegratorStep",
+        }
+        wanted = ["set", "get"]
+        if self.kind == "co-simulation":
+            wanted.append("step")
+        else:
+            wanted += ["time", "completed"] if self.needs_completed_step else ["time"]
+
+        def start() -> int:
+            return self._steps
+
+        def finish(steps: int) -> None:
+            self._steps = steps
+
+        def error(call: int, status: int, t: float) -> DesignerError:
+            return self.status_error(f"fmi{v}{names[kb.CALLS[call]]}", status, t)
+
+        return kb.Binding(
+            kb.FMI3 if v == 3 else kb.FMI2,
+            fmu.component,
+            start,
+            finish,
+            functions={w: fmi_function(fmu, f"fmi{v}{names[w]}") for w in wanted},
+            in_vr=self._in_vr,
+            out_vr=self._out_vr,
+            event=lambda: self.completed(True, False),
+            error=error,
+            terminated=self.terminated,
+        )
+
+    def terminated(self) -> DesignerError:
         return DesignerError(
             f"FMU instance {self.fmu.instanceName} asked to terminate the simulation",
             "check the FMU's inputs and parameters",
@@ -367,4 +483,5 @@ class FmuSystem:
             self.fmu.freeInstance()
         finally:
             _LOGS.pop(getattr(self, "_token", None), None)
-            shutil.rmtree(self._dir, ignore_errors=True)
+            if self._owned:
+                shutil.rmtree(self._dir, ignore_errors=True)

@@ -1,11 +1,12 @@
 """Run a Master's fixed-step loop in the compiled kernel (fmus/kernel/): same exchange, same bits, C speed.
 
 Python keeps everything but the loop: the Master checks the wiring and orders the exchange
-(`Master.schedule`), fmpy instantiates the FMUs, the Robot compiles the MuJoCo model. This module
-hands the kernel their raw pointers (each FMU's instance and its fmi2/fmi3 Set/Get/DoStep functions,
-mjModel and mjData, the motor references' numbers) and a preallocated output array, then reads the
-array. `run_master` picks the engine: the kernel when it can run every system, else the Python master
-(`Trace.engine` says which ran).
+(`Master.schedule`), fmpy instantiates the FMUs, the Robot compiles the MuJoCo model. Each system
+describes itself to the kernel through `binding()` (the contract in designer/cosim/binding.py): the
+address of its instance, its FMI functions and value references, and what to do before and after a
+run. `bind(master)` turns those into the kernel's structs once; `Bound.run` then only fills a
+preallocated output array. `run_master` picks the engine: the kernel when it can run every system,
+else the Python master (`Trace.engine` says which ran).
 """
 
 from __future__ import annotations
@@ -18,75 +19,28 @@ from ctypes import POINTER, c_double, c_int32, c_int64, c_uint32, c_void_p
 import numpy as np
 
 from ..errors import DesignerError
-from .fmu import FmuSystem
+from . import binding as kb
 from .master import Master, Trace, diverged, steps
-from .references import Chirp, Sine, Step, Trajectory
-from .rig import HubServo
-from .robot import Robot
+from .rig import ServoStruct
+from .robot import RobotStruct
 from .robot import diverged as robot_diverged
 
 ENGINES = ("auto", "kernel", "python")
 #: rows per kernel call without a progress callback
 CHUNK = 10000
-_ROBOT, _FMI2, _FMI3, _SERVO = 0, 1, 2, 3
 _OK, _FMU_STATUS, _DIVERGED, _ROBOT_DIVERGED, _EVENT, _TERMINATE = 0, 1, 2, 3, 4, 5
-_CALLS = {2: ("SetReal", "GetReal", "DoStep"), 3: ("SetFloat64", "GetFloat64", "DoStep")}
-_P_DOUBLE = POINTER(c_double)
-_P_INT = POINTER(c_int32)
-
-
-class _Reference(ctypes.Structure):
-    _fields_ = [
-        ("kind", c_int32),
-        ("n", c_int32),
-        ("p", c_double * 4),
-        ("t", _P_DOUBLE),
-        ("q", _P_DOUBLE),
-        ("cursor", c_int64),
-    ]
-
-
-class _Robot(ctypes.Structure):
-    _fields_ = [
-        ("model", c_void_p),
-        ("data", c_void_p),
-        ("n_joints", c_int32),
-        ("n_inputs", c_int32),
-        ("qposadr", _P_INT),
-        ("dofadr", _P_INT),
-        ("input_dof", _P_INT),
-        ("refs", POINTER(_Reference)),
-        ("motor_q", _P_DOUBLE),
-        ("motor_v", _P_DOUBLE),
-        ("steps", c_int64),
-        ("time", c_double),
-        ("n_engine", c_int32),
-        ("pad", c_int32),
-        ("engine_actuator", _P_INT),
-        ("engine_joint", _P_INT),
-        ("engine_law", _P_DOUBLE),
-    ]
-
-
-class _Servo(ctypes.Structure):
-    _fields_ = [
-        ("chirp", _Reference),
-        ("stiffness", c_double),
-        ("damping", c_double),
-        ("out", c_double * 2),
-        ("steps", c_int64),
-        ("h", c_double),
-    ]
 
 
 class _System(ctypes.Structure):
+    """kernel.h ks_system: one system of the graph, as its Binding describes it."""
+
     _fields_ = [
         ("kind", c_int32),
         ("n_in", c_int32),
         ("n_out", c_int32),
         ("out_offset", c_int32),
-        ("src", _P_INT),
-        ("in_buf", _P_DOUBLE),
+        ("src", kb.P_INT),
+        ("in_buf", kb.P_DOUBLE),
         ("instance", c_void_p),
         ("set_fn", c_void_p),
         ("get_fn", c_void_p),
@@ -102,14 +56,16 @@ class _System(ctypes.Structure):
 
 
 class _Run(ctypes.Structure):
+    """kernel.h ks_run: the systems, the schedule, the output rows and, after an error, what failed."""
+
     _fields_ = [
         ("n_systems", c_int32),
         ("n_ops", c_int32),
         ("n_cols", c_int32),
         ("pad", c_int32),
         ("systems", POINTER(_System)),
-        ("ops", _P_INT),
-        ("values", _P_DOUBLE),
+        ("ops", kb.P_INT),
+        ("values", kb.P_DOUBLE),
         ("step", c_double),
         ("n", c_int64),
         ("error_system", c_int32),
@@ -133,11 +89,11 @@ def library() -> ctypes.CDLL:
     lib = ctypes.CDLL(str(build_kernel()))
     lib.ks_run_rows.argtypes = [POINTER(_Run), c_int64, c_int64]
     lib.ks_run_rows.restype = c_int32
-    lib.ks_reference_eval.argtypes = [POINTER(_Reference), c_double, _P_DOUBLE, _P_DOUBLE]
+    lib.ks_reference_eval.argtypes = [POINTER(kb.Reference), c_double, kb.P_DOUBLE, kb.P_DOUBLE]
     lib.ks_reference_eval.restype = None
     sizes = (c_int64 * 5)()
     lib.ks_sizes(sizes)
-    mirror = [ctypes.sizeof(t) for t in (_Reference, _Robot, _Servo, _System, _Run)]
+    mirror = [ctypes.sizeof(t) for t in (kb.Reference, RobotStruct, ServoStruct, _System, _Run)]
     if list(sizes) != mirror:
         raise DesignerError(
             f"the kernel's structs ({list(sizes)} bytes) do not match their Python mirror ({mirror})",
@@ -146,198 +102,136 @@ def library() -> ctypes.CDLL:
     return lib
 
 
-def _ints(values) -> np.ndarray:
-    return np.ascontiguousarray(values, dtype=np.int32)
-
-
-def _ptr(array: np.ndarray, kind=_P_DOUBLE):
-    return array.ctypes.data_as(kind)
-
-
-def reference(ref, keep: list) -> _Reference:
-    """A motor reference as the kernel's struct; arrays it points to are appended to `keep`.
+def _describe(master: Master, name: str, system, out: _System, keep: list) -> kb.Binding:
+    """Fill `out` from the system's Binding; arrays it points to go to `keep`.
 
     Raises:
-        DesignerError: a reference type the kernel does not know (a Python callable), or a
-            trajectory without samples.
+        DesignerError: a system without `binding()` (one written in Python only).
     """
-    out = _Reference()
-    if isinstance(ref, Step):
-        out.kind, params = 0, (ref.amplitude, ref.at, ref.initial)
-    elif isinstance(ref, Sine):
-        out.kind, params = 1, (ref.amplitude, ref.frequency, ref.offset, ref.phase)
-    elif isinstance(ref, Chirp):
-        out.kind, params = 2, (ref.amplitude, ref.f0, ref.f1, ref.sweep)
-    elif isinstance(ref, Trajectory):
-        t, q = np.ascontiguousarray(ref.t, float), np.ascontiguousarray(ref.q, float)
-        if t.ndim != 1 or len(t) < 1 or q.shape != t.shape:
-            raise DesignerError(
-                f"the trajectory has {t.size} times and {q.size} angles",
-                "give one angle per time, at least one sample",
-            )
-        keep += [t, q]
-        out.kind, params, out.n, out.t, out.q = 3, (), len(t), _ptr(t), _ptr(q)
-    else:
+    make = getattr(system, "binding", None)
+    if make is None:
         raise DesignerError(
-            f"the kernel has no motor reference of type {type(ref).__name__}",
-            "use a step, sine, chirp or trajectory reference, or engine='python'",
+            f"the kernel cannot run system {name} ({type(system).__name__})",
+            "use engine='python' for systems written in Python",
         )
-    out.p[: len(params)] = [float(p) for p in params]
-    return out
+    b = make()
+    src = kb.ints(master.sources(name))
+    buf = np.zeros(len(src))
+    keep += [src, buf, b.keep]
+    out.kind, out.instance = b.kind, b.instance
+    out.n_in, out.n_out = len(system.inputs), len(system.outputs)
+    out.out_offset = master.output_slice(name).start
+    out.src, out.in_buf = kb.pointer(src, kb.P_INT), kb.pointer(buf)
+    for call in kb.CALLS:
+        setattr(out, f"{call}_fn", b.functions.get(call))
+    if b.in_vr is not None:
+        out.in_vr = ctypes.cast(b.in_vr, POINTER(c_uint32))
+    if b.out_vr is not None:
+        out.out_vr = ctypes.cast(b.out_vr, POINTER(c_uint32))
+    return b
 
 
-def _robot(robot: Robot, keep: list) -> _Robot:
-    """The robot as the kernel's struct: MuJoCo's mjModel/mjData pointers, its joints and motors,
-    the spring-dampers MuJoCo computes itself (the validation reference).
+class Bound:
+    """A master's systems bound to the kernel once (`bind`); `run` as many times as wanted, each
+    after the systems were reset (or left where the last run ended).
+
+    Raises (constructor):
+        DesignerError: the kernel cannot be built or cannot run one of the systems.
+    """
+
+    def __init__(self, master: Master) -> None:
+        self.master = master
+        self.lib = library()
+        self._keep: list = []
+        self._structs = (_System * len(master.systems))()
+        self._bindings = [
+            _describe(master, name, system, out, self._keep)
+            for out, (name, system) in zip(self._structs, master.systems.items(), strict=True)
+        ]
+        index = {name: i for i, name in enumerate(master.systems)}
+        self._ops = kb.ints(
+            [(0 if op == "get" else 1, index[name]) for op, name in master.schedule()]
+        ).ravel()
+
+    def _fail(self, run: _Run, rc: int) -> DesignerError:
+        """The error for the kernel's outcome `rc`: divergence, a stop request, an FMU's error status."""
+        if rc == _DIVERGED:
+            return diverged(run.error_time)
+        if rc == _ROBOT_DIVERGED:
+            return robot_diverged(run.error_time)
+        b = self._bindings[run.error_system]
+        if rc == _TERMINATE and b.terminated is not None:
+            return b.terminated()
+        return b.error(run.error_call, run.error_status, run.error_time)
+
+    def _events(self) -> None:
+        """Run the event iterations the Model Exchange instances asked for in their last step."""
+        for out, b in zip(self._structs, self._bindings, strict=True):
+            if out.asked:
+                out.asked = 0
+                b.finish(out.steps)
+                b.event()
+
+    def _loop(self, state: _Run, chunk: int, progress) -> None:
+        """Rows 0..n in chunks of `chunk` rows, progress after each; events handled between rows."""
+        n, first = state.n, 0
+        while first <= n:
+            last = min(first + chunk, n + 1)
+            rc = self.lib.ks_run_rows(ctypes.byref(state), first, last)
+            if rc == _EVENT:
+                self._events()
+                first = state.event_row + 1
+                continue
+            if rc != _OK:
+                raise self._fail(state, rc)
+            if progress is not None:
+                progress(min(last, n) / n)
+            first = last
+
+    def run(self, duration: float, step: float, *, progress: Callable[[float], None] | None = None) -> Trace:
+        """Run the bound systems from where they are for `duration` (s) at macro step `step` (s).
+
+        Raises:
+            DesignerError: an FMU returned Discard, Error or Fatal; the co-simulation diverged.
+        """
+        n = steps(duration, step)
+        master = self.master
+        for out, b in zip(self._structs, self._bindings, strict=True):
+            out.steps, out.asked, out.failed = b.start(), 0, 0
+        values = np.empty((n + 1, len(master.columns)))
+        state = _Run(
+            n_systems=len(self._structs),
+            n_ops=len(self._ops) // 2,
+            n_cols=values.shape[1],
+            systems=self._structs,
+            ops=kb.pointer(self._ops, kb.P_INT),
+            values=kb.pointer(values),
+            step=step,
+            n=n,
+        )
+        # back in Python every chunk: for the progress, and so that Ctrl-C stops a long run within ms
+        chunk = CHUNK if progress is None else max(1, n // 200)
+        try:
+            self._loop(state, chunk, progress)
+        finally:
+            for out, b in zip(self._structs, self._bindings, strict=True):
+                b.finish(out.steps)
+        return Trace(
+            time=np.arange(n + 1) * step,
+            columns=master.columns,
+            values=values,
+            delays=master.delays(),
+            engine="kernel",
+        )
+
+
+def bind(master: Master) -> Bound:
+    """`master`'s systems bound to the compiled kernel once (see `Bound`).
 
     Raises:
-        DesignerError: mujoco's bindings too old to give raw pointers.
+        DesignerError: the kernel cannot be built or cannot run one of the systems.
     """
-    if not hasattr(robot.model, "_address"):  # the raw pointers came with mujoco's 3.x bindings
-        raise DesignerError(
-            "this mujoco's Python bindings give no raw model pointers",
-            "update mujoco, or use engine='python'",
-        )
-    refs = (_Reference * len(robot.motors))(*[reference(r, keep) for r in robot.motors])
-    qposadr, dofadr, inputs = _ints(robot.qpos), _ints(robot.dof), _ints(robot._input_dof)
-    engine_act = _ints(robot.actuators)
-    engine_joint = _ints([robot.joints.index(j) for j in robot.in_engine])
-    engine_law = np.array([(v.k, v.c, v.offset) for v in robot.in_engine.values()], float).reshape(-1, 3)
-    keep += [refs, qposadr, dofadr, inputs, engine_act, engine_joint, engine_law]
-    return _Robot(
-        model=robot.model._address,
-        data=robot.data._address,
-        n_joints=len(robot.joints),
-        n_inputs=len(inputs),
-        qposadr=_ptr(qposadr, _P_INT),
-        dofadr=_ptr(dofadr, _P_INT),
-        input_dof=_ptr(inputs, _P_INT),
-        refs=refs,
-        motor_q=_ptr(robot.motor_q),
-        motor_v=_ptr(robot.motor_v),
-        steps=robot._steps,
-        time=robot.time,
-        n_engine=len(engine_act),
-        engine_actuator=_ptr(engine_act, _P_INT),
-        engine_joint=_ptr(engine_joint, _P_INT),
-        engine_law=_ptr(engine_law),
-    )
-
-
-def _function(fmu, name: str) -> int:
-    return ctypes.cast(getattr(fmu.dll, name), c_void_p).value
-
-
-def _fmu(system: FmuSystem, out: _System) -> None:
-    """An FMU instance: co-simulation (DoStep) or Model Exchange without states (SetTime, and
-    CompletedIntegratorStep when the FMU needs it), as FmuSystem.do_step drives it."""
-    fmu, v = system.fmu, system.version
-    out.kind = _FMI3 if v == 3 else _FMI2
-    out.instance = fmu.component
-    p = f"fmi{v}"
-    out.set_fn = _function(fmu, p + ("SetFloat64" if v == 3 else "SetReal"))
-    out.get_fn = _function(fmu, p + ("GetFloat64" if v == 3 else "GetReal"))
-    if system.kind == "co-simulation":
-        out.step_fn = _function(fmu, p + "DoStep")
-    else:
-        out.time_fn = _function(fmu, p + "SetTime")
-        if system._needs_cis:
-            out.completed_fn = _function(fmu, p + "CompletedIntegratorStep")
-    out.in_vr = ctypes.cast(system._in_vr, POINTER(c_uint32))
-    out.out_vr = ctypes.cast(system._out_vr, POINTER(c_uint32))
-    out.steps = system._steps
-
-
-def _systems(master: Master, keep: list) -> ctypes.Array:
-    """The master's systems as kernel structs, in its order.
-
-    Raises:
-        DesignerError: a system the kernel cannot run (not a Robot, FmuSystem or HubServo).
-    """
-    structs = (_System * len(master.systems))()
-    for out, (name, system) in zip(structs, master.systems.items(), strict=True):
-        src = _ints(master._src[name])
-        buf = np.zeros(len(src))
-        keep += [src, buf]
-        out.n_in, out.n_out = len(system.inputs), len(system.outputs)
-        out.out_offset = master._out[name].start
-        out.src, out.in_buf = _ptr(src, _P_INT), _ptr(buf)
-        if isinstance(system, Robot):
-            robot = _robot(system, keep)
-            keep.append(robot)
-            out.kind, out.instance = _ROBOT, ctypes.addressof(robot)
-        elif isinstance(system, FmuSystem):
-            _fmu(system, out)
-        elif isinstance(system, HubServo):
-            servo = _Servo(
-                reference(system.chirp, keep),
-                system.stiffness,
-                system.damping,
-                (c_double * 2)(*system._out),
-                system._steps,
-                system._h,
-            )
-            keep.append(servo)
-            out.kind, out.instance = _SERVO, ctypes.addressof(servo)
-        else:
-            raise DesignerError(
-                f"the kernel cannot run system {name} ({type(system).__name__})",
-                "use engine='python' for systems written in Python",
-            )
-    return structs
-
-
-def _fail(master: Master, run: _Run, rc: int) -> DesignerError:
-    """The error for the kernel's outcome `rc`: divergence, a stop request, an FMU's error status."""
-    if rc == _DIVERGED:
-        return diverged(run.error_time)
-    if rc == _ROBOT_DIVERGED:
-        return robot_diverged(run.error_time)
-    name = list(master.systems)[run.error_system]
-    system = master.systems[name]
-    if rc == _TERMINATE:
-        return system._terminated()
-    call = (*_CALLS[system.version], "SetTime", "CompletedIntegratorStep")[run.error_call]
-    return system.status_error(f"fmi{system.version}{call}", run.error_status, run.error_time)
-
-
-def _events(master: Master, structs: ctypes.Array) -> None:
-    """Run the event iterations the Model Exchange instances asked for in their last step."""
-    for out, system in zip(structs, master.systems.values(), strict=True):
-        if out.asked:
-            out.asked = 0
-            system._steps = out.steps
-            system.completed(True, False)
-
-
-def _loop(lib: ctypes.CDLL, master: Master, state: _Run, structs: ctypes.Array, chunk: int, progress) -> None:
-    """Rows 0..n in chunks of `chunk` rows, progress after each; events handled between rows."""
-    n, first = state.n, 0
-    while first <= n:
-        last = min(first + chunk, n + 1)
-        rc = lib.ks_run_rows(ctypes.byref(state), first, last)
-        if rc == _EVENT:
-            _events(master, structs)
-            first = state.event_row + 1
-            continue
-        if rc != _OK:
-            raise _fail(master, state, rc)
-        if progress is not None:
-            progress(min(last, n) / n)
-        first = last
-
-
-def _sync(master: Master, structs: ctypes.Array) -> None:
-    """Hand the step counts and times the kernel advanced back to the Python systems."""
-    for out, system in zip(structs, master.systems.values(), strict=True):
-        if isinstance(system, Robot):
-            robot = _Robot.from_address(out.instance)
-            system._steps, system.time = robot.steps, robot.time
-        elif isinstance(system, HubServo):
-            servo = _Servo.from_address(out.instance)
-            system._steps, system._h, system._out[:] = servo.steps, servo.h, list(servo.out)
-        else:
-            system._steps = out.steps
+    return Bound(master)
 
 
 def run(
@@ -351,36 +245,7 @@ def run(
         DesignerError: the kernel cannot be built or cannot run a system; an FMU returned Discard,
             Error or Fatal; the co-simulation diverged.
     """
-    n = steps(duration, step)
-    lib = library()
-    keep: list = []
-    structs = _systems(master, keep)
-    index = {name: i for i, name in enumerate(master.systems)}
-    ops = _ints([(0 if op == "get" else 1, index[name]) for op, name in master.schedule()]).ravel()
-    values = np.empty((n + 1, len(master.columns)))
-    state = _Run(
-        n_systems=len(structs),
-        n_ops=len(ops) // 2,
-        n_cols=values.shape[1],
-        systems=structs,
-        ops=_ptr(ops, _P_INT),
-        values=_ptr(values),
-        step=step,
-        n=n,
-    )
-    # back in Python every chunk: for the progress, and so that Ctrl-C stops a long run within ms
-    chunk = CHUNK if progress is None else max(1, n // 200)
-    try:
-        _loop(lib, master, state, structs, chunk, progress)
-    finally:
-        _sync(master, structs)
-    return Trace(
-        time=np.arange(n + 1) * step,
-        columns=master.columns,
-        values=values,
-        delays=master.delays(),
-        engine="kernel",
-    )
+    return bind(master).run(duration, step, progress=progress)
 
 
 def run_master(
@@ -390,23 +255,26 @@ def run_master(
     *,
     progress: Callable[[float], None] | None = None,
     engine: str = "auto",
+    bound: Bound | None = None,
 ) -> Trace:
     """Run `master` with `engine`: "kernel", "python" (Master.run), or "auto" (the kernel when it can).
 
     "auto" falls back to the Python master when there is no C compiler or a system is one the kernel
-    cannot run (a system written in Python); `Trace.engine` says which ran.
+    cannot run (a system written in Python); `Trace.engine` says which ran. `bound`, the master bound
+    once by `bind`, saves binding it again.
 
     Raises:
         DesignerError: unknown engine; with engine="kernel", the kernel cannot run; any run error.
     """
     if engine not in ENGINES:
         raise DesignerError(f"unknown engine '{engine}'", f"use one of: {', '.join(ENGINES)}")
-    if engine == "auto":
-        try:
-            library()
-            _systems(master, [])
-        except DesignerError:
-            engine = "python"
     if engine == "python":
         return master.run(duration, step, progress)
-    return run(master, duration, step, progress=progress)
+    if bound is None:
+        try:
+            bound = bind(master)
+        except DesignerError:
+            if engine == "kernel":
+                raise
+            return master.run(duration, step, progress)
+    return bound.run(duration, step, progress=progress)

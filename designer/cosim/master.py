@@ -31,6 +31,10 @@ ALGORITHMS = ("gauss-seidel", "jacobi")
 
 
 class System(Protocol):
+    """A system the master steps. `reset()` brings it back to t = 0 for a new run (a prepared
+    Session resets every system before each run). A system the compiled kernel can run also has
+    `binding() -> designer.cosim.binding.Binding` (the kernel contract)."""
+
     inputs: list[str]
     outputs: list[str]
     feedthrough: bool
@@ -38,6 +42,7 @@ class System(Protocol):
     def get(self) -> np.ndarray: ...
     def set(self, values: np.ndarray) -> None: ...
     def do_step(self, h: float) -> None: ...
+    def reset(self) -> None: ...
 
 
 @dataclass(frozen=True)
@@ -154,6 +159,14 @@ class Master:
     def _index(self, ref: str, kind: str) -> int:
         name, var = self._split(ref)
         return self._out[name].start + self._position(name, var, kind)
+
+    def sources(self, name: str) -> list[int]:
+        """The output column feeding each input of system `name`, in its `inputs` order."""
+        return [int(i) for i in self._src[name]]
+
+    def output_slice(self, name: str) -> slice:
+        """The columns of system `name`'s outputs in a row of `columns`."""
+        return self._out[name]
 
     def delays(self) -> tuple[str, ...]:
         """The systems' statements of outputs lagging their inputs by one step (see FmuSystem.delay)."""

@@ -8,13 +8,30 @@ in one piece by scipy at tight tolerance.
 
 from __future__ import annotations
 
+import ctypes
+from ctypes import c_double, c_int64
+
 import numpy as np
 
 from ..errors import DesignerError
+from . import binding as kb
 from .references import Chirp
 
 #: hub servo stiffness as a multiple of the specimen's k
 HUB_GAIN = 4.0
+
+
+class ServoStruct(ctypes.Structure):
+    """kernel.h ks_servo: the hub as the compiled kernel runs it."""
+
+    _fields_ = [
+        ("chirp", kb.Reference),
+        ("stiffness", c_double),
+        ("damping", c_double),
+        ("out", c_double * 2),
+        ("steps", c_int64),
+        ("h", c_double),
+    ]
 
 
 class HubServo:
@@ -28,9 +45,14 @@ class HubServo:
         self.chirp = chirp
         self.stiffness = stiffness
         self.damping = damping
+        self._out = np.zeros(2)
+        self.reset()
+
+    def reset(self) -> None:
+        """Back to t = 0."""
         self._steps = 0
         self._h = 0.0
-        self._out = np.zeros(2)
+        self._out[:] = 0.0
 
     def set(self, values: np.ndarray) -> None:
         q, dq = self.chirp(self._steps * self._h)
@@ -43,6 +65,23 @@ class HubServo:
     def do_step(self, h: float) -> None:
         self._h = h
         self._steps += 1
+
+    def binding(self) -> kb.Binding:
+        """The hub for the compiled kernel (see designer.cosim.binding)."""
+        keep: list = []
+        struct = ServoStruct(kb.reference(self.chirp, keep))
+        keep.append(struct)
+
+        def start() -> int:
+            struct.stiffness, struct.damping = self.stiffness, self.damping
+            struct.out[:] = list(self._out)
+            struct.steps, struct.h, struct.chirp.cursor = self._steps, self._h, 0
+            return self._steps
+
+        def finish(steps: int) -> None:
+            self._steps, self._h, self._out[:] = struct.steps, struct.h, list(struct.out)
+
+        return kb.Binding(kb.SERVO, ctypes.addressof(struct), start, finish, keep=keep)
 
 
 def servo_gains(m: float, c: float, k: float) -> tuple[float, float]:

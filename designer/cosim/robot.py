@@ -8,13 +8,16 @@ MuJoCo (a `general` actuator with affine bias) as the validation reference.
 
 from __future__ import annotations
 
+import ctypes
 from collections.abc import Mapping, Sequence
+from ctypes import POINTER, c_double, c_int32, c_int64, c_void_p
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import DesignerError
+from . import binding as kb
 from .references import Reference
 
 INTEGRATORS = ("euler", "implicitfast", "implicit", "rk4")
@@ -105,11 +108,67 @@ def diverged(t: float) -> DesignerError:
 
 @dataclass(frozen=True)
 class SpringDamper:
-    """The law computed in-engine for the reference: tau = -(k (s - offset) + c v), SI."""
+    """The joint's law computed inside MuJoCo (the validation reference and the sweeps' in-engine
+    path): tau = -(k (s - offset) + c v), SI, with s = q - q_motor and v = q' - q_motor' its
+    deflection and rate. This class is its one definition: MuJoCo computes it as a `general`
+    actuator with affine bias (gain 1, bias -k q - c q') driven by `control`; the compiled kernel
+    (fmus/kernel/systems.c) and the sweeps' rollout (designer/sweep/engine.py) compute `control` too,
+    and tests/test_cosim.py checks each against `torque`.
+    """
 
     k: float
     c: float
     offset: float = 0.0
+
+    def torque(self, s, v):
+        """The torque (N.m, or N on a slide) at deflection `s` and rate `v` (arrays broadcast)."""
+        return -(self.k * (s - self.offset) + self.c * v)
+
+    def control(self, motor_q, motor_v):
+        """The actuator control that makes MuJoCo's affine bias equal `torque` for motor angle
+        `motor_q` and rate `motor_v` (arrays broadcast): k (q_motor + offset) + c q_motor'."""
+        return self.k * (motor_q + self.offset) + self.c * motor_v
+
+    def actuator(self, spec, joint: str):
+        """Add the `general` actuator `flex_<joint>` computing this law to MuJoCo spec `spec`."""
+        import mujoco
+
+        act = spec.add_actuator(
+            name=f"flex_{joint}",
+            target=joint,
+            trntype=mujoco.mjtTrn.mjTRN_JOINT,
+            gaintype=mujoco.mjtGain.mjGAIN_FIXED,
+            biastype=mujoco.mjtBias.mjBIAS_AFFINE,
+        )
+        act.gainprm[0] = 1.0
+        act.biasprm[1] = -self.k
+        act.biasprm[2] = -self.c
+        act.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
+        return act
+
+
+class RobotStruct(ctypes.Structure):
+    """kernel.h ks_robot: the robot as the compiled kernel steps it."""
+
+    _fields_ = [
+        ("model", c_void_p),
+        ("data", c_void_p),
+        ("n_joints", c_int32),
+        ("n_inputs", c_int32),
+        ("qposadr", kb.P_INT),
+        ("dofadr", kb.P_INT),
+        ("input_dof", kb.P_INT),
+        ("refs", POINTER(kb.Reference)),
+        ("motor_q", kb.P_DOUBLE),
+        ("motor_v", kb.P_DOUBLE),
+        ("steps", c_int64),
+        ("time", c_double),
+        ("n_engine", c_int32),
+        ("pad", c_int32),
+        ("engine_actuator", kb.P_INT),
+        ("engine_joint", kb.P_INT),
+        ("engine_law", kb.P_DOUBLE),
+    ]
 
 
 class Robot:
@@ -135,17 +194,7 @@ class Robot:
         spec.option.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{integrator.upper()}")
         self.in_engine = dict(in_engine or {})
         for name, law in self.in_engine.items():
-            act = spec.add_actuator(
-                name=f"flex_{name}",
-                target=name,
-                trntype=mujoco.mjtTrn.mjTRN_JOINT,
-                gaintype=mujoco.mjtGain.mjGAIN_FIXED,
-                biastype=mujoco.mjtBias.mjBIAS_AFFINE,
-            )
-            act.gainprm[0] = 1.0
-            act.biasprm[1] = -law.k
-            act.biasprm[2] = -law.c
-            act.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
+            law.actuator(spec, name)
         self.model = spec.compile()
         if constraint_free(self.model):  # same result, 20 % less per step on the built-in arm
             self.model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
@@ -161,10 +210,17 @@ class Robot:
         self.inputs = [f"{j}.tau" for j in driven]
         self._input_dof = np.array([self.model.joint(j).dofadr[0] for j in driven], dtype=int)
         self.outputs = [f"{j}.{v}" for v in ("s", "v", "q", "motor") for j in self.joints]
-        self.time = 0.0
-        self._steps = 0
         self.motor_q = np.zeros(len(self.joints))
         self.motor_v = np.zeros(len(self.joints))
+        self.reset()
+
+    def reset(self) -> None:
+        """Back to t = 0 (mj_resetData, counters), each link undeflected where its motor puts it."""
+        import mujoco
+
+        mujoco.mj_resetData(self.model, self.data)
+        self.time = 0.0
+        self._steps = 0
         self._motor(0.0)
         # start undeflected: each link where its motor puts it, moving with it
         self.data.qpos[self.qpos] = self.motor_q
@@ -187,12 +243,58 @@ class Robot:
         """Advance one physics step (h must be the model's timestep), then move the motors to t + h."""
         for i, (j, law) in enumerate(self.in_engine.items()):
             k = self.joints.index(j)
-            self.data.ctrl[self.actuators[i]] = (
-                law.k * (self.motor_q[k] + law.offset) + law.c * self.motor_v[k]
-            )
+            self.data.ctrl[self.actuators[i]] = law.control(self.motor_q[k], self.motor_v[k])
         self._mj_step(self.model, self.data)
         if self._bad.number:
             raise diverged(self.time)
         self._steps += 1
         self.time = self._steps * h
         self._motor(self.time)
+
+    def binding(self) -> kb.Binding:
+        """The robot for the compiled kernel (see designer.cosim.binding): MuJoCo's mjModel/mjData
+        pointers, its joints and motors, the spring-dampers MuJoCo computes itself.
+
+        Raises:
+            DesignerError: mujoco's bindings too old to give raw pointers, or a motor reference the
+                kernel does not know.
+        """
+        if not hasattr(self.model, "_address"):  # the raw pointers came with mujoco's 3.x bindings
+            raise DesignerError(
+                "this mujoco's Python bindings give no raw model pointers",
+                "update mujoco, or use engine='python'",
+            )
+        keep: list = []
+        refs = (kb.Reference * len(self.motors))(*[kb.reference(r, keep) for r in self.motors])
+        qposadr, dofadr, inputs = kb.ints(self.qpos), kb.ints(self.dof), kb.ints(self._input_dof)
+        engine_act = kb.ints(self.actuators)
+        engine_joint = kb.ints([self.joints.index(j) for j in self.in_engine])
+        engine_law = np.array([(v.k, v.c, v.offset) for v in self.in_engine.values()], float).reshape(-1, 3)
+        struct = RobotStruct(
+            model=self.model._address,
+            data=self.data._address,
+            n_joints=len(self.joints),
+            n_inputs=len(inputs),
+            qposadr=kb.pointer(qposadr, kb.P_INT),
+            dofadr=kb.pointer(dofadr, kb.P_INT),
+            input_dof=kb.pointer(inputs, kb.P_INT),
+            refs=refs,
+            motor_q=kb.pointer(self.motor_q),
+            motor_v=kb.pointer(self.motor_v),
+            n_engine=len(engine_act),
+            engine_actuator=kb.pointer(engine_act, kb.P_INT),
+            engine_joint=kb.pointer(engine_joint, kb.P_INT),
+            engine_law=kb.pointer(engine_law),
+        )
+        keep += [refs, qposadr, dofadr, inputs, engine_act, engine_joint, engine_law, struct]
+
+        def start() -> int:
+            struct.steps, struct.time = self._steps, self.time
+            for ref in refs:
+                ref.cursor = 0
+            return self._steps
+
+        def finish(steps: int) -> None:
+            self._steps, self.time = struct.steps, struct.time
+
+        return kb.Binding(kb.ROBOT, ctypes.addressof(struct), start, finish, keep=keep)

@@ -6,9 +6,8 @@ robot or the rig, computes the metrics and, when asked, compares with the refere
 
 from __future__ import annotations
 
-import contextlib
 import json
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -17,13 +16,13 @@ import numpy as np
 
 from .. import units
 from ..errors import DesignerError, check_type, path_argument
-from ..files import atomic_folder, atomic_path, atomic_write, private_tempdir
-from .fmu import FmuSystem, read_parameters
+from ..files import atomic_folder, atomic_path, atomic_write
 from .kernel import run_master
 from .master import Master, Trace
 from .metrics import joint_metrics
-from .robot import Robot, SpringDamper, load_spec
-from .scenario import JointSource, Scenario
+from .robot import SpringDamper
+from .scenario import Scenario
+from .session import Session, prepare, robot_system
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -86,114 +85,18 @@ class Result:
         return out
 
 
-@contextlib.contextmanager
-def joint_fmus(sc: Scenario) -> Iterator[dict[str, Path]]:
-    """The FMU file of every joint (key "rig" for the rig), exporting the others into a temporary folder."""
-    sources = {"rig": sc.rig_joint} if sc.kind == "rig" else sc.joints
-    with private_tempdir("designer-cosim-") as tmp:  # the FMUs' unpacked folders go in there too
-        paths = {}
-        for name, src in sources.items():
-            if src.fmu is not None:
-                paths[name] = src.fmu
-                continue
-            from ..export.fmu import export_fmu
-
-            interface = "body" if sc.kind == "rig" else "force"
-            paths[name] = export_fmu(
-                src.joint, Path(tmp) / f"{name}.fmu", fmi_version=src.fmi_version, interface=interface
-            )
-        yield paths
-
-
-def law(src: JointSource, path: Path) -> dict[str, float]:
-    """The SI parameters m, c, k, offset the joint's FMU runs with (start values, then overrides)."""
-    params = read_parameters(path, src.axis)
-    for key, value in src.parameters.items():
-        axis, _, q = key.partition(".")
-        if axis == src.axis:
-            params[q] = float(value)
-    params.setdefault("offset", 0.0)
-    return params
-
-
-def robot_run(
-    sc: Scenario,
-    fmus: Mapping[str, Path],
-    step: float,
-    duration: float,
-    algorithm: str,
-    progress: Progress = None,
-    engine: str = "auto",
-) -> Trace:
-    """The robot co-simulated with its joint FMUs at macro step `step`, by `engine` (kernel.run_master)."""
-    robot = Robot(load_spec(sc.model, sc.lengths, sc.masses), sc.motors, step, sc.integrator)
-    systems: dict = {"robot": robot}
-    connections = []
-    try:
-        for name, src in sc.joints.items():
-            systems[name] = FmuSystem(fmus[name], [src.axis], name=name, parameters=src.parameters)
-            if systems[name].interface != "force":
-                raise DesignerError(
-                    f"the FMU of joint {name} has the body interface", "export it with interface='force'"
-                )
-            a = src.axis
-            connections += [
-                (f"robot.{name}.s", f"{name}.{a}.s"),
-                (f"robot.{name}.v", f"{name}.{a}.v"),
-                (f"{name}.{a}.f", f"robot.{name}.tau"),
-            ]
-        master = Master(systems, connections, algorithm)
-        return run_master(master, duration, step, progress=progress, engine=engine)
-    finally:
-        for s in systems.values():
-            if isinstance(s, FmuSystem):
-                s.close()
-
-
-def robot_reference(sc: Scenario, laws: Mapping, step: float, duration: float, integrator: str) -> Trace:
-    """The same robot with every joint's spring-damper computed inside MuJoCo."""
-    springs = {j: SpringDamper(p["k"], p["c"], p["offset"]) for j, p in laws.items()}
-    robot = Robot(load_spec(sc.model, sc.lengths, sc.masses), sc.motors, step, integrator, in_engine=springs)
-    return run_master(Master({"robot": robot}, []), duration, step)
-
-
-def rig_run(
-    sc: Scenario,
-    fmu: Path,
-    params: Mapping,
-    step: float,
-    duration: float,
-    progress: Progress = None,
-    engine: str = "auto",
-) -> Trace:
-    """The hub servo driving the joint FMU's body interface, by `engine` (see kernel.run_master)."""
-    from .rig import HubServo, check_stable, servo_gains
-
-    check_stable(params["m"], params["c"], params["k"], step)
-    a = sc.rig_joint.axis
-    joint = FmuSystem(fmu, [a], name="joint", parameters=sc.rig_joint.parameters)
-    try:
-        if joint.interface != "body":
-            raise DesignerError("the rig's FMU has the force interface", "export it with interface='body'")
-        hub = HubServo(sc.hub, *servo_gains(params["m"], params["c"], params["k"]))
-        connections = [(f"joint.{a}.s", "hub.s"), (f"joint.{a}.v", "hub.v"), ("hub.f", f"joint.{a}.f")]
-        master = Master({"joint": joint, "hub": hub}, connections, sc.algorithm)
-        return run_master(master, duration, step, progress=progress, engine=engine)
-    finally:
-        joint.close()
-
-
 def _angles(res: Trace, joints) -> np.ndarray:
     return np.column_stack([res.column(f"robot.{j}.q") for j in joints])
 
 
-def _validate_rig(sc: Scenario, fmus: Mapping[str, Path], laws: Mapping, progress: Progress) -> dict:
+def _validate_rig(session: Session, case: Mapping, laws: Mapping, progress: Progress) -> dict:
     from .rig import reference
 
+    sc = session.scenario
     p, rows = laws["rig"], []
     steps = sorted(sc.validation_steps, reverse=True)
     for i, h in enumerate([sc.step, *steps]):
-        res = rig_run(sc, fmus["rig"], p, h, sc.validation_duration)
+        res = session.trace(case, step=h, duration=sc.validation_duration)
         s = res.column(f"joint.{sc.rig_joint.axis}.s")
         error = np.max(np.abs(s - reference(p["m"], p["c"], p["k"], sc.hub, res.time)))
         rows.append({"step": h, "max_error": float(error)})
@@ -206,12 +109,20 @@ def _validate_rig(sc: Scenario, fmus: Mapping[str, Path], laws: Mapping, progres
     }
 
 
-def _validate_robot(sc: Scenario, fmus: Mapping[str, Path], laws: Mapping, progress: Progress) -> dict:
+def robot_reference(sc: Scenario, laws: Mapping, step: float, duration: float, integrator: str) -> Trace:
+    """The same robot with every joint's spring-damper computed inside MuJoCo."""
+    springs = {j: SpringDamper(p["k"], p["c"], p["offset"]) for j, p in laws.items()}
+    robot = robot_system(sc, step, integrator=integrator, in_engine=springs)
+    return run_master(Master({"robot": robot}, []), duration, step)
+
+
+def _validate_robot(session: Session, case: Mapping, laws: Mapping, progress: Progress) -> dict:
+    sc = session.scenario
     duration, joints = sc.validation_duration, list(sc.joints)
     steps = sorted(sc.validation_steps, reverse=True)
     fine = min(steps) / 4
     ref_fine = _angles(robot_reference(sc, laws, fine, duration, "rk4"), joints)
-    same = _angles(robot_run(sc, fmus, sc.step, duration, sc.algorithm), joints)
+    same = _angles(session.trace(case, duration=duration), joints)
     same_ref = _angles(robot_reference(sc, laws, sc.step, duration, sc.integrator), joints)
     rows = []
     for i, h in enumerate(steps):
@@ -221,7 +132,7 @@ def _validate_robot(sc: Scenario, fmus: Mapping[str, Path], laws: Mapping, progr
                 f"validation step {h:g} s is not a multiple of {fine:g} s",
                 "use steps halving from the largest",
             )
-        q = _angles(robot_run(sc, fmus, h, duration, sc.algorithm), joints)
+        q = _angles(session.trace(case, step=h, duration=duration), joints)
         q_same = _angles(robot_reference(sc, laws, h, duration, sc.integrator), joints)
         rows.append(
             {
@@ -269,10 +180,40 @@ def rig_metrics(sc: Scenario, res: Trace, params: Mapping) -> dict:
     }
 
 
+def result(
+    session: Session,
+    case: Mapping[str, Mapping[str, float]],
+    duration: float | None,
+    engine: str,
+    validate: bool,
+    progress: Progress,
+) -> Result:
+    """One run of a prepared session (what `Session.run` returns; `case` as Session.parameters gives it)."""
+    share = 0.5 if validate else 1.0
+
+    def part(offset: float, scale: float) -> Progress:
+        return None if progress is None else (lambda f: progress(offset + scale * f))
+
+    sc = session.scenario
+    laws = session.laws(case)
+    trace = session.trace(case, duration=duration, progress=part(0.0, share), engine=engine)
+    if sc.kind == "rig":
+        metrics, check = rig_metrics(sc, trace, laws["rig"]), _validate_rig
+    else:
+        metrics, check = robot_metrics(sc, trace, laws), _validate_robot
+    validation = check(session, case, laws, part(share, 1.0 - share)) if validate else None
+    return Result(
+        sc, trace.time, trace.columns, trace.values, metrics, laws, validation, trace.delays, trace.engine
+    )
+
+
 def run(
     scenario: Scenario, *, validate: bool = False, progress: Progress = None, engine: str = "auto"
 ) -> Result:
-    """Co-simulate `scenario` and return the result in memory; no file is written.
+    """Co-simulate `scenario` once and return the result in memory; no file is written.
+
+    `with prepare(scenario) as s: return s.run(...)`: for many runs of one scenario, prepare a
+    `Session` yourself and call its `run` per case.
 
     Args:
         scenario: a `Scenario` (built in code, or read by `designer.cosim.load`).
@@ -284,31 +225,11 @@ def run(
             and it can run every system; `Result.engine` says which ran.
 
     Raises:
-        DesignerError: an FMU that cannot be loaded, a co-simulation that diverges.
+        DesignerError: a bad scenario, an FMU that cannot be loaded or refuses its parameters, a
+            co-simulation that diverges.
     """
-    share = 0.5 if validate else 1.0
-
-    def part(offset: float, scale: float) -> Progress:
-        return None if progress is None else (lambda f: progress(offset + scale * f))
-
-    fix = "read one with designer.cosim.load(path)"
-    check_type(scenario, Scenario, "scenario", expected="a Scenario", fix=fix)
-    sc = scenario
-    with joint_fmus(sc) as fmus:
-        if sc.kind == "rig":
-            laws = {"rig": law(sc.rig_joint, fmus["rig"])}
-            trace = rig_run(sc, fmus["rig"], laws["rig"], sc.step, sc.duration, part(0.0, share), engine)
-            metrics = rig_metrics(sc, trace, laws["rig"])
-            check = _validate_rig if validate else None
-        else:
-            laws = {j: law(src, fmus[j]) for j, src in sc.joints.items()}
-            trace = robot_run(sc, fmus, sc.step, sc.duration, sc.algorithm, part(0.0, share), engine)
-            metrics = robot_metrics(sc, trace, laws)
-            check = _validate_robot if validate else None
-        validation = None if check is None else check(sc, fmus, laws, part(share, 1.0 - share))
-    return Result(
-        sc, trace.time, trace.columns, trace.values, metrics, laws, validation, trace.delays, trace.engine
-    )
+    with prepare(scenario) as session:
+        return session.run(validate=validate, progress=progress, engine=engine)
 
 
 def rig_log(result: Result) -> pd.DataFrame:
@@ -350,7 +271,7 @@ def write_outputs(
     staging folder beside `folder` and moved in together, so an interrupt leaves the folder as it was.
 
     Raises:
-        DesignerError: `folder` is a file or cannot be created or written.
+        DesignerError: `folder` is a file or cannot be created or written; `result` is not a Result.
     """
     check_type(result, Result, "result", expected="a Result", fix="give what designer.cosim.run returns")
     out = path_argument(folder, "folder", what="a folder")

@@ -1,16 +1,18 @@
-"""Scenarios: what to co-simulate, built in code (checked when built) or read from a TOML file.
+"""Scenarios: what to co-simulate, built in code or read from a TOML file.
 
 A scenario is either a robot (`joints`: flexible joints of a MuJoCo model, each driven by a motor
-reference) or the virtual rig (`rig_joint` driven by the hub chirp). `Scenario(...)` checks every
-value when it is built, so a run never starts on a bad scenario; `load(path)` also checks the file's
-keys and types and names the file and key of the first problem. The README documents every key.
+reference) or the virtual rig (`rig_joint` driven by the hub chirp). `Scenario(...)` stores its values
+(so `dataclasses.replace` is free); `Scenario.check()` checks every value and fills the defaults, and
+`load(path)` and `designer.cosim.prepare` call it, so a run never starts on a bad scenario. `load`
+also checks the file's keys and types and names the file and key of the first problem. The README
+documents every key.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -33,8 +35,9 @@ class JointSource:
     """Where a joint FMU comes from: an FMU file, or a `Joint` exported on the fly.
 
     `parameters` overrides FMU parameters in SI, keyed "axis.field" (e.g. {"theta.k": 0.3}).
+    Building one stores the values; `check()` (called by `load` and `prepare`) checks them.
 
-    Raises:
+    Check raises:
         DesignerError: not exactly one of `fmu` and `joint`, an unknown axis, an FMU file that is
             missing or lacks the axis, a joint without the axis, a bad `fmi_version` or parameter.
     """
@@ -45,7 +48,12 @@ class JointSource:
     fmi_version: int = 2
     parameters: Mapping[str, float] = field(default_factory=dict)
 
-    def __post_init__(self) -> None:
+    def check(self) -> JointSource:
+        """This source checked, its path a Path (construction only stores; load/prepare check).
+
+        Raises:
+            DesignerError: as the class says.
+        """
         units.check_axis(self.axis)
         if (self.fmu is None) == (self.joint is None):
             raise DesignerError("a JointSource needs exactly one of fmu= or joint=", "give one of them")
@@ -59,18 +67,18 @@ class JointSource:
                     f"use {', '.join(f'{self.axis}.{f}' for f in PARAMETER_FIELDS)}",
                 )
             _finite(value, f"parameter '{key}'")
-        if self.fmu is not None:
-            from .fmu import check_fmu
-
-            object.__setattr__(self, "fmu", Path(self.fmu))
-            check_fmu(self.fmu, [self.axis])
-        else:
+        if self.fmu is None:
             self.joint.axis(self.axis)
+            return self
+        from .fmu import check_fmu
+
+        check_fmu(self.fmu, [self.axis])
+        return replace(self, fmu=Path(self.fmu))
 
 
 @dataclass(frozen=True)
 class Scenario:
-    """A checked scenario; times in s, lengths in m, masses in kg, paths absolute.
+    """A scenario; times in s, lengths in m, masses in kg, paths absolute.
 
     Robot: `joints` maps hinge or slide joints of the model (None: the built-in planar arm with
     `lengths` and `masses`, hinges j1..jN) to their `JointSource`; `motors` gives each joint's motor
@@ -79,8 +87,8 @@ class Scenario:
     `validation_steps` default to the step halved three times; `validation_duration` to `duration`.
     `path` is the file the scenario was read from, if any.
 
-    Raises:
-        DesignerError: the first value that is out of range or inconsistent, naming its field.
+    Building one stores the values (scikit-learn's convention); `check()` checks and completes them,
+    and `load` and `designer.cosim.prepare` call it.
     """
 
     duration: float
@@ -105,7 +113,15 @@ class Scenario:
         """ "robot" or "rig"."""
         return "rig" if self.rig_joint is not None else "robot"
 
-    def __post_init__(self) -> None:
+    def check(self) -> Scenario:
+        """This scenario checked and completed (defaults filled in, paths as Path, sources checked).
+
+        Building a Scenario only stores its values; `load` and `cosim.prepare` call this, so a run
+        never starts on a bad scenario, and `dataclasses.replace` costs no file reads.
+
+        Raises:
+            DesignerError: the first value that is out of range or inconsistent, naming its field.
+        """
         step, duration = _positive(self.step, "step"), _positive(self.duration, "duration")
         if duration < step:
             raise DesignerError(f"duration = {duration:g} s is shorter than step = {step:g} s", "lengthen it")
@@ -116,24 +132,23 @@ class Scenario:
                 "a scenario needs joints (a robot) or rig_joint (the virtual rig), not both or neither",
                 "give joints={'j1': JointSource(...)} or rig_joint=JointSource(...)",
             )
-        if self.kind == "robot":
-            self._check_robot()
-        else:
-            self._check_rig()
         unknown = set(self.outputs) - set(OUTPUTS)
         if unknown or not all(isinstance(v, bool) for v in self.outputs.values()):
             raise DesignerError(
                 f"outputs = {dict(self.outputs)} is not a set of switches", "use csv, parquet, plot"
             )
-        object.__setattr__(self, "outputs", {k: bool(self.outputs.get(k, True)) for k in OUTPUTS})
-        self._check_validation()
-        check_memory(self)
+        fields = self._robot_fields() if self.kind == "robot" else self._rig_fields()
+        fields["outputs"] = {k: bool(self.outputs.get(k, True)) for k in OUTPUTS}
+        sc = replace(self, **fields, **self._validation_fields())
+        check_memory(sc)
+        return sc
 
-    def _check_robot(self) -> None:
+    def _robot_fields(self) -> dict[str, Any]:
         from .robot import check_joints, load_spec
 
+        out: dict[str, Any] = {}
         if self.model is not None:
-            object.__setattr__(self, "model", Path(self.model))
+            out["model"] = Path(self.model)
         else:
             lengths = tuple(_positive(v, "lengths") for v in self.lengths)
             masses = tuple(_positive(v, "masses") for v in self.masses)
@@ -142,12 +157,13 @@ class Scenario:
                     f"lengths ({len(lengths)}) and masses ({len(masses)}) differ in number",
                     "give one length and one mass per link",
                 )
-            object.__setattr__(self, "lengths", lengths)
-            object.__setattr__(self, "masses", masses)
-        check_joints(load_spec(self.model, self.lengths, self.masses), list(self.joints))
+            out |= {"lengths": lengths, "masses": masses}
+        spec = load_spec(out.get("model"), out.get("lengths", self.lengths), out.get("masses", self.masses))
+        check_joints(spec, list(self.joints))
         for name, src in self.joints.items():
             if not isinstance(src, JointSource):
                 raise DesignerError(f"joints['{name}'] is a {type(src).__name__}", "give a JointSource")
+        out["joints"] = {name: src.check() for name, src in self.joints.items()}
         extra = set(self.motors) - set(self.joints)
         if extra:
             raise DesignerError(
@@ -159,26 +175,29 @@ class Scenario:
                 raise DesignerError(
                     f"motors['{name}'] is a {type(ref).__name__}", "give a Step, Sine, Chirp or Trajectory"
                 )
-        object.__setattr__(self, "motors", {j: self.motors.get(j, Step(0.0)) for j in self.joints})
+        out["motors"] = {j: self.motors.get(j, Step(0.0)) for j in self.joints}
+        return out
 
-    def _check_rig(self) -> None:
+    def _rig_fields(self) -> dict[str, Any]:
         src = self.rig_joint
         if not isinstance(src, JointSource):
             raise DesignerError(f"rig_joint is a {type(src).__name__}", "give a JointSource")
+        src = src.check()
         if src.joint is not None and src.joint.axis(src.axis).m is None:
             raise DesignerError(
                 f"the rig joint has no mass on axis {src.axis}",
                 "give its m, or build it from a design so the mass follows from geometry",
             )
-        if self.hub is None:
-            object.__setattr__(self, "hub", Chirp())
-        self.hub.check_sampling(1.0 / self.step, what="1 / step")
+        hub = Chirp() if self.hub is None else self.hub
+        hub.check_sampling(1.0 / self.step, what="1 / step")
+        out: dict[str, Any] = {"rig_joint": src, "hub": hub}
         if self.factors is not None:
             from .. import space
 
-            object.__setattr__(self, "factors", space.check_design(self.factors))
+            out["factors"] = space.check_design(self.factors)
+        return out
 
-    def _check_validation(self) -> None:
+    def _validation_fields(self) -> dict[str, Any]:
         steps = self.validation_steps or tuple(self.step / 2**i for i in range(4))
         steps = tuple(_positive(s, "validation_steps") for s in steps)
         if len(steps) < 2:
@@ -190,8 +209,7 @@ class Scenario:
             if self.validation_duration is None
             else _positive(self.validation_duration, "validation_duration")
         )
-        object.__setattr__(self, "validation_steps", steps)
-        object.__setattr__(self, "validation_duration", min(span, self.duration))
+        return {"validation_steps": steps, "validation_duration": min(span, self.duration)}
 
     def signals(self) -> int:
         """How many signals a run records per step (the width of its result)."""
@@ -337,7 +355,7 @@ def load(path: str | Path) -> Scenario:
     if ("rig" in doc) == ("robot" in doc):
         raise DesignerError(f"{path.name} needs exactly one of [robot] or [rig]", "see the README")
     try:
-        return _rig(doc, d, common) if "rig" in doc else _robot(doc, d, common)
+        return (_rig(doc, d, common) if "rig" in doc else _robot(doc, d, common)).check()
     except DesignerError as exc:
         if exc.problem.startswith(path.name):
             raise

@@ -7,6 +7,7 @@ radian whatever the compiler's angle; springref is 0). Into a robot: see `mjcf_i
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from pathlib import Path
 
 from .. import units
@@ -74,7 +75,7 @@ def series_text(
     link = robot.links(joint)[a]
     moving = link.inertia if rot else link.mass
     si = joint.axes[a].si()
-    flex = step_advice(si["k"], si["c"], moving)
+    flex = step_advice(si["k"], si["c"], moving, basis="about the joint axis: the link, the motor held")
     # the motor turns its armature, its body (the flexure's clamped part, as the link) and the link
     servo = robot.Servo.for_flexure(
         flex, carried=2 * moving, motor_inertia=motor_inertia, bandwidth=motor_bandwidth
@@ -82,7 +83,12 @@ def series_text(
     n = joint.name
     advice = {
         f"{n}_{a}": flex,
-        f"{n}_motor": step_advice(servo.kp, servo.kv, servo.motor_inertia + 2 * moving),
+        f"{n}_motor": step_advice(
+            servo.kp,
+            servo.kv,
+            servo.motor_inertia + 2 * moving,
+            basis="about the joint axis: the motor's armature, its body and the link, the flexure held",
+        ),
     }
     kind = "hinge" if rot else "slide"
     body = [
@@ -111,6 +117,57 @@ def series_text(
         f"the motor joint's damping {servo.kv:.4g} (SI)",
     ]
     return _document(joint, notes, body, actuators), advice
+
+
+@contextmanager
+def _mujoco_warnings():
+    """Collect MuJoCo's warnings (a host's deprecated attributes...) for the notes, rather than let
+    MuJoCo print them and append them to MUJOCO_LOG.TXT in the current folder."""
+    import mujoco
+
+    warned: list[str] = []
+    previous = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(lambda message: warned.append(" ".join(message.split())))
+    try:
+        yield warned
+    finally:
+        mujoco.set_mju_user_warning(previous)
+
+
+def _into(
+    joint: Joint,
+    into: str | Path,
+    path: Path,
+    *,
+    joint_name: str,
+    axis: str | None,
+    form: str,
+    rest: float | None,
+    motor_inertia: float | None,
+    motor_bandwidth: float | None,
+    allow_outside_range: bool,
+) -> tuple[dict[str, StepAdvice], tuple[str, ...]]:
+    """`into_series` or `into_parallel` with export_mjcf's arguments: (advice, notes)."""
+    if form == "series":
+        return into_series(
+            joint,
+            into,
+            path,
+            joint_name=joint_name,
+            axis=axis,
+            rest=0.0 if rest is None else rest,
+            motor_inertia=motor_inertia,
+            motor_bandwidth=motor_bandwidth,
+        )
+    return into_parallel(
+        joint,
+        into,
+        path,
+        joint_name=joint_name,
+        axis=axis,
+        rest=rest,
+        allow_outside_range=allow_outside_range,
+    )
 
 
 def export_mjcf(
@@ -145,27 +202,20 @@ def export_mjcf(
     if into is not None:
         if joint_name is None:
             raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
-        if form == "series":
-            advice = into_series(
+        with _mujoco_warnings() as warned:
+            advice, notes = _into(
                 joint,
                 into,
                 path,
                 joint_name=joint_name,
                 axis=axis,
-                rest=0.0 if rest is None else rest,
+                form=form,
+                rest=rest,
                 motor_inertia=motor_inertia,
                 motor_bandwidth=motor_bandwidth,
+                allow_outside_range=allow_outside_range,
             )
-            return robot.RobotExport(path, advice)
-        advice, notes = into_parallel(
-            joint,
-            into,
-            path,
-            joint_name=joint_name,
-            axis=axis,
-            rest=rest,
-            allow_outside_range=allow_outside_range,
-        )
+        notes += tuple(f"MuJoCo warns about the robot: {w}" for w in dict.fromkeys(warned))
         return robot.RobotExport(path, advice, notes)
     if rest not in (None, 0.0):
         raise DesignerError(

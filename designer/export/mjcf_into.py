@@ -40,6 +40,11 @@ _DERIVED = {
 }
 #: compiled-model arrays the parallel edit sets, per joint, degree of freedom or qpos entry
 _EDITED = {"jnt_stiffness": "jnt", "dof_damping": "dof", "dof_armature": "dof", "qpos_spring": "qpos"}
+#: what the advice's inertia is when it comes from the compiled robot
+MASS_MATRIX_BASIS = (
+    "about the joint axis: MuJoCo's joint-space inertia (armature included) at the reference pose qpos0, "
+    "the other joints held"
+)
 #: body attributes that place a body in its parent's frame
 _FRAME = ("pos", "quat", "euler", "axisangle", "xyaxes", "zaxis")
 
@@ -146,7 +151,7 @@ def _mass_diagonal(model) -> np.ndarray:
     return np.diag(full)
 
 
-def _compare_parallel(before, after, joint_name: str) -> None:
+def _compare_parallel(before, after, joint_name: str, k: float, c: float) -> None:
     """Raise if compiling the edited model changed anything but the joint and its mass-matrix terms."""
     j = after.joint(joint_name)
     index = {"jnt": j.id, "dof": j.dofadr[0], "qpos": j.qposadr[0]}
@@ -161,11 +166,32 @@ def _compare_parallel(before, after, joint_name: str) -> None:
         if a.shape != b.shape or not np.array_equal(a, b, equal_nan=True):
             changed.append(name)
     changed += [g for g in ("opt", "vis") if repr(getattr(before, g)) != repr(getattr(after, g))]
+    _check_joint(after, joint_name, k, c)
     if changed:
         raise RuntimeError(f"editing one joint changed the compiled model's {', '.join(changed)}")
 
 
-def _flexure(host: _Host, joint: Joint, a: str, rest: float) -> dict[str, str]:
+def _springdamper_off(host: _Host, joint_name: str, values: dict[str, str], notes: list[str]) -> None:
+    """Add springdamper="0 0" to `values` (and say so) when the host joint has one: MuJoCo would
+    otherwise compute stiffness and damping from it and ignore the flexure's."""
+    timeconst, ratio = (float(v) for v in host.spec.joint(joint_name).springdamper)
+    if timeconst > 0:
+        values["springdamper"] = "0 0"
+        notes.append(
+            f"springdamper (time constant {timeconst:.4g} s, damping ratio {ratio:.4g}) -> 0 0: MuJoCo would "
+            "derive stiffness and damping from it in place of the flexure's"
+        )
+
+
+def _check_joint(after, joint_name: str, k: float, c: float) -> None:
+    """Raise unless MuJoCo compiled the edited joint with exactly stiffness `k` and damping `c`."""
+    j = after.joint(joint_name)
+    got = (float(j.stiffness[0]), float(after.dof_damping[j.dofadr[0]]))
+    if got != (k, c):
+        raise RuntimeError(f"joint {joint_name} compiled with stiffness, damping {got}, not {(k, c)}")
+
+
+def _flexure(host: _Host, joint: Joint, a: str, rest: float, notes: list[str]) -> dict[str, str]:
     """Set the joint element's stiffness, damping, armature (moving inertia, if known) and springref;
     return them as written."""
     si = joint.axes[a].si()
@@ -173,6 +199,7 @@ def _flexure(host: _Host, joint: Joint, a: str, rest: float) -> dict[str, str]:
     if si["m"] is not None:
         values["armature"] = si["m"]
     values = {attr: robot.num(v) for attr, v in values.items()}
+    _springdamper_off(host, host.element.get("name"), values, notes)
     for attr, v in values.items():
         host.element.set(attr, v)
     return values
@@ -214,11 +241,12 @@ def into_parallel(
     raw = h.path.read_bytes()
     encoding = h.tree.docinfo.encoding or "utf-8"
     text = _retag(raw.decode(encoding), joint_name, values)
-    check = partial(_compare_parallel, h.model, joint_name=joint_name)
-    after = _write_checked(h, path, check, text.encode(encoding))
     si = joint.axes[a].si()
+    check = partial(_compare_parallel, h.model, joint_name=joint_name, k=si["k"], c=si["c"])
+    after = _write_checked(h, path, check, text.encode(encoding))
     dof = after.joint(joint_name).dofadr[0]
-    return {joint_name: step_advice(si["k"], si["c"], _mass_diagonal(after)[dof])}, notes
+    inertia = _mass_diagonal(after)[dof]
+    return {joint_name: step_advice(si["k"], si["c"], inertia, basis=MASS_MATRIX_BASIS)}, notes
 
 
 def _parallel_values(
@@ -263,6 +291,7 @@ def _parallel_values(
         )
     notes += [f"{attr}: {old[attr]:.4g} -> {v:.4g} (SI)" for attr, v in new.items() if v != old[attr]]
     values = {attr: robot.num(h.angle(v) if attr == "springref" else v) for attr, v in new.items()}
+    _springdamper_off(h, joint_name, values, notes)
     return values, tuple(notes)
 
 
@@ -281,9 +310,10 @@ def _insert_motor(host: _Host, joint_name: str, motor: robot.Sphere, servo: robo
     link = host.element.getparent()
     parent = link.getparent()
     body = etree.Element("body", name=f"{joint_name}_motor")
-    for attr in _FRAME:
+    # the link's childclass gave the host joint its defaults: the motor joint, its copy, needs it too
+    for attr in (*_FRAME, "childclass"):
         if attr in link.attrib:
-            body.set(attr, link.attrib.pop(attr))
+            body.set(attr, link.get(attr) if attr == "childclass" else link.attrib.pop(attr))
     parent.insert(parent.index(link), body)
     motor_joint = copy.deepcopy(host.element)
     motor_joint.set("name", f"{joint_name}_motor")
@@ -309,8 +339,10 @@ def _insert_motor(host: _Host, joint_name: str, motor: robot.Sphere, servo: robo
         section = root.find("actuator")
         if section is None:
             section = etree.SubElement(root, "actuator")
+        # ctrllimited stated: a host's actuator defaults may limit control to a range it never gave
         servo_xml = (
-            f'<position name="{joint_name}_motor" joint="{joint_name}_motor" kp="{robot.num(servo.kp)}"/>'
+            f'<position name="{joint_name}_motor" joint="{joint_name}_motor" kp="{robot.num(servo.kp)}" '
+            'ctrllimited="false"/>'
         )
         section.append(etree.fromstring(servo_xml))
     return len(moved)
@@ -358,7 +390,7 @@ def _extend_keys(host: _Host, joint_name: str, at: dict[str, int], rest: float, 
             key.set(name, " ".join(values))
 
 
-def _compare_series(before, after, joint_name: str) -> None:
+def _compare_series(before, after, joint_name: str, k: float, c: float) -> None:
     """Raise unless every host body keeps its world pose and every host joint its numbers.
 
     MuJoCo numbers bodies and joints in the file's depth-first order, so the inserted motor body and
@@ -393,6 +425,91 @@ def _compare_series(before, after, joint_name: str) -> None:
             changed.append(mine.name or f"joint {i}")
     if changed:
         raise RuntimeError(f"the series edit changed host bodies or joints: {', '.join(changed)}")
+    _check_joint(after, joint_name, k, c)
+
+
+def _freeze_springdampers(host: _Host, joint_name: str) -> list[str]:
+    """Write out the compiled stiffness and damping of every other joint with a springdamper.
+
+    MuJoCo derives those from the mass matrix, so the motor body's mass would change them; written
+    out (springdamper 0 0) they stay what the host compiled them to.
+    """
+    frozen = []
+    for j in host.spec.joints:
+        if j.name == joint_name or j.springdamper[0] <= 0:
+            continue
+        found = host.tree.getroot().xpath("//worldbody//joint[@name=$n]", n=j.name) if j.name else []
+        if len(found) != 1:
+            raise DesignerError(
+                f"joint {j.name or '(unnamed)'} takes stiffness and damping from springdamper, which the "
+                "series edit's motor body would change, and designer cannot find it in the file to keep them",
+                "name the joint in the robot's file, or use form='parallel'",
+            )
+        compiled = host.model.joint(j.name)
+        found[0].set("stiffness", robot.num(compiled.stiffness[0]))
+        found[0].set("damping", robot.num(host.model.dof_damping[compiled.dofadr[0]]))
+        found[0].set("springdamper", "0 0")
+        frozen.append(j.name)
+    if not frozen:
+        return []
+    named = ", ".join(frozen[:3]) + (", ..." if len(frozen) > 3 else "")
+    return [
+        f"{len(frozen)} joints with springdamper ({named}) "
+        "keep their compiled stiffness and damping, now written out (springdamper 0 0): MuJoCo derives them "
+        "from the mass matrix, which the motor body changes"
+    ]
+
+
+def _refuse_limit_sensors(host: _Host, joint_name: str) -> None:
+    """Refuse a series edit of a joint that a joint-limit sensor reads: the flexure has no limit."""
+    import mujoco
+
+    kinds = {mujoco.mjtSensor.mjSENS_JOINTLIMITPOS, mujoco.mjtSensor.mjSENS_JOINTLIMITVEL}
+    kinds |= {mujoco.mjtSensor.mjSENS_JOINTLIMITFRC}
+    readers = [
+        s.name or s.type.name.removeprefix("mjSENS_").lower()
+        for s in host.spec.sensors
+        if s.type in kinds and s.objname == joint_name
+    ]
+    if readers:
+        raise DesignerError(
+            f"sensor {', '.join(readers)} reads the limit of robot joint '{joint_name}', which the series "
+            "form moves to the motor joint (the flexure has no limit)",
+            f"point the sensor at {joint_name}_motor in the robot first, or use form='parallel'",
+        )
+
+
+def _series_notes(host: _Host, joint_name: str, si: dict, moved: int, rest: float) -> list[str]:
+    """What the series edit did to the host's own values, one sentence each (SI)."""
+    j = host.model.joint(joint_name)
+    dof, adr = j.dofadr[0], j.qposadr[0]
+    unit = "rad" if host.hinge else "m"
+    old = (float(j.stiffness[0]), float(host.model.dof_damping[dof]), float(host.model.dof_armature[dof]))
+    new = (si["k"], si["c"], si["m"])
+    notes = [
+        f"{joint_name} is now the flexure (SI): "
+        + ", ".join(
+            f"{n} {a:.4g} -> {b:.4g}"
+            for n, a, b in zip(("stiffness", "damping", "armature"), old, new, strict=True)
+        )
+        + f", springref {float(host.model.qpos_spring[adr]):.4g} -> {rest:.4g} {unit}"
+    ]
+    if j.limited[0]:
+        lo, hi = (float(v) for v in j.range)
+        notes.append(f"range [{lo:.4g}, {hi:.4g}] {unit} moved to {joint_name}_motor; {joint_name} unlimited")
+    if float(host.model.qpos0[adr]) != 0.0:
+        notes.append(
+            f"{joint_name}'s ref {float(host.model.qpos0[adr]):.4g} {unit} -> 0 (the motor keeps it)"
+        )
+    notes.append(
+        f"{moved} actuator(s) moved from {joint_name} to {joint_name}_motor"
+        if moved
+        else f"position servo {joint_name}_motor added (no actuator drove {joint_name})"
+    )
+    keys = host.model.nkey
+    if keys:
+        notes.append(f"{keys} keyframe(s) extended with {joint_name}_motor (the host's angle less the rest)")
+    return notes
 
 
 def into_series(
@@ -405,7 +522,7 @@ def into_series(
     rest: float = 0.0,
     motor_inertia: float | None = None,
     motor_bandwidth: float | None = None,
-) -> dict[str, StepAdvice]:
+) -> tuple[dict[str, StepAdvice], tuple[str, ...]]:
     """Write a copy of MJCF `host` to `path` with motor -> flexure -> link at robot joint `joint_name`.
 
     A motor body `<joint_name>_motor` (carrying the flexure's clamped part) is inserted before the
@@ -415,16 +532,19 @@ def into_series(
     armature = its moving inertia, springref = `rest`, unlimited). With no actuator on the joint, a
     position servo is added (see `robot.Servo`). Sensors, tendons and
     equalities on `joint_name` now see the flexure's deflection. Returns the step advice of the flexure
-    (motor held) and, when added, of the servo (flexure held), inertias from the mass matrix.
+    (motor held) and, when added, of the servo (flexure held), inertias from the mass matrix, and one
+    note per host value the edit changed.
 
     Raises:
-        DesignerError: as `into_parallel`, or when the names `<joint_name>_motor` are taken.
+        DesignerError: as `into_parallel`, when the names `<joint_name>_motor` are taken, or when a
+            joint-limit sensor reads the joint.
     """
     h = _open(host, joint_name)
     a = _axis(joint, axis, h, joint_name)
     taken = {e.name for e in (*h.spec.joints, *h.spec.bodies, *h.spec.actuators)}
     if f"{joint_name}_motor" in taken:
         raise DesignerError(f"the robot already has something named {joint_name}_motor", "rename it first")
+    _refuse_limit_sensors(h, joint_name)
     full = robot.with_masses(joint)
     si, clamp = full.axes[a].si(), robot.links(full)[a]
     # the link as the flexure sees it: the host's inertia at the joint, less the armature the motor
@@ -442,14 +562,25 @@ def into_series(
     )
     keys = _key_layout(h, joint_name)
     moved = _insert_motor(h, joint_name, clamp, servo)
+    notes = _series_notes(h, joint_name, si, moved, rest)
+    notes.append(
+        f"{joint_name}_motor armature {servo.motor_inertia:.4g} (the motor's reflected inertia; the host "
+        f"joint's was {host_armature:.4g})"
+    )
+    notes += _freeze_springdampers(h, joint_name)
     _extend_keys(h, joint_name, keys, rest, servo_added=not moved)
-    _flexure(h, joint, a, rest)
+    _flexure(h, joint, a, rest, notes)
     for attr, value in (("ref", "0"), ("limited", "false")):
         h.element.set(attr, value)
-    after = _write_checked(h, path, partial(_compare_series, h.model, joint_name=joint_name))
+    check = partial(_compare_series, h.model, joint_name=joint_name, k=si["k"], c=si["c"])
+    after = _write_checked(h, path, check)
     diag = _mass_diagonal(after)
     flex_dof, motor_dof = after.joint(joint_name).dofadr[0], after.joint(f"{joint_name}_motor").dofadr[0]
-    advice = {joint_name: step_advice(si["k"], si["c"], diag[flex_dof])}
+    held = {"basis": MASS_MATRIX_BASIS.replace("the other joints held", "the motor and other joints held")}
+    advice = {joint_name: step_advice(si["k"], si["c"], diag[flex_dof], **held)}
     if not moved:
-        advice[f"{joint_name}_motor"] = step_advice(servo.kp, servo.kv, diag[motor_dof])
-    return advice
+        held = {
+            "basis": MASS_MATRIX_BASIS.replace("the other joints held", "the flexure and other joints held")
+        }
+        advice[f"{joint_name}_motor"] = step_advice(servo.kp, servo.kv, diag[motor_dof], **held)
+    return advice, tuple(notes)

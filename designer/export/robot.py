@@ -210,7 +210,12 @@ def chain(joint: Joint) -> tuple[dict[str, Sphere], dict[str, StepAdvice]]:
         after = [bodies[b] for b in order[i:]]
         inertia = sum(s.inertia if units.is_rotational(a) else s.mass for s in after)
         si = joint.axes[a].si()
-        advice[f"{joint.name}_{a}"] = step_advice(si["k"], si["c"], inertia)
+        basis = (
+            "about the joint axis through the joint origin: this axis' link and those after it in the chain, "
+            "the other axes held; each link's collision sphere has that inertia, so importers that "
+            "recompute it (pybullet by default) agree"
+        )
+        advice[f"{joint.name}_{a}"] = step_advice(si["k"], si["c"], inertia, basis=basis)
     return bodies, advice
 
 

@@ -96,17 +96,20 @@ def _connectors(joint: Joint, interface: str, pad: str) -> tuple[list[str], list
     return lines, wired, used
 
 
-def ssd_text(joints: list[Joint], interface: str) -> str:
-    """The SSD: one component per joint, its inputs and outputs exposed as `<joint>_<variable>`.
+def ssd_text(joints: list[Joint], interface: str, *, system_connectors: bool = False) -> str:
+    """The SSD: one component per joint, bound to its SSV; with `system_connectors`, its inputs and
+    outputs also exposed on the system as `<joint>_<variable>`.
 
     (Not `<joint>.<variable>`: fmpy.ssp names results by dotted path, where that would clash with the
-    component's own connector.)
+    component's own connector.) A connection to a system connector has no startElement or endElement,
+    as the standard allows, and libcosim refuses such an SSD ("No such node (<xmlattr>.endElement)"):
+    hence off by default.
     """
     outer, elements, connections, used = [], [], [], set()
     for j in joints:
         inner, wired, u = _connectors(j, interface, "          ")
         used |= u
-        for var, kind, typ in wired:
+        for var, kind, typ in wired if system_connectors else ():
             outer.append(f'      <ssd:Connector name="{j.name}_{var}" kind="{kind}">{typ}</ssd:Connector>')
             ends = (
                 f'startConnector="{j.name}_{var}" endElement="{j.name}" endConnector="{var}"'
@@ -131,15 +134,11 @@ def ssd_text(joints: list[Joint], interface: str) -> str:
             '<?xml version="1.0" encoding="UTF-8"?>',
             f'<ssd:SystemStructureDescription {_XMLNS} version="1.0" name="flexjoints">',
             '  <ssd:System name="flexjoints">',
-            "    <ssd:Connectors>",
-            *outer,
-            "    </ssd:Connectors>",
+            *(["    <ssd:Connectors>", *outer, "    </ssd:Connectors>"] if outer else []),
             "    <ssd:Elements>",
             *elements,
             "    </ssd:Elements>",
-            "    <ssd:Connections>",
-            *connections,
-            "    </ssd:Connections>",
+            *(["    <ssd:Connections>", *connections, "    </ssd:Connections>"] if connections else []),
             "  </ssd:System>",
             "  <ssd:Units>",
             *_units(used),
@@ -156,6 +155,7 @@ def export_ssp(
     *,
     alternatives: Mapping[str, Mapping[str, Joint]] | None = None,
     interface: str = "body",
+    system_connectors: bool = False,
 ) -> Path:
     """Write an SSP archive at `path` (.ssp): the SSD, per joint an FMI 2 FMU and an SSV, alternatives.
 
@@ -167,6 +167,9 @@ def export_ssp(
             `{"FlexJoint": {"candidate_1": joint1, ...}}`) with that joint's axes, written as
             `resources/<name>.<set>.ssv` for a tool to bind instead.
         interface: "body" (load in, motion out; needs masses, from geometry when a design) or "force".
+        system_connectors: also expose each component's inputs and outputs on the system, wired by
+            connections without startElement/endElement (SSP allows them; fmpy.ssp's `input=` drives
+            them; libcosim cannot load them).
 
     Raises:
         DesignerError: a wrong suffix, repeated joint names, an alternative for no joint or with other
@@ -198,7 +201,7 @@ def export_ssp(
                 )
             other = with_masses(other, why) if interface == "body" else other
             entries[f"resources/{name}.{set_name}.ssv"] = ssv_text(other, set_name).encode()
-    entries["SystemStructure.ssd"] = ssd_text(joints, interface).encode()
+    entries["SystemStructure.ssd"] = ssd_text(joints, interface, system_connectors=system_connectors).encode()
     for j in joints:
         entries[f"resources/{j.name}.fmu"] = _fmu_bytes(j, interface)
     with atomic_path(path) as tmp, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
@@ -255,6 +258,11 @@ def read_ssv(path: str | Path) -> dict[str, float]:
         raise DesignerError(f"path={str(path)!r} cannot be read as XML: {exc}", "give an SSV file") from None
     if root.tag != f"{{{NS['ssv']}}}ParameterSet":
         raise DesignerError(f"path={str(path)!r} is not an SSV parameter set", "give an .ssv file")
+    return _ssv_values(root, path)
+
+
+def _ssv_values(root, path: Path) -> dict[str, float]:
+    """The Real parameters of a parsed SSV, joint parameters converted to SI by their units."""
     declared = {}
     for u in root.iterfind("ssv:Units/ssc:Unit", NS):
         base = u.find("ssc:BaseUnit", NS)
@@ -288,3 +296,52 @@ def _si_value(name: str, value: float, unit: str | None, base: dict | None, path
             f"give {name} in {si}, or declare {unit!r} with the base units of {si} in the file",
         )
     return factor * value + offset
+
+
+def bound_parameters(path: str | Path) -> dict[str, float]:
+    """The parameter values an SSP's SSD binds to its components, by hierarchical name.
+
+    Every component-level `ParameterBinding` with a `source` is read from the archive (or the folder)
+    and its names made hierarchical as SSP 1.0 resolves them: the binding's `prefix` and the
+    component's name before each name in the SSV (`FlexJoint.x.k`). A joint's m, c, k and offset
+    are converted to SI by their declared units (as `read_ssv`). This is what `fmpy.ssp.simulate_ssp(path,
+    parameter_set=...)` needs, as fmpy applies only the set it is given and not the SSD's bindings;
+    `fmpy_parameter_set` wraps it.
+
+    Raises:
+        DesignerError: the archive or a bound SSV cannot be read.
+    """
+    import xml.etree.ElementTree as ET
+
+    path = Path(path)
+    try:
+        if path.is_dir():
+            read = lambda name: (path / name).read_bytes()  # noqa: E731
+        else:
+            archive = zipfile.ZipFile(path)
+            read = archive.read
+        ssd = ET.fromstring(read("SystemStructure.ssd"))
+        out = {}
+        for component in ssd.iterfind("ssd:System/ssd:Elements/ssd:Component", NS):
+            for binding in component.iterfind("ssd:ParameterBindings/ssd:ParameterBinding", NS):
+                if binding.get("source") is None:
+                    continue
+                ssv = ET.fromstring(read(binding.get("source")))
+                prefix = f"{component.get('name')}.{binding.get('prefix', '')}"
+                values = _ssv_values(ssv, path / binding.get("source"))
+                out.update({prefix + name: value for name, value in values.items()})
+        return out
+    except (OSError, KeyError, zipfile.BadZipFile, ET.ParseError) as exc:
+        raise DesignerError(
+            f"path={str(path)!r} cannot be read as an SSP: {exc}", "give an .ssp archive"
+        ) from None
+
+
+def fmpy_parameter_set(path: str | Path):
+    """`bound_parameters(path)` as an `fmpy.ssp.ssd.ParameterSet` for `fmpy.ssp.simulate_ssp`."""
+    from fmpy.ssp.ssd import Parameter, ParameterSet
+
+    ps = ParameterSet(name="bound")
+    for name, value in bound_parameters(path).items():
+        ps.parameters.append(Parameter(name=name, type="Real", value=value))
+    return ps

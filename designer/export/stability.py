@@ -31,12 +31,14 @@ INTEGRATORS = ("Euler", "implicitfast", "RK4")
 @dataclass(frozen=True)
 class StepAdvice:
     """Natural frequency (Hz), damping ratio, the largest stable timestep (s) per integrator, and the
-    inertia (kg.m^2, or kg on a slide) they were computed with."""
+    inertia (kg.m^2, or kg on a slide) they were computed with, with what that inertia is (`basis`:
+    about which axis, from what, other joints how): another reading of the same file moves them."""
 
     inertia: float
     natural_frequency: float
     damping_ratio: float
     max_timestep: dict[str, float]
+    basis: str = ""
 
     def to_dict(self) -> dict[str, object]:
         return {
@@ -44,13 +46,16 @@ class StepAdvice:
             "natural_frequency_hz": self.natural_frequency,
             "damping_ratio": self.damping_ratio,
             "max_stable_timestep_s": dict(self.max_timestep),
+            "inertia_basis": self.basis,
         }
 
     def text(self) -> str:
         """One line for an XML comment or a terminal: frequency and the three step limits."""
         steps = ", ".join(f"{n} {h * 1e3:.3g} ms" for n, h in self.max_timestep.items())
+        basis = f"; {self.basis}" if self.basis else ""
         return (
-            f"natural frequency {self.natural_frequency:.4g} Hz (moving inertia {self.inertia:.4g} SI), "
+            f"natural frequency {self.natural_frequency:.4g} Hz "
+            f"(moving inertia {self.inertia:.4g} SI{basis}), "
             f"damping ratio {self.damping_ratio:.3g}; "
             f"largest stable timestep: {steps}"
         )
@@ -74,8 +79,9 @@ def _rk4_limit(k: float, c: float, inertia: float) -> float:
     return float(lo)
 
 
-def step_advice(k: float, c: float, inertia: float) -> StepAdvice:
-    """Natural frequency, damping ratio and stable timesteps of M q'' + c q' + k q = 0 (SI).
+def step_advice(k: float, c: float, inertia: float, *, basis: str = "") -> StepAdvice:
+    """Natural frequency, damping ratio and stable timesteps of M q'' + c q' + k q = 0 (SI); `basis`
+    says what the inertia is.
 
     Raises:
         DesignerError: when k or inertia is not positive or c is negative.
@@ -92,4 +98,5 @@ def step_advice(k: float, c: float, inertia: float) -> StepAdvice:
         natural_frequency=omega / (2 * math.pi),
         damping_ratio=c / (2 * math.sqrt(k * inertia)),
         max_timestep={"Euler": implicit, "implicitfast": implicit, "RK4": _rk4_limit(k, c, inertia)},
+        basis=basis,
     )

@@ -17,7 +17,7 @@ from .. import units
 from ..errors import DesignerError
 from ..files import atomic_path, atomic_write, check_suffix
 from ..joint import Joint, check_joint
-from . import robot, xmltext
+from . import robot, urdf_drake, xmltext
 from .stability import step_advice
 from .urdf_inertia import moved_inertia
 
@@ -34,25 +34,43 @@ def _gazebo(name: str, k: float, rest: float) -> list[str]:
     ]
 
 
+#: what a URDF --into advice's inertia is
+INERTIA_BASIS = (
+    "about the joint axis at the zero pose, from the links' <inertial> as written (origin and rpy honoured), "
+    "the other joints held at 0; pybullet uses it only when loaded with flags=p.URDF_USE_INERTIA_FROM_FILE "
+    "(by default it recomputes inertia from the collision shapes)"
+)
 #: who reads what of a URDF joint: URDF has no joint spring, only the extension some hosts read
 READERS = (
-    "the spring (<gazebo> springStiffness/springReference) is read by Gazebo only; MuJoCo, pybullet and "
-    "Drake load this joint as a pure damper (<dynamics damping>)",
+    "the spring is read by Gazebo (<gazebo> springStiffness/springReference) and Drake (a "
+    "<drake:linear_bushing_rpy> on the joint axis, exact within half a turn of the rest); MuJoCo and "
+    "pybullet load this joint as a pure damper (<dynamics damping>)",
     "for the spring in MuJoCo export mjcf --into the robot's MJCF; in pybullet apply -k (q - rest) as the "
     "joint's torque each step (README: Robot and system formats)",
 )
 
 
 def urdf_text(joint: Joint, *, rest: float = 0.0) -> tuple[str, dict[str, robot.StepAdvice]]:
-    """A fixed base link and one moving link per axis, chained; damping declared, spring in extensions
-    (springReference `rest`, rad or m)."""
+    """A base link fixed to `world` and one moving link per axis, chained; damping declared, spring in
+    the Gazebo and Drake extensions (springReference `rest`, rad or m).
+
+    The base carries the flexure's clamped part (the first axis' link sphere): a URDF link of mass 0
+    is dropped by Gazebo's converter (libsdformat), and with it every link and joint after it.
+    """
     bodies, advice = robot.chain(joint)
-    lines = ['<?xml version="1.0"?>', robot.provenance_comment(joint), f'<robot name="{joint.name}">']
+    first = bodies[next(iter(joint.axes))]
+    lines = ['<?xml version="1.0"?>', robot.provenance_comment(joint)]
     lines += [
+        f'<robot name="{joint.name}" xmlns:drake="{urdf_drake.DRAKE_NS}">',
+        "  " + robot.xml_comment("world: Gazebo, Drake and MuJoCo fix a joint to a link of that name"),
+        '  <link name="world"/>',
+        f'  <joint name="{joint.name}_fixed" type="fixed">',
+        '    <parent link="world"/>',
+        f'    <child link="{joint.name}_base"/>',
+        "  </joint>",
         f'  <link name="{joint.name}_base">',
-        "    " + robot.xml_comment("fixed base: mass 0 said, as pybullet makes a link without inertial 1 kg"),
-        '    <inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/>'
-        "</inertial>",
+        "    " + robot.xml_comment("the flexure's clamped part: " + first.basis),
+        *_inertial(first),
         "  </link>",
     ]
     parent = f"{joint.name}_base"
@@ -65,7 +83,6 @@ def urdf_text(joint: Joint, *, rest: float = 0.0) -> tuple[str, dict[str, robot.
             else f'\n    <limit lower="{-PRISMATIC_LIMIT}" upper="{PRISMATIC_LIMIT}" effort="1e9" '
             'velocity="1e9"/>'
         )
-        i = robot.num(s.inertia)
         lines += [
             "  " + robot.xml_comment(f"{name}: {advice[name].text()}"),
             f'  <joint name="{name}" type="{"continuous" if rot else "prismatic"}">',
@@ -75,18 +92,35 @@ def urdf_text(joint: Joint, *, rest: float = 0.0) -> tuple[str, dict[str, robot.
             f'    <dynamics damping="{robot.num(si["c"])}" friction="0"/>',
             "  </joint>",
             *_gazebo(name, si["k"], rest),
+            *urdf_drake.bushing_lines(
+                name,
+                parent=parent,
+                child=f"{name}_link",
+                axis=[float(v) for v in robot.AXIS_VECTORS[a].split()],
+                k=si["k"],
+                rest=rest,
+                prismatic=not rot,
+            ),
             f'  <link name="{name}_link">',
             "    " + robot.xml_comment(s.basis + "; the collision sphere has the same inertia"),
-            "    <inertial>",
-            '      <origin xyz="0 0 0" rpy="0 0 0"/>',
-            f'      <mass value="{robot.num(s.mass)}"/>',
-            f'      <inertia ixx="{i}" ixy="0" ixz="0" iyy="{i}" iyz="0" izz="{i}"/>',
-            "    </inertial>",
-            f'    <collision><geometry><sphere radius="{robot.num(s.radius)}"/></geometry></collision>',
+            *_inertial(s),
             "  </link>",
         ]
         parent = f"{name}_link"
     return "\n".join([*lines, "</robot>", ""]), advice
+
+
+def _inertial(s: robot.Sphere) -> list[str]:
+    """A link's `<inertial>` (about its origin, the joint's) and a collision sphere of the same inertia."""
+    i = robot.num(s.inertia)
+    return [
+        "    <inertial>",
+        '      <origin xyz="0 0 0" rpy="0 0 0"/>',
+        f'      <mass value="{robot.num(s.mass)}"/>',
+        f'      <inertia ixx="{i}" ixy="0" ixz="0" iyy="{i}" iyz="0" izz="{i}"/>',
+        "    </inertial>",
+        f'    <collision><geometry><sphere radius="{robot.num(s.radius)}"/></geometry></collision>',
+    ]
 
 
 def sdf_text(joint: Joint) -> tuple[str, dict[str, robot.StepAdvice]]:
@@ -127,11 +161,23 @@ def sdf_text(joint: Joint) -> tuple[str, dict[str, robot.StepAdvice]]:
     return "\n".join([*lines, "  </model>", "</sdf>", ""]), advice
 
 
+def _host_values(root, element, joint_name: str) -> dict[str, float]:
+    """The joint's damping and Gazebo spring as the host URDF gives them (URDF's default damping 0)."""
+    dynamics = element.find("dynamics")
+    old = {"damping": float(dynamics.get("damping", 0)) if dynamics is not None else 0.0}
+    for tag in ("springStiffness", "springReference"):
+        found = root.xpath(f"/robot/gazebo[@reference=$n]/{tag}", n=joint_name)
+        if found:
+            old[tag] = float(found[0].text)
+    return old
+
+
 def _into_urdf(
-    joint: Joint, host: Path, *, joint_name: str, axis: str | None, rest: float
-) -> tuple[bytes, dict[str, robot.StepAdvice]]:
+    joint: Joint, host: Path, *, joint_name: str, axis: str | None, rest: float | None
+) -> tuple[bytes, dict[str, robot.StepAdvice], tuple[str, ...]]:
     """The host URDF's bytes with `joint_name`'s damping and Gazebo spring set, the rest as written;
-    and the joint's step advice (none when the links it moves declare no inertia)."""
+    the joint's step advice (none when the links it moves declare no inertia); one note per host
+    value changed or kept (old -> new, SI). `rest` None keeps the host's springReference (else 0)."""
     from lxml import etree
 
     if not host.is_file():
@@ -157,13 +203,51 @@ def _into_urdf(
             "give an axis of the same kind as the robot joint",
         )
     si = joint.axes[a].si()
+    old = _host_values(root, found[0], joint_name)
+    notes = []
+    if rest is None:
+        rest = old.get("springReference", 0.0)
+        how = "kept at the host's" if "springReference" in old else "set to"
+        notes.append(f"springReference {how} {rest:.4g} (give rest to set it)")
+    new = {"damping": si["c"], "springStiffness": si["k"], "springReference": rest}
+    notes += [
+        f"{tag}: {'none' if tag not in old else format(old[tag], '.4g')} -> {v:.4g} (SI)"
+        for tag, v in new.items()
+        if v != old.get(tag)
+    ]
     encoding = tree.docinfo.encoding or "utf-8"
     # the robot-level <joint> among every element <joint name=...> (a <transmission> names its joint too)
     nth = [j.getparent() is root for j in root.iter("joint") if j.get("name") == joint_name].index(True)
     text = _set_damping(host.read_bytes().decode(encoding), joint_name, robot.num(si["c"]), nth)
     moved = moved_inertia(root, joint_name)
-    advice = {joint_name: step_advice(si["k"], si["c"], moved)} if moved > 0 else {}
-    return _set_spring(text, joint_name, si["k"], rest).encode(encoding), advice
+    advice = {joint_name: step_advice(si["k"], si["c"], moved, basis=INERTIA_BASIS)} if moved > 0 else {}
+    text = _set_spring(text, joint_name, si["k"], rest)
+    text = _add_drake_spring(text, root, found[0], si["k"], rest, prismatic=not rot)
+    return text.encode(encoding), advice, tuple(notes)
+
+
+def _add_drake_spring(text: str, root, element, k: float, rest: float, *, prismatic: bool) -> str:
+    """`text` with the Drake bushing of joint `element` before `</robot>` (and Drake's namespace
+    declared on `<robot>` when it is not)."""
+    name = element.get("name")
+    if root.xpath("/robot/frame[@name=$n]", n=f"{name}_spring_A"):
+        raise DesignerError(
+            f"the robot already has Drake spring frames for joint '{name}' (an earlier export?)",
+            "export into the robot file as it was before",
+        )
+    lines = urdf_drake.bushing_lines(
+        name, k=k, rest=rest, prismatic=prismatic, **urdf_drake.joint_geometry(element)
+    )
+    end = text.rindex("</robot")
+    text = f"{text[:end].rstrip()}\n" + "\n".join(lines) + f"\n{text[end:]}"
+    if root.nsmap.get("drake") is None:
+        start = xmltext.find_one(text, "robot", "name", root.get("name"))
+        text = (
+            text[: start.start()]
+            + xmltext.set_attributes(start.group(0), {"xmlns:drake": urdf_drake.DRAKE_NS})
+            + text[start.end() :]
+        )
+    return text
 
 
 def _set_damping(text: str, joint_name: str, damping: str, nth: int) -> str:
@@ -233,10 +317,10 @@ def export_urdf(
     if into is not None:
         if joint_name is None:
             raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
-        data, advice = _into_urdf(joint, Path(into), joint_name=joint_name, axis=axis, rest=rest or 0.0)
+        data, advice, notes = _into_urdf(joint, Path(into), joint_name=joint_name, axis=axis, rest=rest)
         with atomic_path(path) as tmp:
             tmp.write_bytes(data)
-        return robot.RobotExport(path, advice, READERS)
+        return robot.RobotExport(path, advice, notes + READERS)
     text, advice = urdf_text(robot.with_masses(joint), rest=rest or 0.0)
     with atomic_write(path) as fh:
         fh.write(text)

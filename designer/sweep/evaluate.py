@@ -7,28 +7,62 @@ with status "failed" and its message; it does not stop the batch.
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import time
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, replace
-from pathlib import Path
+from dataclasses import dataclass
 
 import numpy as np
 
 from .. import units
 from ..cosim.master import Trace
 from ..cosim.scenario import JointSource, Scenario
+from ..cosim.session import Session, sources
 from ..errors import DesignerError
 from .cases import Case
 
 
 @dataclass(frozen=True)
 class Task:
-    """A batch for one worker: the scenario, the evaluation path ("fmu" | "engine") and the cases."""
+    """A batch for one worker: the scenario, the evaluation path ("fmu" | "engine") and the cases.
+
+    `hold`: the worker keeps its prepared Session for the next batch of the same scenario (local
+    processes and this process, which close it at their end; not Dask workers, whose end is not
+    the sweep's).
+    """
 
     scenario: Scenario
     path: str
     cases: tuple[Case, ...]
+    hold: bool = False
+
+
+#: the Session this process holds between batches of one scenario (Task.hold), by the scenario's repr
+_HELD: dict[str, Session] = {}
+
+
+def held(sc: Scenario) -> Session:
+    """The Session this process holds for `sc`, prepared on first use (the one held before, for
+    another scenario, is closed)."""
+    from ..cosim import prepare
+
+    key = repr(sc)
+    session = _HELD.get(key)
+    if session is None:
+        release()
+        session = _HELD[key] = prepare(sc)
+    return session
+
+
+def release() -> None:
+    """Close the Session this process holds: its FMU instances freed, its temporary folder removed
+    (at the end of a sweep in this process, and when a worker process exits)."""
+    while _HELD:
+        _HELD.popitem()[1].close()
+
+
+atexit.register(release)
 
 
 def si_law(src: JointSource, coefficients: dict[str, float]) -> dict[str, float]:
@@ -44,38 +78,37 @@ def metrics(sc: Scenario, *, trace: Trace, case: Case) -> dict[str, dict]:
     return robot_metrics(sc, trace, laws)
 
 
-def fmu_result(sc: Scenario, *, fmus: dict[str, Path], case: Case):
-    """Co-simulate one case with `designer.cosim.run`: the batch's joint FMUs, the case's k and c set
-    as FMU parameters (SI). Returns the cosim `Result` (time series and per-joint metrics)."""
-    from ..cosim import run
+def case_parameters(sc: Scenario, case: Case) -> dict[str, dict[str, float]]:
+    """A case's k and c as the FMU parameters `Session.run` takes: {joint: {"axis.k", "axis.c"}}, SI."""
+    srcs = sources(sc)
+    return {
+        j: {f"{src.axis}.{q}": v for q, v in si_law(src, case.coefficients[j]).items()}
+        for j, src in srcs.items()
+    }
 
-    joints = {}
-    for j, src in sc.joints.items():
-        params = dict(src.parameters)
-        params |= {f"{src.axis}.{q}": v for q, v in si_law(src, case.coefficients[j]).items()}
-        joints[j] = JointSource(axis=src.axis, fmu=fmus[j], fmi_version=src.fmi_version, parameters=params)
-    return run(replace(sc, joints=joints))
+
+def fmu_result(session: Session, *, case: Case):
+    """Co-simulate one case in a prepared session: the case's k and c set as FMU parameters (SI).
+    Returns the cosim `Result` (time series and per-joint metrics)."""
+    return session.run(case_parameters(session.scenario, case))
 
 
 #: per-case metrics of a rig sweep: the identified coefficients (rig units), their errors, the fit's R2
 RIG_METRICS = ("k_identified", "c_identified", "k_error_pct", "c_error_pct", "r2")
 
 
-def rig_identification(sc: Scenario, *, fmus: dict[str, Path], case: Case) -> dict[str, dict]:
+def rig_identification(session: Session, *, case: Case) -> dict[str, dict]:
     """Run the virtual rig on one case's joint, identify its log, and compare with the case's k and c.
 
     The log is the one `designer cosim` writes for the rig (designer.cosim.run.rig_log), read
     through the rig-log validation and identified as a measured log would be.
     """
-    from ..cosim import run
     from ..cosim.run import rig_log
     from ..rig.identify import identify
     from ..rig.logs import validate_frame
 
-    src, true = sc.rig_joint, case.coefficients["rig"]
-    params = dict(src.parameters) | {f"{src.axis}.{q}": v for q, v in si_law(src, true).items()}
-    joint = JointSource(axis=src.axis, fmu=fmus["rig"], fmi_version=src.fmi_version, parameters=params)
-    log = validate_frame(rig_log(run(replace(sc, rig_joint=joint))), f"virtual rig log of case {case.index}")
+    src, true = session.scenario.rig_joint, case.coefficients["rig"]
+    log = validate_frame(rig_log(fmu_result(session, case=case)), f"virtual rig log of case {case.index}")
     res = identify(log)[0]
     if src.axis in res.failures:
         raise DesignerError(f"case {case.index}: the rig log failed identification: {res.failures[src.axis]}")
@@ -104,19 +137,29 @@ def _failure(exc: Exception) -> Exception:
 
 
 def _fmu_batch(task: Task) -> list[dict]:
-    from ..cosim.run import joint_fmus
+    """The batch's cases through one prepared Session: set-up once, then a reset and a run per case.
+    After a failed case the session is closed and the next case prepares a fresh one."""
+    from ..cosim import prepare
 
     rows = []
-    with joint_fmus(task.scenario) as fmus:
+    with contextlib.ExitStack() as stack:
+        session: Session | None = None
         for case in task.cases:
             start = time.perf_counter()
             try:
+                if session is None:
+                    session = (
+                        held(task.scenario) if task.hold else stack.enter_context(prepare(task.scenario))
+                    )
                 if task.scenario.kind == "rig":
-                    outcome: dict | Exception = rig_identification(task.scenario, fmus=fmus, case=case)
+                    outcome: dict | Exception = rig_identification(session, case=case)
                 else:
-                    outcome = fmu_result(task.scenario, fmus=fmus, case=case).metrics
+                    outcome = fmu_result(session, case=case).metrics
             except Exception as exc:  # a failed case is recorded, never fatal to the sweep
                 outcome = _failure(exc)
+                if session is not None:
+                    release() if task.hold else session.close()
+                    session = None
             rows.append(case_row(case, outcome=outcome, wall=time.perf_counter() - start))
     return rows
 
@@ -157,6 +200,8 @@ def evaluate(task: Task) -> list[dict]:
         return _engine_batch(task) if task.path == "engine" else _fmu_batch(task)
 
 
-def batches(scenario: Scenario, *, path: str, cases: Sequence[Case], size: int) -> list[Task]:
-    """Cases split into tasks of at most `size`."""
-    return [Task(scenario, path, tuple(cases[i : i + size])) for i in range(0, len(cases), size)]
+def batches(
+    scenario: Scenario, *, path: str, cases: Sequence[Case], size: int, hold: bool = False
+) -> list[Task]:
+    """Cases split into tasks of at most `size` (`hold`: see Task)."""
+    return [Task(scenario, path, tuple(cases[i : i + size]), hold) for i in range(0, len(cases), size)]

@@ -6,7 +6,7 @@ import contextlib
 import json
 import math
 from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import Executor, Future, as_completed
+from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO
@@ -15,7 +15,7 @@ import pandas as pd
 
 from ..errors import DesignerError, describe
 from .cases import Case, make_cases
-from .evaluate import Task, batches, evaluate
+from .evaluate import Task, batches, evaluate, release
 from .spec import Spec, check
 
 Progress = Callable[[float], None] | None
@@ -52,10 +52,9 @@ def read_journal(path: Path | None) -> dict[str, dict]:
 def _batch_size(spec: Spec, n_cases: int, workers: int) -> int:
     if spec.batch is not None:
         return spec.batch
-    # FMU cases take tens of ms each, so small batches keep workers busy and the bar moving;
-    # the engine path wants large batches for mujoco.rollout
-    cap = 256 if spec.path == "engine" else 8
-    return max(1, min(cap, math.ceil(n_cases / (4 * max(workers, 1)))))
+    # a batch is one prepared Session (FMU path, tens of ms to set up, a few ms a 1 s case) or one
+    # mujoco.rollout (engine path): large batches; four per worker keep the bar moving
+    return max(1, min(256, math.ceil(n_cases / (4 * max(workers, 1)))))
 
 
 @contextlib.contextmanager
@@ -93,6 +92,15 @@ def _journal(path: Path | None) -> Iterator[IO | None]:
         if torn:
             fh.write("\n")
         yield fh
+
+
+@contextlib.contextmanager
+def _releasing() -> Iterator[None]:
+    """Close, at the end, the Session this process held for the sweep's batches (evaluate.release)."""
+    try:
+        yield
+    finally:
+        release()
 
 
 def _finished(ex: Executor, tasks: Sequence[Task]) -> Iterator[list[dict]]:
@@ -135,8 +143,10 @@ def evaluate_cases(
 
         workers = 1 if isinstance(executor, SerialExecutor) else local_workers(spec.workers)
         size = _batch_size(spec, len(todo), workers)
-        tasks = batches(spec.scenario, path=spec.path, cases=todo, size=size)
-        with _default_executor(spec, executor) as ex, _journal(journal) as fh:
+        with _default_executor(spec, executor) as ex, _journal(journal) as fh, _releasing():
+            # this process and local worker processes keep one Session between batches
+            hold = isinstance(ex, (SerialExecutor, ProcessPoolExecutor))
+            tasks = batches(spec.scenario, path=spec.path, cases=todo, size=size, hold=hold)
             finished = 0
             for rows in _finished(ex, tasks):
                 for row in rows:

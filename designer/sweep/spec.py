@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from ..cosim.scenario import Scenario
+from ..cosim.session import sources  # noqa: F401  (the joints a sweep can vary, by name)
 from ..errors import DesignerError, check_type
 from ..keys import check_keys, read_toml
 from .limits import Limit, parse_limit
@@ -62,11 +63,6 @@ class Spec:
     batch: int | None = None
     cluster: dict[str, Any] = field(default_factory=dict)
     source: Path | None = None
-
-
-def sources(scenario: Scenario) -> dict[str, Any]:
-    """The joints a sweep can vary, by name: a robot's joints, or the rig's joint as "rig"."""
-    return {"rig": scenario.rig_joint} if scenario.kind == "rig" else dict(scenario.joints)
 
 
 def _where(path: Path, key: str) -> str:

@@ -92,7 +92,7 @@ def engine_check(spec: Spec, *, cases: Sequence[Case], frame: pd.DataFrame) -> d
     """The engine path against the FMU co-simulation on `spec.check` cases spread over the finished ones."""
     if spec.path != "engine" or spec.check == 0:
         return None
-    from ..cosim.run import joint_fmus
+    from ..cosim import prepare
     from .engine import rollout_traces
     from .evaluate import fmu_result, metrics
 
@@ -106,9 +106,9 @@ def engine_check(spec: Spec, *, cases: Sequence[Case], frame: pd.DataFrame) -> d
     sc = spec.scenario
     engine = rollout_traces(sc, picks)
     angle, metric_diff = 0.0, {}
-    with joint_fmus(sc) as fmus:
+    with prepare(sc) as session:
         for case, fast in zip(picks, engine, strict=True):
-            result = fmu_result(sc, fmus=fmus, case=case)
+            result = fmu_result(session, case=case)
             q = [f"robot.{j}.q" for j in sc.joints]
             angle = max(angle, max(float(np.max(np.abs(result.column(c) - fast.column(c)))) for c in q))
             slow, quick = result.metrics, metrics(sc, trace=fast, case=case)

@@ -1,0 +1,352 @@
+"""Exports into robots nobody here wrote, taken from installed packages (none copied into the repository).
+
+MJCF hosts: gymnasium's MuJoCo assets, dm_control's suite, mujoco's own test model. URDF hosts:
+pybullet_data's xArm6, Unitree A1, Franka Panda, KUKA iiwa and R2D2. For each export: it runs or is
+refused with a one-line reason; the edited joint's k, c and rest are exact in SI in every engine that
+reads them; every other body's pose (at the reference pose and at every keyframe) and every other
+joint's numbers are unchanged; every host value the export changed is in its notes.
+
+The comparisons here are written from the compiled models (MuJoCo's and pybullet's own readings of
+both files), not from the exporter's self-check.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from designer.errors import DesignerError
+from designer.export.checks import joint_numbers, other_joint_changes, pose_changes
+from designer.export.mjcf import export_mjcf
+from designer.export.urdf import export_urdf
+from designer.joint import Joint
+
+mujoco = pytest.importorskip("mujoco")
+
+#: SI: k 0.05 N.m/rad, c 5e-4 N.m.s/rad, J 1e-5 kg.m^2; x: k 800 N/m, c 2 N.s/m, m 0.01 kg
+JOINT = Joint.from_coefficients(
+    {"theta": {"k": 50.0, "c": 0.5, "m": 1e-5}, "x": {"k": 0.8, "c": 2e-3, "m": 0.01}}
+)
+SI = {"theta": JOINT.axes["theta"].si(), "x": JOINT.axes["x"].si()}
+
+
+def _package_dir(name: str, sub: str) -> Path | None:
+    spec = importlib.util.find_spec(name)
+    if spec is None or not spec.submodule_search_locations:
+        return None
+    return Path(next(iter(spec.submodule_search_locations))) / sub
+
+
+#: (package, folder in it, file): every MJCF model these packages ship that has a hinge or slide joint
+MJCF_FOLDERS = {
+    "gymnasium": ("gymnasium", "envs/mujoco/assets"),
+    "dm_control": ("dm_control", "suite"),
+    "mujoco": ("mujoco", "testdata"),
+}
+#: joints worth a case of their own beyond each model's first and last (why, in the comment)
+EXTRA = {
+    ("gymnasium", "humanoid.xml"): ["right_knee"],  # coupled by a fixed tendon
+    ("gymnasium", "reacher.xml"): ["joint1"],  # host armature 1
+    ("gymnasium", "half_cheetah.xml"): ["bshin"],  # host spring k 180
+    ("gymnasium", "ant.xml"): ["ankle_1"],  # range [30, 70] deg
+    ("mujoco", "model.xml"): ["hipy_0", "slider"],  # tendon; a joint-limit sensor
+    ("dm_control", "dog.xml"): ["Ca_1_extend"],  # springdamper: k and c derived from the mass matrix
+}
+#: models too large to try every joint's neighbours: only first, last and EXTRA
+REFUSALS = {
+    # (package, file, joint, form): what the one-line reason must say
+    ("mujoco", "model.xml", "slider", "series"): "reads the limit of robot joint 'slider'",
+}
+
+
+def _mjcf_cases() -> list:
+    cases = []
+    for package, (module, sub) in MJCF_FOLDERS.items():
+        folder = _package_dir(module, sub)
+        if folder is None:
+            cases.append(
+                pytest.param(package, None, marks=pytest.mark.skip(reason=f"{module} is not installed"))
+            )
+            continue
+        for path in sorted(folder.glob("*.xml")):
+            if path.name in ("msh.xml",) or "<worldbody" not in path.read_text(errors="replace"):
+                continue
+            cases.append(pytest.param(package, path, id=f"{package}-{path.stem}"))
+    return cases
+
+
+@pytest.fixture(scope="module")
+def copies(tmp_path_factory):
+    """Each package's model folder copied once (outputs go beside the host so its includes resolve)."""
+    made: dict[Path, Path] = {}
+
+    def copy(path: Path) -> Path:
+        if path.parent not in made:
+            target = tmp_path_factory.mktemp("host") / path.parent.name
+            shutil.copytree(path.parent, target, ignore=shutil.ignore_patterns("*.py", "__pycache__"))
+            made[path.parent] = target
+        return made[path.parent] / path.name
+
+    return copy
+
+
+def _joints(spec, package: str, name: str) -> list[str]:
+    kinds = (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)
+    have = [j.name for j in spec.joints if j.type in kinds and j.name]
+    picked = [*have[:1], *have[-1:], *EXTRA.get((package, name), [])]
+    return list(dict.fromkeys(picked))
+
+
+def _same_poses(before, after) -> None:
+    """Every host body where it was, at the reference pose and at each keyframe (same keys, in order)."""
+    assert pose_changes(before, after) == []
+
+
+def _check_parallel(before, after, name: str, si: dict, notes: tuple[str, ...]) -> None:
+    old, new = joint_numbers(before, name), joint_numbers(after, name)
+    assert new["stiffness"][0] == si["k"] and new["damping"][0] == si["c"]
+    assert new["springref"][0] == pytest.approx(old["springref"][0], rel=1e-12, abs=1e-15)
+    expected_armature = old["armature"][0] if old["armature"][0] > 0 else si["m"]
+    assert new["armature"][0] == expected_armature
+    for field in ("frictionloss", "ref", "range", "limited", "axis", "pos"):
+        assert np.array_equal(old[field], new[field]), field
+    text = " | ".join(notes)
+    for field in ("stiffness", "damping", "armature"):
+        if new[field][0] != old[field][0]:
+            assert f"{field}: {old[field][0]:.4g} -> {new[field][0]:.4g}" in text, (field, text)
+    assert "springref kept" in text
+    if old["armature"][0] > 0:
+        assert "armature kept" in text
+
+
+def _check_series(before, after, name: str, si: dict, notes: tuple[str, ...]) -> None:
+    old, new, motor = (
+        joint_numbers(before, name),
+        joint_numbers(after, name),
+        joint_numbers(after, f"{name}_motor"),
+    )
+    assert new["stiffness"][0] == si["k"] and new["damping"][0] == si["c"] and new["armature"][0] == si["m"]
+    assert new["springref"][0] == 0.0 and new["limited"][0] == 0
+    for field in ("range", "limited", "axis", "ref"):
+        assert np.array_equal(old[field], motor[field]), field
+    text = " | ".join(notes)
+    assert (
+        f"{name} is now the flexure" in text
+        and f"stiffness {old['stiffness'][0]:.4g} -> {si['k']:.4g}" in text
+    )
+    if before.nkey:
+        assert f"{before.nkey} keyframe(s) extended" in text
+    if old["limited"][0]:
+        assert f"moved to {name}_motor" in text
+
+
+@pytest.mark.parametrize("package, path", _mjcf_cases())
+def test_mjcf_into_every_model_the_packages_ship(copies, package, path):
+    host = copies(path)
+    spec = mujoco.MjSpec.from_file(str(host))
+    before = mujoco.MjModel.from_xml_path(str(host))
+    tried = 0
+    for name in _joints(spec, package, path.name):
+        hinge = spec.joint(name).type == mujoco.mjtJoint.mjJNT_HINGE
+        axis = "theta" if hinge else "x"
+        for form in ("parallel", "series"):
+            out_path = host.parent / f"{host.stem}_{name}_{form}.xml"
+            reason = REFUSALS.get((package, path.name, name, form))
+            if reason is not None:
+                with pytest.raises(DesignerError, match=reason) as refused:
+                    export_mjcf(JOINT, out_path, into=host, joint_name=name, form=form, axis=axis)
+                assert "\n" not in str(refused.value) and not out_path.exists()
+                continue
+            out = export_mjcf(JOINT, out_path, into=host, joint_name=name, form=form, axis=axis)
+            after = mujoco.MjModel.from_xml_path(str(out.path))
+            check = _check_parallel if form == "parallel" else _check_series
+            check(before, after, name, SI[axis], out.notes)
+            assert "qpos0" in out.advice[name].basis
+            if spec.joint(name).springdamper[0] > 0:
+                assert any(n.startswith("springdamper (time constant") for n in out.notes), out.notes
+            if form == "series" and any(j.springdamper[0] > 0 and j.name != name for j in spec.joints):
+                assert any("keep their compiled stiffness and damping" in n for n in out.notes), out.notes
+            assert other_joint_changes(before, after, name) == []
+            _same_poses(before, after)
+            tried += 1
+    assert tried or before.njnt == 0
+
+
+def test_mjcf_into_refuses_a_rest_outside_the_range_and_takes_one_inside(copies):
+    folder = _package_dir("gymnasium", "envs/mujoco/assets")
+    if folder is None:
+        pytest.skip("gymnasium is not installed")
+    host = copies(folder / "ant.xml")
+    with pytest.raises(DesignerError, match=r"outside the range \[0.5236, 1.222\] rad") as refused:
+        export_mjcf(JOINT, host.parent / "a.xml", into=host, joint_name="ankle_1", rest=0.0)
+    assert "\n" not in str(refused.value)
+    out = export_mjcf(JOINT, host.parent / "a.xml", into=host, joint_name="ankle_1", rest=math.radians(40))
+    after = mujoco.MjModel.from_xml_path(str(out.path))
+    assert after.qpos_spring[after.joint("ankle_1").qposadr[0]] == pytest.approx(math.radians(40), rel=1e-12)
+    assert any(n.startswith("springref: 0 -> 0.6981") for n in out.notes), out.notes
+
+
+#: pybullet_data robots and a joint of each (ROS transmissions in xArm6 and A1)
+URDF_ROBOTS = [
+    ("xarm/xarm6_robot.urdf", "joint3"),
+    ("a1/a1.urdf", "FR_lower_joint"),
+    ("franka_panda/panda.urdf", "panda_joint4"),
+    ("franka_panda/panda.urdf", "panda_finger_joint1"),
+    ("kuka_iiwa/model.urdf", "lbr_iiwa_joint_4"),
+    ("r2d2.urdf", "head_swivel"),
+]
+
+
+def _bullet_state(p, client, robot: int) -> dict:
+    """pybullet's reading of a robot: per joint its info (damping apart), per link dynamics and pose."""
+    p.resetBasePositionAndOrientation(robot, [0, 0, 0], [0, 0, 0, 1], physicsClientId=client)
+    out = {}
+    for j in range(p.getNumJoints(robot, physicsClientId=client)):
+        info = p.getJointInfo(robot, j, physicsClientId=client)
+        name = info[1].decode()
+        link = p.getLinkState(robot, j, computeForwardKinematics=True, physicsClientId=client)
+        out[name] = {
+            "info": info[:6] + info[7:],
+            "damping": info[6],
+            "dynamics": p.getDynamicsInfo(robot, j, physicsClientId=client)[:4],
+            "pose": np.array([*link[4], *link[5]]),
+        }
+    return out
+
+
+@pytest.mark.parametrize("file, name", URDF_ROBOTS)
+def test_urdf_into_pybullet_data_robots(tmp_path, file, name):
+    pybullet_data = pytest.importorskip("pybullet_data")
+    import pybullet as p
+    from lxml import etree
+
+    host = Path(pybullet_data.getDataPath()) / file
+    root = etree.parse(str(host)).getroot()
+    prismatic = root.xpath("/robot/joint[@name=$n]", n=name)[0].get("type") == "prismatic"
+    axis = "x" if prismatic else "theta"
+    si = SI[axis]
+    # beside the host's folder (its meshes resolve), in a copy so nothing is written into site-packages
+    folder = tmp_path / "robot"
+    shutil.copytree(
+        host.parent, folder, ignore=shutil.ignore_patterns("*.py", "__pycache__"), dirs_exist_ok=True
+    )
+    out = export_urdf(JOINT, folder / "flex.urdf", into=folder / host.name, joint_name=name, axis=axis)
+    edited = etree.parse(str(out.path)).getroot()
+    gz = edited.xpath("/robot/gazebo[@reference=$n]", n=name)
+    assert len(gz) == 1
+    assert (
+        float(gz[0].findtext("springStiffness")) == si["k"] and float(gz[0].findtext("springReference")) == 0
+    )
+    if name in out.advice:  # the links the joint moves state their inertia
+        assert "flags=p.URDF_USE_INERTIA_FROM_FILE" in out.advice[name].text()
+    text = " | ".join(out.notes)
+    assert "damping: " in text and f"-> {si['c']:.4g} (SI)" in text and "MuJoCo and pybullet" in text
+    client = p.connect(p.DIRECT)
+    try:
+        flags = p.URDF_USE_INERTIA_FROM_FILE
+        states = [
+            _bullet_state(
+                p, client, p.loadURDF(str(f), useFixedBase=True, flags=flags, physicsClientId=client)
+            )
+            for f in (folder / host.name, out.path)
+        ]
+    finally:
+        p.disconnect(client)
+    before, after = states
+    assert after[name]["damping"] == si["c"]
+    # MuJoCo reads URDF damping too: where it loads the robot, the joint and nothing else changes
+    try:
+        host_mj = mujoco.MjModel.from_xml_path(str(folder / host.name))
+    except ValueError:  # package:// mesh paths (xArm6, Panda), which MuJoCo does not resolve
+        host_mj = None
+    if host_mj is not None:
+        out_mj = mujoco.MjModel.from_xml_path(str(out.path))
+        assert joint_numbers(out_mj, name)["damping"][0] == si["c"]
+        assert other_joint_changes(host_mj, out_mj, name) == [] and pose_changes(host_mj, out_mj) == []
+    assert before.keys() == after.keys()
+    for joint, old in before.items():
+        new = after[joint]
+        assert old["info"] == new["info"] and old["dynamics"] == new["dynamics"], joint
+        assert np.allclose(old["pose"], new["pose"], atol=1e-12), joint
+        if joint != name:
+            assert old["damping"] == new["damping"], joint
+
+
+def drake_joint_torque(path: Path, name: str, positions: list[float], *, prismatic: bool) -> list[float]:
+    """Drake's generalized force on joint `name` of URDF `path` (gravity off, at rest) at each position
+    of that joint, every other joint at its default: the joint's spring as Drake reads it."""
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import MultibodyPlant
+    from pydrake.multibody.tree import MultibodyForces
+
+    plant = MultibodyPlant(0.0)
+    parser = Parser(plant)
+    parser.package_map().PopulateFromFolder(str(path.parent))
+    parser.AddModels(str(path))
+    plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, 0.0])
+    plant.Finalize()
+    context = plant.CreateDefaultContext()
+    joint = plant.GetJointByName(name)
+    out = []
+    for q in positions:
+        joint.set_translation(context, q) if prismatic else joint.set_angle(context, q)
+        forces = MultibodyForces(plant)
+        plant.CalcForceElementsContribution(context, forces)
+        out.append(float(plant.CalcGeneralizedForces(context, forces)[joint.velocity_start()]))
+    return out
+
+
+@pytest.mark.parametrize("file, name", URDF_ROBOTS)
+def test_urdf_into_pybullet_data_robots_gives_drake_the_spring(tmp_path, file, name):
+    """Drake reads the spring from the export's bushing: -k (q - rest) on the joint, exactly."""
+    pybullet_data = pytest.importorskip("pybullet_data")
+    pytest.importorskip("pydrake", reason="pydrake (Drake) is not installed: pip install drake")
+    host = Path(pybullet_data.getDataPath()) / file
+    folder = tmp_path / "robot"
+    shutil.copytree(
+        host.parent, folder, ignore=shutil.ignore_patterns("*.py", "__pycache__"), dirs_exist_ok=True
+    )
+    prismatic = "finger" in name
+    axis, rest, span = ("x", 0.01, 0.02) if prismatic else ("theta", 0.3, 1.0)
+    try:
+        drake_joint_torque(folder / host.name, name, [0.0], prismatic=prismatic)
+    except (
+        RuntimeError
+    ) as exc:  # the robot as shipped does not load in Drake (xArm6: repeated actuator names)
+        pytest.skip(f"Drake does not load {file} as shipped: {str(exc)[:120]}")
+    out = export_urdf(
+        JOINT, folder / "flex.urdf", into=folder / host.name, joint_name=name, axis=axis, rest=rest
+    )
+    positions = [rest - 0.5 * span, rest, rest + 0.2 * span]
+    got = drake_joint_torque(out.path, name, positions, prismatic=prismatic)
+    want = [-SI[axis]["k"] * (q - rest) for q in positions]
+    assert got == pytest.approx(want, rel=1e-9, abs=1e-15)
+
+
+@pytest.mark.parametrize(
+    "package, sub, file, name",
+    [
+        ("gymnasium", "envs/mujoco/assets", "humanoid.xml", "right_knee"),
+        ("mujoco", "testdata", "model.xml", "hipy_0"),
+    ],
+)
+def test_a_new_rest_on_a_joint_a_fixed_tendon_couples(copies, package, sub, file, name):
+    """MuJoCo derives the tendon's spring length from the new springref: the export runs (it exited 3
+    before), the rest is exact, and nothing else of the host changes."""
+    folder = _package_dir(package, sub)
+    if folder is None:
+        pytest.skip(f"{package} is not installed")
+    host = copies(folder / file)
+    before = mujoco.MjModel.from_xml_path(str(host))
+    lo, hi = before.joint(name).range if before.joint(name).limited[0] else (-1.0, 1.0)
+    rest = 0.3 * lo + 0.7 * hi
+    out = export_mjcf(JOINT, host.parent / f"{name}_rest.xml", into=host, joint_name=name, rest=rest)
+    after = mujoco.MjModel.from_xml_path(str(out.path))
+    assert joint_numbers(after, name)["springref"][0] == pytest.approx(rest, rel=1e-12)
+    assert other_joint_changes(before, after, name) == [] and pose_changes(before, after) == []
+    assert any(n.startswith("springref: ") for n in out.notes), out.notes
