@@ -34,6 +34,12 @@ STOPPED = "stopped by SIGTERM; partial files removed"
 COMMANDS = {
     "cosim": (["cosim", str(EXAMPLES / "rig.toml"), "-o", "res"], (0.3, 6.0), {"res"}),
     "sweep": (["sweep", str(EXAMPLES / "sweep_arm.toml"), "-o", "sw", "--workers", "1"], (0.3, 6.5), {"sw"}),
+    # worker processes, each holding a prepared co-simulation (unpacked FMUs) between batches
+    "sweep-workers": (
+        ["sweep", str(EXAMPLES / "sweep_arm.toml"), "-o", "sw", "--workers", "2", "--path", "fmu"],
+        (1.0, 4.0),
+        {"sw"},
+    ),
     "tune": (
         ["tune", str(EXAMPLES / "tune_one_link.toml"), "--robustness", "4", "--workers", "1", "-o", "t.json"],
         (0.3, 5.0),
@@ -46,7 +52,7 @@ COMMANDS = {
         {"j.fmu"},
     ),
 }
-SEEDS = {"cosim": 3, "sweep": 3, "tune": 3, "validate": 2, "export": 4}
+SEEDS = {"cosim": 3, "sweep": 3, "sweep-workers": 2, "tune": 3, "validate": 2, "export": 4}
 RUNS = [(name, seed) for name, n in SEEDS.items() for seed in range(n)]
 CASE_COUNT = len(RUNS) + 3  # + the compiler running, a sweep resumed after a stop, a finaliser
 
@@ -88,7 +94,7 @@ def _check_finished(name: str, cwd: Path) -> None:
         assert {"timeseries.csv", "metrics.json", "rig_log.csv", "rig_log.json"} <= names, names
         assert len(pd.read_csv(cwd / "res" / "timeseries.csv")) == 20001
         json.loads((cwd / "res" / "metrics.json").read_text())
-    elif name == "sweep":
+    elif name.startswith("sweep"):
         assert {p.name for p in (cwd / "sw").iterdir()} >= {"results.parquet", "summary.json", "cases.jsonl"}
         assert len(pd.read_parquet(cwd / "sw" / "results.parquet")) == 200
     elif name == "tune":
@@ -126,7 +132,7 @@ def test_sigterm_at_a_random_moment_leaves_nothing(name, seed, tmp_path):
     if r.returncode == 143:
         assert r.stderr.splitlines()[-1] == STOPPED, r.stderr
         left = {str(p.relative_to(cwd)) for p in cwd.rglob("*")}
-        if name == "sweep" and left:
+        if name.startswith("sweep") and left:
             assert left == {"sw", "sw/cases.jsonl"}, left
             n = _journal_lines(cwd / "sw" / "cases.jsonl")
             assert f"{n} finished cases kept in sw/cases.jsonl" in r.stderr, r.stderr
