@@ -12,7 +12,8 @@ response surface gets wrong there. Per response, in log space:
 - ``g ~ GP(0, s_g(x) s_g(x') rho(x, x'))``: the study model's local error, a squared-exponential
   correlation over the coded factors whose length scale is the longest the study's own nested
   leave-one-out residuals do not reject (`fit_length`), and whose size is the study's predictive spread
-  ``s_g(x)^2 = s0(x)^2 - sigma_n^2``;
+  ``s_g(x)^2 = s0(x)^2 - sigma_n^2`` times an amplitude from a leave-one-out over the study's runs
+  (`fit_amplitude`: 1 for k; 2.5 for c, whose log spread the study's raw-space interval understates);
 - ``e ~ N(0, sigma_n^2)``: print-to-print scatter, from the study's replicated runs (pure error),
   never below 2.5 %.
 
@@ -45,6 +46,8 @@ MIN_NOISE = 0.025
 LENGTHS = (0.25, 0.35, 0.5, 0.7, 1.0, 1.4, 2.0, 3.0)
 #: log-likelihood drop that still counts as "not rejected" (about a 95 % profile interval)
 LIKELIHOOD_DROP = 2.0
+#: sizes tried for the local correction, as multiples of the study's predictive spread
+AMPLITUDES = (1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0)
 
 
 def coded(X: Mapping[str, Any]) -> np.ndarray:
@@ -93,6 +96,12 @@ def noise_of(base: ResponseSurface) -> float:
     return MIN_NOISE
 
 
+def _local_sd(s0: np.ndarray, noise: float) -> np.ndarray:
+    """The local correction's prior sd at amplitude 1: the study's predictive spread less the print
+    scatter (at least half the spread)."""
+    return np.sqrt(np.maximum(s0**2 - noise**2, 0.25 * s0**2))
+
+
 def _correlation(A: np.ndarray, B: np.ndarray, length: float) -> np.ndarray:
     d2 = np.sum((A[:, None, :] - B[None, :, :]) ** 2, axis=2)
     return np.exp(-0.5 * d2 / length**2)
@@ -112,7 +121,7 @@ def fit_length(base: ResponseSurface, X: Mapping[str, Any], y: np.ndarray, noise
         return LENGTHS[0]
     r = np.log(y) - np.log(np.asarray(held.value, dtype=float))
     _, s0 = _log_moments(base, X)
-    sg = np.sqrt(np.maximum(s0**2 - noise**2, 0.25 * s0**2))
+    sg = _local_sd(s0, noise)
     Z = coded(X)
     ll = []
     for length in LENGTHS:
@@ -123,11 +132,45 @@ def fit_length(base: ResponseSurface, X: Mapping[str, Any], y: np.ndarray, noise
     return max(length for length, v in zip(LENGTHS, ll, strict=True) if v >= max(ll) - LIKELIHOOD_DROP)
 
 
-def _length_of(base: ResponseSurface, X: Mapping[str, Any], y: np.ndarray, noise: float) -> float:
-    """`fit_length`, computed once per study surface (the design loop recalibrates many times)."""
-    if "_calibration_length" not in base.__dict__:
-        base.__dict__["_calibration_length"] = fit_length(base, X, y, noise)
-    return base.__dict__["_calibration_length"]
+def fit_amplitude(
+    base: ResponseSurface, X: Mapping[str, Any], y: np.ndarray, noise: float, length: float
+) -> tuple[float, float]:
+    """(amplitude, sd of the standardized errors): the local correction's size, as a multiple of the
+    study's predictive spread, from a leave-one-out over the study's own runs.
+
+    Each run is predicted from the others through the correction alone (the study's printer, no
+    factor); the smallest amplitude whose standardized errors have an sd of at most 1 is taken. The
+    study's spread is the right size for k (sd 0.98 at 1); for c, whose surface is a constant in
+    raw space, the log-normal stand-in understates how far its runs spread (sd 1.63 at 1).
+    """
+    printed = _as_printed(dict(X))
+    mu0, s0 = _log_moments(base, printed)
+    r = np.log(y) - mu0
+    sg = _local_sd(s0, noise)
+    R = _correlation(coded(printed), coded(printed), length)
+    sd = np.inf
+    for a in AMPLITUDES:
+        K = a**2 * np.outer(sg, sg) * R + noise**2 * np.eye(len(r))
+        Kinv = np.linalg.inv(K)
+        # leave-one-out of a Gaussian process in closed form (Rasmussen & Williams, eq. 5.12)
+        z = (Kinv @ r) / np.sqrt(np.diag(Kinv))
+        sd = float(np.std(z))
+        if sd <= 1.0:
+            return a, sd
+    return AMPLITUDES[-1], sd
+
+
+def _settings_of(prior: Surrogate, response: str) -> tuple[float, float, float]:
+    """(length, amplitude, noise) of `response`'s correction, computed once per study surface (the
+    design loop recalibrates many times)."""
+    base = prior.models[response]
+    if "_calibration_settings" not in base.__dict__:
+        X, y = _study_runs(prior, response)
+        noise = noise_of(base)
+        length = fit_length(base, X, y, noise)
+        amplitude, _ = fit_amplitude(base, X, y, noise, length)
+        base.__dict__["_calibration_settings"] = (length, amplitude, noise)
+    return base.__dict__["_calibration_settings"]
 
 
 @dataclass
@@ -143,6 +186,7 @@ class CalibratedSurface(ResponseSurface):
     #: (n,) 1 for the user's runs (they carry the printer factor), 0 for the study's own runs
     own: np.ndarray = field(default_factory=lambda: np.zeros(0))
     length: float = 1.0
+    amplitude: float = 1.0
     noise: float = MIN_NOISE
     printer_sd: float = PRINTER_SD
 
@@ -153,13 +197,21 @@ class CalibratedSurface(ResponseSurface):
         runs: np.ndarray,
         observed: np.ndarray,
         own: np.ndarray,
-        length: float,
-        noise: float,
+        settings: tuple[float, float, float],
         printer_sd: float = PRINTER_SD,
     ) -> CalibratedSurface:
+        """`settings`: (length, amplitude, noise), as `_settings_of` gives them."""
         shared = {f.name: getattr(base, f.name) for f in fields(ResponseSurface)}
+        length, amplitude, noise = settings
         surf = cls(
-            **shared, runs=runs, observed=observed, own=own, length=length, noise=noise, printer_sd=printer_sd
+            **shared,
+            runs=runs,
+            observed=observed,
+            own=own,
+            length=length,
+            amplitude=amplitude,
+            noise=noise,
+            printer_sd=printer_sd,
         )
         surf._prepare(base)
         return surf
@@ -169,7 +221,7 @@ class CalibratedSurface(ResponseSurface):
         X = dict(zip(space.FACTOR_NAMES, self.runs.T, strict=True))
         mu0, s0 = _log_moments(base, X)
         self._Zu = coded(X)
-        self._sgu = np.sqrt(np.maximum(s0**2 - self.noise**2, 0.25 * s0**2))
+        self._sgu = self.amplitude * _local_sd(s0, self.noise)
         K = self._prior_cov(self._Zu, self._sgu, self.own, self._Zu, self._sgu, self.own)
         K += self.noise**2 * np.eye(len(mu0))
         self._Kinv = np.linalg.inv(K) if len(mu0) else np.zeros((0, 0))
@@ -189,9 +241,10 @@ class CalibratedSurface(ResponseSurface):
         """Calibrated predictive mean and scale of log y at designs X, arrays of shape (n,)."""
         mu0, s0 = _log_moments(self._base, X)
         Z = coded(X)
-        sg = np.sqrt(np.maximum(s0**2 - self.noise**2, 0.25 * s0**2))
-        C = self._prior_cov(Z, sg, np.ones(len(Z)), self._Zu, self._sgu, self.own)
-        var = s0**2 + self.printer_sd**2 - np.einsum("ij,jk,ik->i", C, self._Kinv, C)
+        sg = _local_sd(s0, self.noise)
+        C = self._prior_cov(Z, self.amplitude * sg, np.ones(len(Z)), self._Zu, self._sgu, self.own)
+        prior = s0**2 + (self.amplitude**2 - 1) * sg**2 + self.printer_sd**2
+        var = prior - np.einsum("ij,jk,ik->i", C, self._Kinv, C)
         return mu0 + C @ self._alpha, np.sqrt(np.maximum(var, self.noise**2))
 
     def predict(self, X: Any) -> Prediction:
@@ -205,11 +258,11 @@ class CalibratedSurface(ResponseSurface):
         mu0 = ca.log(value0)
         s0 = (ca.log(hi0) - mu0) / self.t95
         sg = ca.sqrt(ca.fmax(s0**2 - self.noise**2, 0.25 * s0**2))
-        var, mu = s0**2 + self.printer_sd**2, mu0
+        var, mu = s0**2 + (self.amplitude**2 - 1) * sg**2 + self.printer_sd**2, mu0
         if len(self._Zu):
             z = ca.vertcat(*_coded_symbolic(x))
             d2 = ca.sum1((ca.repmat(z, 1, len(self._Zu)) - ca.DM(self._Zu.T)) ** 2).T
-            local = sg * ca.DM(self._sgu) * ca.exp(-0.5 * d2 / self.length**2)
+            local = self.amplitude * sg * ca.DM(self._sgu) * ca.exp(-0.5 * d2 / self.length**2)
             c = self.printer_sd**2 * ca.DM(self.own) + local
             var, mu = var - ca.bilin(ca.DM(self._Kinv), c, c), mu + ca.dot(c, ca.DM(self._alpha))
         half = self.t95 * ca.sqrt(ca.fmax(var, self.noise**2))
@@ -238,10 +291,16 @@ class CalibratedSurface(ResponseSurface):
             "tau2": self.printer_sd**2,
             "noise": self.noise,
             "length": self.length,
+            "amplitude": self.amplitude,
         }
 
     def settings(self) -> dict[str, Any]:
-        return {"length": self.length, "noise": self.noise, "printer_sd": self.printer_sd}
+        return {
+            "length": self.length,
+            "amplitude": self.amplitude,
+            "noise": self.noise,
+            "printer_sd": self.printer_sd,
+        }
 
 
 def _runs_table(runs: Any, surrogate: Surrogate) -> Any:
@@ -306,8 +365,7 @@ def new_printer(surrogate: Surrogate, *, printer_sd: float = PRINTER_SD) -> Surr
         r: CalibratedSurface.from_base(
             base,
             *_evidence(surrogate, r, {n: np.zeros(0) for n in space.FACTOR_NAMES}, np.zeros(0)),
-            _length_of(base, *_study_runs(surrogate, r), noise_of(base)),
-            noise_of(base),
+            _settings_of(surrogate, r),
             printer_sd,
         )
         for r, base in surrogate.models.items()
@@ -361,11 +419,10 @@ def calibrate(surrogate: Surrogate, runs: Any, *, printer_sd: float = PRINTER_SD
         if not rows.any():
             models[r] = base
             continue
-        noise = noise_of(base)
-        length = _length_of(base, *_study_runs(prior, r), noise)
         user = {n: table.loc[rows, n].to_numpy(dtype=float) for n in space.FACTOR_NAMES}
         designs, observed, own = _evidence(prior, r, user, table.loc[rows, r].to_numpy(dtype=float))
-        models[r] = CalibratedSurface.from_base(base, designs, observed, own, length, noise, printer_sd)
+        settings = _settings_of(prior, r)
+        models[r] = CalibratedSurface.from_base(base, designs, observed, own, settings, printer_sd)
     keep = list(space.FACTOR_NAMES) + [r for r in prior.responses if r in table.columns]
     return Surrogate(
         models=models,
