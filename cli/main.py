@@ -120,7 +120,9 @@ def _unraisable(hook):
             # sent again from another thread a moment later, when the main thread has left the
             # callback (raised here, it would land in this hook and be swallowed again)
             signal.signal(exc.signum, _stop)
-            threading.Timer(0.02, os.kill, (os.getpid(), exc.signum)).start()
+            again = threading.Timer(0.02, os.kill, (os.getpid(), exc.signum))
+            again.daemon = True  # never holds up the interpreter's exit
+            again.start()
             return
         hook(unraisable)
 

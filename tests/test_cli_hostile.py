@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from clitools import assert_clean_failure, bundled_table, enter_workdir, run_inprocess, snapshot
+from clitools import assert_clean_failure, bundled_table, enter_workdir, run_inprocess, run_process, snapshot
 from test_cli_campaign import SIX, K
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -474,6 +474,26 @@ def test_negative_zero_damping_is_zero_not_minus_zero(workdir, capsys):
     assert 'start="-0' not in md and 'start="0"' in md or 'start="0.0"' in md
 
 
+REAL = [
+    ["fit", "--data", "in/deccomma_quoted.csv"],
+    ["analyze", "--data", "in/utf16.csv"],
+    ["export", "fmu", "--from", "in/sj_density_text.json", "-o", "j.fmu"],
+    ["cosim", "in/sc_rig_f1_1e6.toml", "-o", "res"],
+    ["cosim", "in/sc_axis_list.toml", "-o", "res"],
+    ["sweep", "in/sw_typo_sweep.toml", "-o", "sw"],
+    ["rig", "simulate", *K, *SIX, "--f1", "900", "-o", "l.csv"],
+]
+
+
+@pytest.mark.parametrize("args", REAL, ids=[" ".join(a)[:50] for a in REAL])
+def test_a_sample_as_real_processes(args, workdir, inputs):
+    """The installed package as a real `python -I` process gives the same clean failure."""
+    before = snapshot(workdir, inputs)
+    r = run_process(args, workdir)
+    assert_clean_failure(r.returncode, r.stderr, (2,))
+    assert r.stdout == "" and snapshot(workdir, inputs) == before
+
+
 # --- the Python API with wrong types --------------------------------------------------------------
 
 
@@ -595,6 +615,7 @@ def test_the_campaign_has_at_least_300_cases_with_the_earlier_rounds():
         + len(SWEEPS)
         + len(IMPOSSIBLE)
         + len(API_CASES)
+        + len(REAL)
     )
     real = test_cli_interrupts.CASE_COUNT + test_files_hostile.CASE_COUNT
     earlier = len(test_cli_campaign.CASES) + len(test_cli_campaign.REAL)
