@@ -51,6 +51,21 @@ def path_argument(value: Any, name: str, *, what: str = "a file") -> Path:
     return Path(value)
 
 
+def names_argument(value: Any, name: str, *, example: str) -> list[str]:
+    """`value` (a str, or a list or tuple of str) as a list of names, e.g. responses or axes.
+
+    Raises:
+        DesignerError: naming the argument `name` when `value` is a number, an array, a dict...
+    """
+    if isinstance(value, str):
+        return [value]
+    fix = f"give {name} as a list of names, e.g. {name}={example}"
+    check_type(value, (list, tuple), name, expected="a list of names", fix=fix)
+    for item in value:
+        check_type(item, str, f"{name}[{value.index(item)}]", expected="a name (str)", fix=fix)
+    return list(value)
+
+
 def number_argument(value: Any, name: str, *, example: str = "0.8") -> float:
     """`value` (a real number, not a bool; numpy scalars too) as a float.
 

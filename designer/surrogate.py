@@ -29,7 +29,7 @@ import casadi as ca
 import numpy as np
 
 from . import space, units
-from .errors import DesignerError, check_type, path_argument
+from .errors import DesignerError, check_type, names_argument, path_argument
 from .files import atomic_write
 
 FORMAT = "flexjoint-surrogate/1"
@@ -670,6 +670,7 @@ class Surrogate:
         axes = axes_present(table)
         if responses is None:
             responses = [f"{q}_{a}" for a in axes for q in ("c", "k")]
+        responses = names_argument(responses, "responses", example='["k_x"]')
         unknown = [r for r in responses if r not in coefficient_columns(table)]
         if unknown or not responses:
             raise DesignerError(
@@ -726,6 +727,8 @@ class Surrogate:
         if not self.models:
             raise DesignerError("the surrogate is not fitted", "call fit(table) or Surrogate.load() first")
         X = _as_printed(_check_designs(designs, allow_extrapolation))
+        if responses is not None:
+            responses = names_argument(responses, "responses", example='["k_x"]')
         return {r: self.model(r).predict(X) for r in (responses or self.responses)}
 
     def _payload_json(self, include_id: bool = True) -> str:

@@ -432,9 +432,9 @@ def _start_values(joint: Joint, interface: str, variables: list[Variable]) -> st
 
 
 def _check(joint: Joint, fmi_version: int, interface: str) -> None:
-    if fmi_version not in FMI_VERSIONS:
+    if isinstance(fmi_version, bool) or not isinstance(fmi_version, int) or fmi_version not in FMI_VERSIONS:
         raise DesignerError(f"fmi_version={fmi_version!r} is not supported", "use fmi_version=2 or 3")
-    if interface not in INTERFACES:
+    if not isinstance(interface, str) or interface not in INTERFACES:
         raise DesignerError(f"interface={interface!r} is not an interface", "use interface='force' or 'body'")
     if interface == "body":
         missing = [a for a, ac in joint.axes.items() if ac.m is None]

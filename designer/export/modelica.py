@@ -41,7 +41,7 @@ def modelica_text(joint: Joint, *, msl: str = "4.0.0") -> str:
     Raises:
         DesignerError: `msl` is not a supported MSL version.
     """
-    if msl not in MSL_UNITS:
+    if not isinstance(msl, str) or msl not in MSL_UNITS:
         raise DesignerError(f"msl={msl!r} is not supported", f"use one of: {', '.join(MSL_UNITS)}")
     si_types = MSL_UNITS[msl]
     decl, eqs = [], []

@@ -31,7 +31,7 @@ import numpy as np
 import pandas as pd
 
 from .. import space, units
-from ..errors import DesignerError, describe
+from ..errors import DesignerError, describe, names_argument
 from ..mass import specimen_mass
 from . import band as bandlib
 from . import channel
@@ -385,7 +385,9 @@ def identify_log(
             is not a finite number.
     """
     log = _as_log(source)
-    chosen = log.axes if axes is None else list(axes)
+    chosen = log.axes if axes is None else names_argument(axes, "axes", example='["x"]')
+    if not chosen:
+        raise DesignerError("axes=[] names no axis", f"give some of {', '.join(log.axes)}, or None for all")
     absent = [a for a in chosen if a not in log.axes]
     if absent:
         raise DesignerError(f"axes={absent} not in the log", f"the log has {', '.join(log.axes)}")
