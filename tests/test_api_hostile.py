@@ -5,12 +5,17 @@ exception from numpy, pandas, concurrent.futures or Python itself."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+SUGGESTION = EXAMPLES / "suggestion.json"
+ARM = EXAMPLES / "one_link.xml"
 DESIGN = {"density": 60, "length": 24, "width": 4.5, "height": 9, "layer": 0.16, "raster": 0}
 
 
@@ -76,6 +81,14 @@ def _calls():
         "export_urdf(axis=)": lambda v: designer.export_urdf(joint, "j.urdf", axis=v),
         "next_prints(n=)": lambda v: designer.next_prints(sur, k=0.8, n=v),
         "next_prints(stop=)": lambda v: designer.next_prints(sur, k=0.8, stop=v),
+        "suggest(weight=)": lambda v: designer.suggest(sur, k=0.8, weight=v),
+        "Surrogate.load": lambda v: designer.Surrogate.load(v),
+        "from_suggestion(candidate=)": lambda v: designer.Joint.from_suggestion(SUGGESTION, candidate=v),
+        "export_ssp(joints)": lambda v: designer.export_ssp(v, "j.ssp"),
+        "export_mjcf(joint_name=)": lambda v: designer.export_mjcf(joint, "j.xml", into=ARM, joint_name=v),
+        "identify(load_delay_s=)": lambda v: designer.identify(log, load_delay_s=v),
+        "cosim.load": lambda v: designer.cosim.load(v),
+        "sweep.load": lambda v: designer.sweep.load(v),
     }
     specials = _specials(table)
     return calls, specials, _values(specials)

@@ -11,7 +11,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .. import units
-from ..errors import DesignerError
+from ..errors import DesignerError, check_type
 from ..files import atomic_write, check_suffix
 from ..joint import Joint, check_joint
 from . import robot
@@ -202,6 +202,7 @@ def export_mjcf(
     if into is not None:
         if joint_name is None:
             raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
+        check_type(joint_name, str, "joint_name", expected="a name", fix="give e.g. joint_name='knee'")
         with _mujoco_warnings() as warned:
             advice, notes = _into(
                 joint,

@@ -14,7 +14,7 @@ import re
 from pathlib import Path
 
 from .. import units
-from ..errors import DesignerError
+from ..errors import DesignerError, check_type
 from ..files import atomic_path, atomic_write, check_suffix
 from ..joint import Joint, check_joint
 from . import robot, urdf_drake, xmltext
@@ -317,6 +317,7 @@ def export_urdf(
     if into is not None:
         if joint_name is None:
             raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
+        check_type(joint_name, str, "joint_name", expected="a name", fix="give e.g. joint_name='knee'")
         data, advice, notes = _into_urdf(joint, Path(into), joint_name=joint_name, axis=axis, rest=rest)
         with atomic_path(path) as tmp:
             tmp.write_bytes(data)

@@ -31,7 +31,7 @@ import numpy as np
 import pandas as pd
 
 from .. import space, units
-from ..errors import DesignerError, describe, names_argument
+from ..errors import DesignerError, describe, names_argument, number_argument
 from ..mass import specimen_mass
 from . import band as bandlib
 from . import channel
@@ -391,7 +391,9 @@ def identify_log(
     absent = [a for a in chosen if a not in log.axes]
     if absent:
         raise DesignerError(f"axes={absent} not in the log", f"the log has {', '.join(log.axes)}")
-    delay = load_delay_s if load_delay_s is not None else (log.load_delay_s or 0.0)
+    delay = log.load_delay_s or 0.0
+    if load_delay_s is not None:
+        delay = number_argument(load_delay_s, "load_delay_s", example="0.002 (s)")
     if not np.isfinite(delay):
         raise DesignerError(f"load_delay_s={load_delay_s} is not finite", "give the delay in seconds")
     lowpass = channel.parse(load_filter if load_filter is not None else log.load_filter)
