@@ -153,6 +153,31 @@ def test_moving_results_in_waits_for_another_writers_lock_on_the_parent(tmp_path
     assert sorted(p.name for p in tmp_path.iterdir()) == ["res"]
 
 
+def test_two_cold_builds_of_one_binary_share_one_whole_cache_entry(tmp_path):
+    """Two exports compiling the same FMU binary at once into an empty cache: both succeed, and the
+    cache holds one entry with its one library (the second finished build is dropped, not mixed in)."""
+    if not (shutil.which("cc") or shutil.which("gcc")):
+        pytest.skip("no C compiler")
+    env = dict(os.environ, XDG_CACHE_HOME=str(tmp_path / "cache"), TMPDIR=str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
+    args = ["export", "fmu", "--k", "0.8", "--c", "2e-3", "--build", "--platforms", "host"]
+    procs = [
+        subprocess.Popen(
+            [*CLI, *args, "-o", f"j{i}.fmu"], cwd=tmp_path, env=env, stderr=subprocess.PIPE, text=True
+        )
+        for i in (1, 2)
+    ]
+    for p in procs:
+        _, err = p.communicate(timeout=300)
+        assert p.returncode == 0 and "Traceback" not in err, err
+    for i in (1, 2):
+        _complete(tmp_path / f"j{i}.fmu")
+    entries = list((tmp_path / "cache" / "flexjoint-designer" / "fmu").iterdir())
+    assert len(entries) == 1 and not entries[0].name.startswith("."), entries
+    assert [f.name for f in entries[0].iterdir()] == ["FlexJoint.so"]
+    assert not list((tmp_path / "tmp").iterdir())
+
+
 # --- outputs through symbolic links ----------------------------------------------------------------
 
 SYMLINKED = {
@@ -293,4 +318,4 @@ def test_disk_full_before_the_work_is_refused_up_front(small_disk):
     assert sorted(p.name for p in small_disk.iterdir()) == ["filler"]
 
 
-CASE_COUNT = len(CONCURRENT) + 2 + len(SYMLINKED) + 1 + len(BAD_LINKS) + 3
+CASE_COUNT = len(CONCURRENT) + 3 + len(SYMLINKED) + 1 + len(BAD_LINKS) + 3
