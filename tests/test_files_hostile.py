@@ -174,7 +174,7 @@ def test_two_cold_builds_of_one_binary_share_one_whole_cache_entry(tmp_path):
         _complete(tmp_path / f"j{i}.fmu")
     entries = list((tmp_path / "cache" / "flexjoint-designer" / "fmu").iterdir())
     assert len(entries) == 1 and not entries[0].name.startswith("."), entries
-    assert [f.name for f in entries[0].iterdir()] == ["FlexJoint.so"]
+    assert len(list(entries[0].iterdir())) == 1  # the library, nothing else
     assert not list((tmp_path / "tmp").iterdir())
 
 
