@@ -257,10 +257,14 @@ def test_suggestion_cases_are_the_candidates(tmp_path):
     assert len({c.key for c in cases}) == 4
 
 
-def test_tune_on_the_fmu_path():
-    """Every evaluation co-simulated with the FMUs; the limit holds at the optimum found."""
+def test_tune_on_the_fmu_path(monkeypatch):
+    """Every evaluation co-simulated with the FMUs, all generations through one prepared Session;
+    the limit holds at the optimum found."""
+    from designer.sweep import evaluate
     from designer.sweep.tune import tune
 
+    real, prepared = cosim.prepare, []
+    monkeypatch.setattr(cosim, "prepare", lambda sc: prepared.append(sc) or real(sc))
     sc = with_duration(cosim.load(EXAMPLES / "tune_one_link.toml"), 0.3)
     result = tune(
         sc,
@@ -274,6 +278,7 @@ def test_tune_on_the_fmu_path():
         robustness=0,
     )
     assert result.evaluations == 18 and result.fmu_check is None
+    assert len(prepared) == 1 and not evaluate._HELD  # one Session, closed at the end
     assert result.feasible and result.metrics["j1.overshoot_pct"] <= 20
     assert 200 <= result.coefficients["j1"]["k"] <= 600 and result.designs["j1"]["candidates"]
 

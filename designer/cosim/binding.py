@@ -96,18 +96,20 @@ def _no_error(call: int, status: int, t: float) -> DesignerError:
 class Binding:
     """A system as the kernel runs it.
 
-    `kind` one of ROBOT, FMI2, FMI3, SERVO; `instance` the address the C side receives (a struct
-    the system owns, or an FMU instance); `functions` the FMI functions' addresses by CALLS name;
-    `in_vr`, `out_vr` ctypes uint32 arrays of value references (FMUs) or None; `keep` what must stay
-    alive while bound. `start()` brings the C side to the system's state before a run and returns its
-    step count; `finish(steps)` hands the kernel's count (and whatever the system's struct advanced)
-    back after a run; `event()` runs an event iteration the instance asked for; `error(call, status,
-    t)` and `terminated()` give the DesignerError for a failed call or a terminate request.
+    `kind` one of ROBOT, FMI2, FMI3, SERVO; `instance` the address the C side receives: `struct`
+    (the system's own ctypes mirror of its C struct, whose size the kernel checks) or an FMU
+    instance; `functions` the FMI functions' addresses by CALLS name; `in_vr`, `out_vr` ctypes
+    uint32 arrays of value references (FMUs) or None; `keep` what must stay alive while bound.
+    `start(step)` brings the C side to the system's state before a run at macro step `step` (s) and
+    returns its step count; `finish(steps)` hands the kernel's count (and whatever the system's
+    struct advanced) back after a run; `event()` runs an event iteration the instance asked for;
+    `error(call, status, t)` and `terminated()` give the DesignerError for a failed call (for the
+    robot: MuJoCo's divergence warning at time t) or a terminate request.
     """
 
     kind: int
     instance: int
-    start: Callable[[], int]
+    start: Callable[[float], int]
     finish: Callable[[int], None]
     functions: Mapping[str, int] = field(default_factory=dict)
     in_vr: Any = None
@@ -116,3 +118,4 @@ class Binding:
     event: Callable[[], None] | None = None
     error: Callable[[int, int, float], DesignerError] = _no_error
     terminated: Callable[[], DesignerError] | None = None
+    struct: ctypes.Structure | None = None

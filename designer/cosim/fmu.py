@@ -73,6 +73,15 @@ def _axes_of(md) -> set[str]:
     return {v.name.split(".")[0] for v in md.modelVariables if "." in v.name}
 
 
+@functools.lru_cache(maxsize=64)
+def _model_description(path: str, mtime_ns: int, size: int):
+    """fmpy's parse of an FMU's modelDescription.xml, once per file version in a process (a scenario
+    check, a prepare and a sweep worker's sessions read it once). Treat it as read-only."""
+    from fmpy import read_model_description
+
+    return read_model_description(path)
+
+
 class FmuDescription:
     """An FMU's modelDescription.xml, read once: what a run needs from it.
 
@@ -85,15 +94,15 @@ class FmuDescription:
     """
 
     def __init__(self, path: str | Path, axes: Sequence[str]) -> None:
-        from fmpy import read_model_description
-
         path = Path(path)
         if not path.exists():
             raise DesignerError(
                 f"FMU {path} does not exist", "export one with `designer export fmu` or fix the path"
             )
         try:
-            md = read_model_description(str(path))
+            xml = path / "modelDescription.xml" if path.is_dir() else path
+            stat = xml.stat()
+            md = _model_description(str(path), stat.st_mtime_ns, stat.st_size)
         except Exception as exc:  # fmpy raises several types for a broken archive
             raise DesignerError(
                 f"{path} is not a readable FMU: {exc}", "give an FMU exported by designer"
@@ -415,13 +424,17 @@ class FmuSystem:
         """Act on CompletedIntegratorStep's answer: stop, or an event iteration (also for the kernel).
 
         Raises:
-            DesignerError: the FMU asked to terminate the simulation.
+            DesignerError: the FMU asked to terminate the simulation, or an event-mode call returned
+                an error status (with the FMU's log).
         """
         if terminate:
             raise self.terminated()
         if enter:
-            self.fmu.enterEventMode()
-            self._event_iteration()
+            try:
+                self.fmu.enterEventMode()
+                self._event_iteration()
+            except Exception as exc:
+                self._surface(exc)
 
     def binding(self) -> kb.Binding:
         """The instance for the compiled kernel (see designer.cosim.binding): its FMI functions,
@@ -441,7 +454,8 @@ class FmuSystem:
         else:
             wanted += ["time", "completed"] if self.needs_completed_step else ["time"]
 
-        def start() -> int:
+        def start(step: float) -> int:
+            self._h = step  # the macro step the kernel runs, for the time in error messages
             return self._steps
 
         def finish(steps: int) -> None:

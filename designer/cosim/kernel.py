@@ -21,14 +21,11 @@ import numpy as np
 from ..errors import DesignerError
 from . import binding as kb
 from .master import Master, Trace, diverged, steps
-from .rig import ServoStruct
-from .robot import RobotStruct
-from .robot import diverged as robot_diverged
 
 ENGINES = ("auto", "kernel", "python")
 #: rows per kernel call without a progress callback
 CHUNK = 10000
-_OK, _FMU_STATUS, _DIVERGED, _ROBOT_DIVERGED, _EVENT, _TERMINATE = 0, 1, 2, 3, 4, 5
+_OK, _DIVERGED, _EVENT, _TERMINATE = 0, 2, 4, 5  # else 1 (an FMU's status) or 3 (the robot's), see _fail
 
 
 class _System(ctypes.Structure):
@@ -91,9 +88,11 @@ def library() -> ctypes.CDLL:
     lib.ks_run_rows.restype = c_int32
     lib.ks_reference_eval.argtypes = [POINTER(kb.Reference), c_double, kb.P_DOUBLE, kb.P_DOUBLE]
     lib.ks_reference_eval.restype = None
-    sizes = (c_int64 * 5)()
+    lib.ks_struct_size.argtypes = [c_int32]
+    lib.ks_struct_size.restype = c_int64
+    sizes = (c_int64 * 3)()
     lib.ks_sizes(sizes)
-    mirror = [ctypes.sizeof(t) for t in (kb.Reference, RobotStruct, ServoStruct, _System, _Run)]
+    mirror = [ctypes.sizeof(t) for t in (kb.Reference, _System, _Run)]
     if list(sizes) != mirror:
         raise DesignerError(
             f"the kernel's structs ({list(sizes)} bytes) do not match their Python mirror ({mirror})",
@@ -115,6 +114,12 @@ def _describe(master: Master, name: str, system, out: _System, keep: list) -> kb
             "use engine='python' for systems written in Python",
         )
     b = make()
+    if b.struct is not None and ctypes.sizeof(b.struct) != library().ks_struct_size(b.kind):
+        raise DesignerError(
+            f"the kernel's struct for system {name} ({library().ks_struct_size(b.kind)} bytes) does not "
+            f"match its Python mirror {type(b.struct).__name__} ({ctypes.sizeof(b.struct)} bytes)",
+            "use engine='python', and report this with your platform",
+        )
     src = kb.ints(master.sources(name))
     buf = np.zeros(len(src))
     keep += [src, buf, b.keep]
@@ -157,9 +162,7 @@ class Bound:
         """The error for the kernel's outcome `rc`: divergence, a stop request, an FMU's error status."""
         if rc == _DIVERGED:
             return diverged(run.error_time)
-        if rc == _ROBOT_DIVERGED:
-            return robot_diverged(run.error_time)
-        b = self._bindings[run.error_system]
+        b = self._bindings[run.error_system]  # an FMU's status, or the robot's divergence
         if rc == _TERMINATE and b.terminated is not None:
             return b.terminated()
         return b.error(run.error_call, run.error_status, run.error_time)
@@ -197,7 +200,7 @@ class Bound:
         n = steps(duration, step)
         master = self.master
         for out, b in zip(self._structs, self._bindings, strict=True):
-            out.steps, out.asked, out.failed = b.start(), 0, 0
+            out.steps, out.asked, out.failed = b.start(step), 0, 0
         values = np.empty((n + 1, len(master.columns)))
         state = _Run(
             n_systems=len(self._structs),

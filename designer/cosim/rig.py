@@ -9,6 +9,7 @@ in one piece by scipy at tight tolerance.
 from __future__ import annotations
 
 import ctypes
+from collections.abc import Mapping
 from ctypes import c_double, c_int64
 
 import numpy as np
@@ -66,13 +67,22 @@ class HubServo:
         self._h = h
         self._steps += 1
 
+    def tune(self, law: Mapping[str, float], step: float) -> None:
+        """Set the servo's gains for a joint with SI `law` m, c, k (servo_gains).
+
+        Raises:
+            DesignerError: the sampled loop would be unstable at macro step `step` (s).
+        """
+        check_stable(law["m"], law["c"], law["k"], step)
+        self.stiffness, self.damping = servo_gains(law["m"], law["c"], law["k"])
+
     def binding(self) -> kb.Binding:
         """The hub for the compiled kernel (see designer.cosim.binding)."""
         keep: list = []
         struct = ServoStruct(kb.reference(self.chirp, keep))
         keep.append(struct)
 
-        def start() -> int:
+        def start(step: float) -> int:
             struct.stiffness, struct.damping = self.stiffness, self.damping
             struct.out[:] = list(self._out)
             struct.steps, struct.h, struct.chirp.cursor = self._steps, self._h, 0
@@ -81,7 +91,7 @@ class HubServo:
         def finish(steps: int) -> None:
             self._steps, self._h, self._out[:] = struct.steps, struct.h, list(struct.out)
 
-        return kb.Binding(kb.SERVO, ctypes.addressof(struct), start, finish, keep=keep)
+        return kb.Binding(kb.SERVO, ctypes.addressof(struct), start, finish, keep=keep, struct=struct)
 
 
 def servo_gains(m: float, c: float, k: float) -> tuple[float, float]:

@@ -107,6 +107,8 @@ class Scenario:
     validation_steps: tuple[float, ...] = ()
     validation_duration: float | None = None
     path: Path | None = None
+    #: True on what `check()` returns; `dataclasses.replace` gives an unchecked copy again
+    checked: bool = field(default=False, init=False, repr=False, compare=False)
 
     @property
     def kind(self) -> str:
@@ -141,6 +143,7 @@ class Scenario:
         fields["outputs"] = {k: bool(self.outputs.get(k, True)) for k in OUTPUTS}
         sc = replace(self, **fields, **self._validation_fields())
         check_memory(sc)
+        object.__setattr__(sc, "checked", True)  # a frozen dataclass's own flag, set once here
         return sc
 
     def _robot_fields(self) -> dict[str, Any]:

@@ -22,14 +22,18 @@ import math
 import tempfile
 from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import DesignerError, check_type
 from .fmu import FmuDescription, FmuSystem, unpack
 from .kernel import ENGINES, Bound, bind, run_master
 from .master import Master, Trace
+from .rig import HubServo
 from .robot import Robot, SpringDamper, load_spec
 from .scenario import PARAMETER_FIELDS, JointSource, Scenario
+
+if TYPE_CHECKING:
+    from .run import Result
 
 Progress = Callable[[float], None] | None
 
@@ -74,7 +78,8 @@ class Session:
 
     Attributes: `scenario` (checked), `descriptions` (each joint FMU's modelDescription, read once),
     `systems` (the FMU systems by name), `master` (the wiring at the scenario's step). Build it with
-    `prepare`; use it as a context manager or call `close()`.
+    `prepare`; use it as a context manager or call `close()`. A session runs one case at a time:
+    its FMU instances and MjData are its own; prepare one per thread.
     """
 
     def __init__(self, scenario: Scenario, stack: contextlib.ExitStack, folder: Path) -> None:
@@ -86,11 +91,26 @@ class Session:
         self._masters: dict[float, Master] = {}
         self._bound: dict[float, Bound | None] = {}
         self.closed = False
+        self._load()  # what it builds is registered on `stack`, which its caller closes on failure
+
+    @property
+    def master(self) -> Master:
+        """The systems wired at the scenario's step (robot or hub, and the joint FMUs).
+
+        Raises:
+            DesignerError: the session is closed.
+        """
+        self._open()
+        return self._masters[self.scenario.step]
+
+    def _open(self) -> None:
+        if self.closed:
+            raise DesignerError("the session is closed", "prepare the scenario again")
 
     # ------------------------------------------------------------------ set-up (prepare)
 
     def _load(self) -> None:
-        """Export or take each joint FMU, read its description, instantiate it; wire the master."""
+        """Unpack (or write) each joint FMU, read its description, instantiate it; wire the master."""
         sc = self.scenario
         interface = "body" if sc.kind == "rig" else "force"
         for name, src in sources(sc).items():
@@ -113,8 +133,6 @@ class Session:
         systems: dict[str, Any] = {}
         connections = []
         if sc.kind == "rig":
-            from .rig import HubServo
-
             a = sc.rig_joint.axis
             systems = {"joint": self.systems["rig"], "hub": HubServo(sc.hub, 0.0, 0.0)}
             connections = [(f"joint.{a}.s", "hub.s"), (f"joint.{a}.v", "hub.v"), ("hub.f", f"joint.{a}.f")]
@@ -155,7 +173,8 @@ class Session:
                     )
                 if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                     raise DesignerError(
-                        f"parameters['{name}']['{key}'] = {value!r} is not a number", "give SI"
+                        f"parameters['{name}']['{key}'] = {value!r} is not a finite number",
+                        "give its value in SI",
                     )
                 out[name][str(key)] = float(value)
         return out
@@ -190,8 +209,7 @@ class Session:
         Raises:
             DesignerError: as `run`.
         """
-        if self.closed:
-            raise DesignerError("the session is closed", "prepare the scenario again")
+        self._open()
         sc = self.scenario
         case = self.parameters(None) if case is None else case
         step = sc.step if step is None else step
@@ -200,16 +218,12 @@ class Session:
         master = self._masters[step]
         for name, system in self.systems.items():
             system.reset(case[name])
-        for name, system in master.systems.items():
+        for system in master.systems.values():
             if isinstance(system, FmuSystem):
                 continue
             system.reset()
-            if name == "hub":
-                from .rig import check_stable, servo_gains
-
-                p = self.laws(case)["rig"]
-                check_stable(p["m"], p["c"], p["k"], step)
-                system.stiffness, system.damping = servo_gains(p["m"], p["c"], p["k"])
+            if isinstance(system, HubServo):  # the rig's servo loop is tuned to the case's joint
+                system.tune(self.laws(case)["rig"], step)
         bound = self._kernel(step, master, engine)
         if bound is None and engine == "auto":
             engine = "python"
@@ -239,7 +253,7 @@ class Session:
         engine: str = "auto",
         validate: bool = False,
         progress: Progress = None,
-    ):
+    ) -> Result:
         """Run one case and return its `Result` (in memory; nothing is written).
 
         Args:
@@ -287,12 +301,11 @@ def prepare(scenario: Scenario) -> Session:
     """
     fix = "read one with designer.cosim.load(path)"
     check_type(scenario, Scenario, "scenario", expected="a Scenario", fix=fix)
-    sc = scenario.check()
+    sc = scenario if scenario.checked else scenario.check()
     stack = contextlib.ExitStack()
     try:
         folder = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="designer-cosim-")))
         session = Session(sc, stack, folder)
-        session._load()
     except BaseException:
         stack.close()
         raise

@@ -15,8 +15,9 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..cosim.master import Trace
-from ..cosim.robot import Robot, SpringDamper, load_spec
+from ..cosim.robot import SpringDamper
 from ..cosim.scenario import Scenario
+from ..cosim.session import robot_system
 from ..errors import DesignerError
 from .cases import Case
 from .evaluate import si_law
@@ -45,11 +46,11 @@ def rollout_traces(sc: Scenario, cases: Sequence[Case]) -> list[Trace | Exceptio
 
     joints = list(sc.joints)
     offsets = _offsets(sc)
-    laws = [{j: si_law(sc.joints[j], case.coefficients[j]) for j in joints} for case in cases]
-    first = {j: SpringDamper(laws[0][j]["k"], laws[0][j]["c"], offsets[j]) for j in joints}
-    robot = Robot(
-        load_spec(sc.model, sc.lengths, sc.masses), sc.motors, sc.step, sc.integrator, in_engine=first
-    )
+    laws = [
+        {j: SpringDamper(**si_law(sc.joints[j], case.coefficients[j]), offset=offsets[j]) for j in joints}
+        for case in cases
+    ]
+    robot = robot_system(sc, sc.step, in_engine=laws[0])
     base = robot.model
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     state0 = np.empty(mujoco.mj_stateSize(base, spec))
@@ -60,9 +61,9 @@ def rollout_traces(sc: Scenario, cases: Sequence[Case]) -> list[Trace | Exceptio
     for b, law in enumerate(laws):
         model = copy.copy(base)
         for k, (j, act) in enumerate(zip(joints, robot.actuators, strict=True)):
-            model.actuator_biasprm[act, 1] = -law[j]["k"]
-            model.actuator_biasprm[act, 2] = -law[j]["c"]
-            controls[b, :, act] = law[j]["k"] * (mq[:-1, k] + offsets[j]) + law[j]["c"] * mv[:-1, k]
+            model.actuator_biasprm[act, 1] = -law[j].k
+            model.actuator_biasprm[act, 2] = -law[j].c
+            controls[b, :, act] = law[j].control(mq[:-1, k], mv[:-1, k])
         models.append(model)
     states, _ = rollout.rollout(models, mujoco.MjData(base), state0[None, :], controls)
     qadr = 1 + robot.qpos  # FULLPHYSICS state: time, qpos, qvel, act, plugin

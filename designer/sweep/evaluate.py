@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import atexit
 import contextlib
+import multiprocessing.util
+import os
 import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
@@ -38,8 +40,10 @@ class Task:
     hold: bool = False
 
 
-#: the Session this process holds between batches of one scenario (Task.hold), by the scenario's repr
+#: the Session this process holds between batches of one scenario (Task.hold), by the scenario's full repr
 _HELD: dict[str, Session] = {}
+#: the processes in which `release` is registered as a multiprocessing finalizer
+_FINALIZED: set[int] = set()
 
 
 def held(sc: Scenario) -> Session:
@@ -47,11 +51,17 @@ def held(sc: Scenario) -> Session:
     another scenario, is closed)."""
     from ..cosim import prepare
 
-    key = repr(sc)
+    with np.printoptions(threshold=2**31, precision=17):  # every sample of a trajectory, exactly
+        key = repr(sc)
     session = _HELD.get(key)
     if session is None:
         release()
         session = _HELD[key] = prepare(sc)
+        if os.getpid() not in _FINALIZED:
+            # a worker process closes it when it ends: multiprocessing runs its finalizers then, also
+            # in forked workers, which skip atexit (registered here, in the worker: a fork clears them)
+            multiprocessing.util.Finalize(None, release, exitpriority=10)
+            _FINALIZED.add(os.getpid())
     return session
 
 
@@ -63,6 +73,22 @@ def release() -> None:
 
 
 atexit.register(release)
+
+#: how many `holding` blocks are open in this process
+_OPEN = [0]
+
+
+@contextlib.contextmanager
+def holding() -> Iterator[None]:
+    """Keep the Session this process holds for the block's batches, and close it when the outermost
+    block ends (a sweep, or a tune's generations)."""
+    _OPEN[0] += 1
+    try:
+        yield
+    finally:
+        _OPEN[0] -= 1
+        if not _OPEN[0]:
+            release()
 
 
 def si_law(src: JointSource, coefficients: dict[str, float]) -> dict[str, float]:

@@ -15,7 +15,7 @@ import pandas as pd
 
 from ..errors import DesignerError, describe
 from .cases import Case, make_cases
-from .evaluate import Task, batches, evaluate, release
+from .evaluate import Task, batches, evaluate, holding
 from .spec import Spec, check
 
 Progress = Callable[[float], None] | None
@@ -94,15 +94,6 @@ def _journal(path: Path | None) -> Iterator[IO | None]:
         yield fh
 
 
-@contextlib.contextmanager
-def _releasing() -> Iterator[None]:
-    """Close, at the end, the Session this process held for the sweep's batches (evaluate.release)."""
-    try:
-        yield
-    finally:
-        release()
-
-
 def _finished(ex: Executor, tasks: Sequence[Task]) -> Iterator[list[dict]]:
     """The rows of each task as it finishes; a serial executor runs one task at a time, so its rows
     reach the journal and the progress bar as they come (submitting all first would run them all)."""
@@ -143,7 +134,7 @@ def evaluate_cases(
 
         workers = 1 if isinstance(executor, SerialExecutor) else local_workers(spec.workers)
         size = _batch_size(spec, len(todo), workers)
-        with _default_executor(spec, executor) as ex, _journal(journal) as fh, _releasing():
+        with _default_executor(spec, executor) as ex, _journal(journal) as fh, holding():
             # this process and local worker processes keep one Session between batches
             hold = isinstance(ex, (SerialExecutor, ProcessPoolExecutor))
             tasks = batches(spec.scenario, path=spec.path, cases=todo, size=size, hold=hold)

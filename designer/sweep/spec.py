@@ -230,10 +230,12 @@ def check(spec: Spec) -> Spec:
 
     Raises:
         DesignerError: a rig scenario with the engine path or limits, a case naming an unknown
-            joint, or a Monte Carlo sweep without its count; `spec` not a Spec.
+            joint, or a Monte Carlo sweep without its count; a bad scenario (Scenario.check); `spec`
+            not a Spec.
     """
     check_type(spec, Spec, "spec", expected="a sweep Spec", fix="read one with designer.sweep.load(path)")
-    sc = spec.scenario
+    sc = spec.scenario if spec.scenario.checked else spec.scenario.check()
+    spec = dataclasses.replace(spec, scenario=sc)
     if sc.kind == "rig" and (spec.path != "fmu" or spec.limits):
         raise DesignerError(
             "a rig sweep identifies each case's virtual rig log through the FMU",

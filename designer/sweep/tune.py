@@ -28,6 +28,7 @@ from ..errors import DesignerError
 from ..surrogate import Surrogate
 from .cases import Case, finish
 from .draws import on_axis, source_axis
+from .evaluate import holding
 from .limits import Limit, applies, metric
 from .run import evaluate_cases
 from .spec import PATHS, Cases, Spec
@@ -196,7 +197,7 @@ def tune(
     surrogate = surrogate or Surrogate.load()
     box = _bounds(scenario, joints, dict(bounds or {}), surrogate)
     spec = Spec(scenario=scenario, cases=Cases(type="grid"), path=path, limits=tuple(limits), check=0)
-    with _executor(executor, workers) as ex:
+    with _executor(executor, workers) as ex, holding():  # one Session for every generation
         search = _Search(spec, [(j, q) for j in joints for q in ("k", "c")], objective, ex)
         result = _optimise(search, box, seed=seed, maxiter=maxiter, popsize=popsize, progress=progress)
         best = search.coefficients(result.x)

@@ -5,8 +5,8 @@
  * mjModel and mjData, and one exchange schedule (a list of get/set operations per system, the same
  * the Python master runs). The kernel steps rows [first, last) of a preallocated output array
  * (rows x columns, C order) and stops at the first FMU error status, MuJoCo warning, or non-finite
- * output, reporting where in `ks_run`. Every struct here is mirrored field for field by ctypes in
- * designer/cosim/kernel.py.
+ * output, reporting where in `ks_run`. Every struct here is mirrored field for field by ctypes: the
+ * kernel's own in designer/cosim/kernel.py and binding.py, a system's in its module (robot.py, rig.py).
  */
 #ifndef DESIGNER_KERNEL_H
 #define DESIGNER_KERNEL_H
@@ -125,8 +125,11 @@ typedef struct {
 KS_EXPORT int32_t ks_run_rows(ks_run *run, int64_t first, int64_t last);
 KS_EXPORT void ks_reference_eval(ks_reference *ref, double t, double *q, double *v);
 KS_EXPORT void ks_robot_motors(ks_robot *robot, double t);
-/* sizes of ks_reference, ks_robot, ks_servo, ks_system, ks_run: the ctypes mirror checks them */
-KS_EXPORT void ks_sizes(int64_t sizes[5]);
+/* sizes of ks_reference, ks_system, ks_run: the ctypes mirrors in designer/cosim check them */
+KS_EXPORT void ks_sizes(int64_t sizes[3]);
+/* the size of a kind's own struct (ks_robot, ks_servo; 0 for FMUs): checked against the mirror a
+ * system's binding() hands over */
+KS_EXPORT int64_t ks_struct_size(int32_t kind);
 
 /* systems.c */
 int32_t ks_get(ks_system *s, double *row);

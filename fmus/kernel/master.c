@@ -101,10 +101,19 @@ int32_t ks_run_rows(ks_run *run, int64_t first, int64_t last) {
     return rc;
 }
 
-void ks_sizes(int64_t sizes[5]) {
+void ks_sizes(int64_t sizes[3]) {
     sizes[0] = sizeof(ks_reference);
-    sizes[1] = sizeof(ks_robot);
-    sizes[2] = sizeof(ks_servo);
-    sizes[3] = sizeof(ks_system);
-    sizes[4] = sizeof(ks_run);
+    sizes[1] = sizeof(ks_system);
+    sizes[2] = sizeof(ks_run);
+}
+
+int64_t ks_struct_size(int32_t kind) {
+    switch (kind) {
+    case KS_ROBOT:
+        return sizeof(ks_robot);
+    case KS_SERVO:
+        return sizeof(ks_servo);
+    default:
+        return 0; /* an FMU instance: no struct of ours */
+    }
 }
