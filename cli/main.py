@@ -102,10 +102,16 @@ class Stopped(BaseException):
         self.signum = signum
 
 
+#: the stop signals received, in order (a Stopped that a C extension turned into another exception,
+#: such as "ImportError: initialization failed" when it landed in a module's import, is still a stop)
+RECEIVED: list[int] = []
+
+
 def _stop(signum: int, frame) -> None:
     # later signals are ignored so that the cleanup they interrupt runs to its end
     for s in _signals():
         signal.signal(s, signal.SIG_IGN)
+    RECEIVED.append(signum)
     raise Stopped(signum)
 
 
@@ -199,6 +205,8 @@ def _run(args: list[str], debug: bool) -> int:
             return _internal(exc, debug)
         return _fail(*_os_message(exc), 2)
     except Exception as exc:  # noqa: BLE001 - the one place that turns any bug into exit 3
+        if RECEIVED:  # the stop, converted on its way out: not a bug
+            return _stopped(RECEIVED[0])
         return _internal(exc, debug)
 
 

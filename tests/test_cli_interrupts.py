@@ -54,7 +54,7 @@ COMMANDS = {
 }
 SEEDS = {"cosim": 3, "sweep": 3, "sweep-workers": 2, "tune": 3, "validate": 2, "export": 4}
 RUNS = [(name, seed) for name, n in SEEDS.items() for seed in range(n)]
-CASE_COUNT = len(RUNS) + 3  # + the compiler running, a sweep resumed after a stop, a finaliser
+CASE_COUNT = len(RUNS) + 4  # + the compiler running, a sweep resumed, a finaliser, a converted stop
 
 
 def _env(tmp_path: Path) -> dict[str, str]:
@@ -216,3 +216,32 @@ except m.Stopped as exc:
     r = subprocess.run([sys.executable, "-I", "-c", code], capture_output=True, text=True, timeout=60)
     assert r.returncode == 143, r.stderr
     assert r.stderr == "" and time.monotonic() - start < 15
+
+
+def test_a_stop_turned_into_another_exception_is_still_a_stop(tmp_path, monkeypatch, capsys):
+    """SIGTERM landing in a C extension's import surfaced as "ImportError: initialization failed",
+    reported as an internal error (exit 3, "a bug in designer"); it is the stop (143)."""
+    from clitools import run_inprocess
+    from designer_cli import main as m
+
+    import designer.rig.clean as cleaning
+    from designer.data import load_table
+
+    monkeypatch.chdir(tmp_path)
+    load_table().to_csv("t.csv", index=False)
+    saved = {s: signal.getsignal(s) for s in m._signals()}
+
+    def interrupted(*args, **kwargs):
+        try:
+            m._stop(signal.SIGTERM, None)  # the handler raises Stopped in the import...
+        except m.Stopped:
+            raise ImportError("initialization failed") from None  # ...which the import replaces
+
+    monkeypatch.setattr(m, "RECEIVED", [])
+    monkeypatch.setattr(cleaning, "clean", interrupted)
+    try:
+        code, out, err = run_inprocess(["clean", "t.csv"], capsys)
+    finally:
+        for s, handler in saved.items():
+            signal.signal(s, handler)
+    assert code == 143 and err.strip() == STOPPED, err
