@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Annotated
 
@@ -124,11 +125,17 @@ def _print_identification(res) -> None:
         )
         console.print(f"  {f.axis}: c(frequency) [{cu}] {freq} (p equal {f.c_frequency['p_equal']:.2g})")
     for w in res.warnings:
-        console.print(f"  warning: {w}")
+        console.print(f"  warning: {_as_flags(w)}")
     for a, why in res.failures.items():
-        console.print(f"  FAILED {a}: {why}")
+        console.print(f"  FAILED {a}: {_as_flags(why)}")
     for a, why in res.still.items():
         console.print(f"  still {a}: {why}; not identified (the moving axes are)")
+
+
+def _as_flags(text: str) -> str:
+    """The library's argument names in a warning or reason, as this command's flags."""
+    text = re.sub(r"load_filter='([^']+)'", r"--load-filter \1", text)
+    return text.replace("load_delay_s", "--load-delay")
 
 
 TABLE_SUFFIXES = (".csv", ".parquet", ".pq")

@@ -13,6 +13,7 @@ import shutil
 import subprocess
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -82,13 +83,31 @@ class Browser:
                 return reply.get("result", {})
             self.events.append(reply)
 
-    def wait_event(self, method: str, session: str, timeout: float = 20) -> dict:
-        """The first (kept or new) event `method` of the session."""
+    def wait_event(
+        self,
+        method: str,
+        session: str,
+        timeout: float = 20,
+        where: Callable[[dict], bool] | None = None,
+        forget: tuple[str, ...] = (),
+    ) -> dict:
+        """The first (kept or new) event `method` of the session whose params pass `where`; kept
+        events of the `forget` methods that arrived before it are dropped as stale."""
         deadline = time.monotonic() + timeout
         while True:
             for i, e in enumerate(self.events):
                 if e.get("method") == method and e.get("sessionId") == session:
-                    return self.events.pop(i)
+                    if where is not None and not where(e.get("params", {})):
+                        continue
+                    stale = [
+                        j
+                        for j, k in enumerate(self.events[:i])
+                        if k.get("method") in forget and k.get("sessionId") == session
+                    ]
+                    event = self.events.pop(i)
+                    for j in reversed(stale):
+                        self.events.pop(j)
+                    return event
             if time.monotonic() > deadline:
                 raise TimeoutError(method)
             self.events.append(json.loads(self.ws.recv()))
@@ -146,7 +165,15 @@ class Page:
     def goto(self, url: str) -> float:
         """Navigate and wait for the load event; returns the wall time it took, seconds."""
         t0 = time.perf_counter()
-        self.call("Page.navigate", url=url)
+        loader = self.call("Page.navigate", url=url).get("loaderId")
+        # the load event of this navigation: its document committed first (a load event kept from an
+        # earlier one, such as the about:blank of a new tab, is stale and was raced against)
+        self.browser.wait_event(
+            "Page.frameNavigated",
+            self.session,
+            where=lambda p: p.get("frame", {}).get("loaderId") == loader,
+            forget=("Page.loadEventFired",),
+        )
         self.browser.wait_event("Page.loadEventFired", self.session)
         return time.perf_counter() - t0
 

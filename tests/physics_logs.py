@@ -2,19 +2,21 @@
 
 The study's rig imposes a linear chirp on the specimen: r(t) = A sin(phi(t)) with
 phi = 2 pi (f0 t + (f1 - f0) t^2 / (2 T)). The load on the specimen is whatever its equation of
-motion needs, F = m r'' + c r' + k r (+ k3 r^3 for a stiffening spring, + the force of a Maxwell
-arm k2, tau for viscoelastic, frequency-dependent damping, integrated as an ODE). With
+motion needs, F = m r'' + c r' + k r (+ k3 r^3 for a stiffening spring, k3 < 0 a softening one,
++ the force of a Maxwell arm k2, tau for viscoelastic, frequency-dependent damping, integrated as an
+ODE, + Coulomb friction Fc sign(r') in the clamp, + a drift of k in time, k (1 + d (t/T - 1/2))). With
 `servo`, the motion is not imposed but comes from the hub pulling the specimen through a stiff
 spring and damper, solved as an ODE. The sensors then add what real rigs add: white noise on
 position and load, offsets and linear drift, timestamps with jitter, a delay of the load channel,
-and dropouts (both channels NaN, or the load stuck at zero).
+dropouts (both channels NaN, or the load stuck at zero), single-sample glitches of the load (NaN
+or an exact zero), and the load sensor's own analogue Butterworth low-pass (scipy.signal).
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pandas as pd
-from scipy.signal import lsim
+from scipy.signal import butter, cont2discrete, lfilter, lsim
 
 LOADS = {"x": "Fx", "y": "Fy", "z": "Fz", "theta": "Ttheta", "phi": "Tphi", "psi": "Tpsi"}
 #: kg (kg.m^2) -> the log's inertia coefficient: N per mm/s^2 is 1000 kg, N.mm per rad/s^2 1e-3 kg.m^2
@@ -64,11 +66,32 @@ def _load(t, spec: dict, f0: float, f1: float, T: float, axis: str) -> tuple[np.
     if spec.get("servo"):
         return _servo(t, spec, f0, f1, T, m)
     r, dr, ddr = sweep(t, f0, f1, T, spec["amplitude"])
-    load = m * ddr + spec["c"] * dr + spec["k"] * r + spec.get("k3", 0.0) * r**3
+    k = spec["k"] * (1.0 + spec.get("drift", 0.0) * (t / T - 0.5))
+    load = m * ddr + spec["c"] * dr + k * r + spec.get("k3", 0.0) * r**3
+    load = load + spec.get("friction", 0.0) * np.sign(dr)
     if "maxwell" in spec:
         k2, tau = spec["maxwell"]
         load = load + _maxwell(t, dr, k2, tau)
     return r, load
+
+
+#: oversampling of the continuous-time load noise that a sensor's analogue filter sees
+OVERSAMPLE = 8
+
+
+def _sensor_filter(t, load, noise_sd, load_filter, rng) -> np.ndarray:
+    """The load plus broadband noise through an analogue Butterworth, then sampled at t.
+
+    The noise is white up to OVERSAMPLE x the sampling rate (noise_sd per sample below the
+    original Nyquist, so the in-band level is that of the unfiltered case): the filter acts on a
+    continuous signal and what passes above Nyquist aliases, as in a real sensor and ADC.
+    """
+    fine = np.linspace(t[0], t[-1], (t.size - 1) * OVERSAMPLE + 1)
+    signal = np.interp(fine, t, load) + noise_sd * np.sqrt(OVERSAMPLE) * rng.standard_normal(fine.size)
+    b, a = butter(load_filter[0], 2 * np.pi * load_filter[1], analog=True)
+    # exact for input linear between the fine samples (as lsim), as a recursive filter: fast
+    bd, ad, _ = cont2discrete((b, a), (fine[-1] - fine[0]) / (fine.size - 1), method="foh")
+    return np.interp(t, fine, lfilter(np.ravel(bd), ad, signal))
 
 
 def make_log(
@@ -85,17 +108,23 @@ def make_log(
     dropouts: float = 0.0,
     offsets: bool = False,
     time_scale: float = 1.0,
+    glitches: float = 0.0,
+    glitch_value: float = np.nan,
+    load_filter: tuple[int, float] | None = None,
     seed: int = 0,
 ) -> pd.DataFrame:
     """A log in the rig schema (t [s], coordinates mm or rad, loads N or N.mm).
 
     axes: {axis: {"k", "c", "m" (kg or kg.m^2), "amplitude", optional "k3", "maxwell": (k2, tau),
-    "servo": True}}
+    "servo": True, "friction": Fc (N or N.mm), "drift": d (k changes by the fraction d from start to
+    end, linearly in time), "still": True (logged, not moving: position and load only noise)}
     in rig units. position_noise: white noise as a fraction of the amplitude; load_noise: as a
     fraction of the load's RMS. skew_s: the load channel lags by this much. jitter: sampling
     instants move by up to this fraction of the interval. dropouts: fraction of samples in 40 ms
     segments, alternately NaN in both channels and the load stuck at zero. offsets: add sensor
     offsets and linear drift. time_scale: multiplies the t column (1e9 writes nanoseconds).
+    glitches: fraction of load samples replaced, one by one at random, by `glitch_value` (NaN or 0).
+    load_filter: (order, cutoff Hz) of an analogue Butterworth the load (with its noise) goes through.
     """
     rng = np.random.default_rng(seed)
     n = int(round(duration * rate)) + 1
@@ -107,11 +136,22 @@ def make_log(
     seg = max(int(0.04 * rate), 6)
     starts = rng.integers(0, n - seg, size=int(round(dropouts * n / seg)))
     for axis, spec in axes.items():
-        r, load = _load(t, spec, f0, f1, duration, axis)
-        if skew_s:
-            load = _load(np.clip(t - skew_s, 0.0, None), spec, f0, f1, duration, axis)[1]
+        if spec.get("still"):
+            r, load = np.zeros(n), np.zeros(n)
+            rms = spec["k"] * spec["amplitude"]
+        else:
+            r, load = _load(t, spec, f0, f1, duration, axis)
+            if skew_s:
+                load = _load(np.clip(t - skew_s, 0.0, None), spec, f0, f1, duration, axis)[1]
+            rms = np.sqrt(np.mean(load**2))
         r = r + position_noise * spec["amplitude"] * rng.standard_normal(n)
-        load = load + load_noise * np.sqrt(np.mean(load**2)) * rng.standard_normal(n)
+        if load_filter is None:
+            load = load + load_noise * rms * rng.standard_normal(n)
+        else:
+            load = _sensor_filter(t, load, load_noise * rms, load_filter, rng)
+        if glitches:
+            rows = rng.choice(np.arange(1, n - 1), size=int(glitches * n), replace=False)
+            load[rows] = glitch_value
         if offsets:
             r = r + 0.05 * spec["amplitude"] + 0.01 * spec["amplitude"] * t / duration
             rms = np.sqrt(np.mean(load**2))

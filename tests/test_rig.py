@@ -100,7 +100,7 @@ def _log(**cols):
 @pytest.mark.parametrize(
     "frame, words",
     [
-        (_log(t=np.r_[np.arange(50), 49, np.arange(51, 100)] / 100.0), ["time not increasing", "row 51"]),
+        (_log(t=np.r_[np.arange(50), 49, np.arange(51, 100)] / 100.0), ["time repeated", "row 51"]),
         (_log(Fx=None), ["missing column 'Fx'"]),
         (_log(t=None), ["missing column 't'"]),
         (_log(Fx=np.full(100, np.nan)), ["'Fx'", "all NaN"]),
@@ -121,7 +121,7 @@ def test_bad_log_exits_2_with_one_line(tmp_path):
     bad.to_csv(tmp_path / "bad.csv", index=False)
     out = _cli("identify", tmp_path / "bad.csv")
     assert out.returncode == 2
-    assert out.stderr.count("\n") == 1 and "time not increasing at row 51" in out.stderr
+    assert out.stderr.count("\n") == 1 and "time repeated at row 51" in out.stderr
     assert "Traceback" not in out.stderr
 
 

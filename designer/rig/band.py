@@ -3,7 +3,8 @@
 Two stages. First, block means: the log is averaged over blocks of `factor` samples down to about
 `PRE_RATE` (a boxcar filter plus decimation; its gain and phase are the same on every channel, so
 they cancel in the regression, and block means of white noise stay white). Dropout blocks are
-filled by a cubic spline through the valid ones (and left out of the fit later). Second, one FFT per
+filled by a cubic spline through the valid ones (and left out of the fit later, unless the gap is so
+short that the fill is exact to a tenth of the noise). Second, one FFT per
 channel: the excitation band is read from the position's power spectrum, and the filter is a
 zero-phase low-pass, flat to `pass_edge` and raised-cosine to zero at 1.5 x `pass_edge`; r' and r''
 are iw and -w^2 times the filtered position spectrum, a known channel delay is the exact phase
@@ -34,6 +35,8 @@ STOP_RATIO = 1.5
 GRID_RATIO = 2.5
 #: rows within this many 1 / (transition width) of an end or of a filled sample are left out
 GUARD_TRANSITIONS = 2.5
+#: a filled gap whose cubic fill errs by under this fraction of the amplitude is kept in the fit
+FILL_TOLERANCE = 1e-4
 #: samples averaged at each end to take out the straight line that joins the ends before the FFT
 END_SAMPLES = 5
 
@@ -141,7 +144,7 @@ def fill(values: np.ndarray, bad: np.ndarray) -> None:
     """Replace the `bad` entries in place: the cubic through the two good samples either side.
 
     (Held flat past the ends.) Over a gap of a few samples of a slow signal the cubic's error is
-    of the fourth order in the gap's length; filled rows are left out of the fit anyway.
+    of the fourth order in the gap's length; the rows near longer gaps are left out of the fit.
     """
     if not bad.any():
         return
@@ -278,8 +281,33 @@ def lowpass(freqs: np.ndarray, pass_edge: float) -> np.ndarray:
     return 0.5 * (1.0 + np.cos(np.pi * x))
 
 
+def _long_gaps(filled: np.ndarray, longest: int) -> np.ndarray:
+    """The filled samples in runs of more than `longest` consecutive ones."""
+    edges = np.diff(np.concatenate(([0], filled.astype(np.int8), [0])))
+    starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    out = np.zeros(filled.shape, dtype=bool)
+    for a, b in zip(starts[ends - starts > longest], ends[ends - starts > longest], strict=True):
+        out[a:b] = True
+    return out
+
+
+def fill_tolerant(spec: Spectra) -> int:
+    """The longest run of filled series samples whose cubic fill is exact enough to keep in the fit.
+
+    The cubic through two samples either side of a gap of g errs by at most
+    (w h)^4 / 24 x ((g + 1) / 2)^2 ((g + 3) / 2)^2 of the amplitude in the gap's middle, with w
+    the band's top in rad/s and h the sample interval: kept while that is under FILL_TOLERANCE
+    (a tenth of the usual position noise), such a gap needs no guard.
+    """
+    wh = 2 * np.pi * spec.band.high / spec.rate
+    g = 0
+    while wh**4 / 24 * ((g + 2) / 2) ** 2 * ((g + 4) / 2) ** 2 <= FILL_TOLERANCE and g < 64:
+        g += 1
+    return g
+
+
 def _guard(filled: np.ndarray, n: int, nd: int, samples: int, reach: int) -> np.ndarray:
-    """Grid rows within `reach` rows of a filled series sample or of either end of the record."""
+    """Grid rows within `reach` rows of a (marked) filled series sample or of either end of the record."""
     edges = np.zeros(nd + 1, dtype=np.int32)
     rows = np.unique(np.round(np.flatnonzero(filled) * nd / n).astype(np.int64))
     np.add.at(edges, np.clip(rows - reach, 0, nd), 1)
@@ -289,6 +317,43 @@ def _guard(filled: np.ndarray, n: int, nd: int, samples: int, reach: int) -> np.
     near[: reach + 1] = True
     near[max(last - reach, 0) :] = True
     return near
+
+
+def _grid(spec: Spectra, pass_edge: float) -> tuple[int, int]:
+    """The rfft bins the low-pass at `pass_edge` keeps, and the (even) length of the filtered grid."""
+    stop = STOP_RATIO * pass_edge
+    bins = min(int(np.ceil(stop * spec.n / spec.rate)) + 1, spec.position.size)
+    nd = min(fast_len(max(int(np.ceil(GRID_RATIO * stop * spec.n / spec.rate)), 2 * bins)), spec.n)
+    return bins, nd + nd % 2
+
+
+def series_motion(spec: Spectra, pass_edge: float) -> tuple[np.ndarray, np.ndarray]:
+    """r and r' through the low-pass at `pass_edge`, at the series samples (scaled units)."""
+    gain = spec.position * lowpass(spec.freqs, pass_edge)
+    r = np.fft.irfft(gain, n=spec.n)[: spec.samples]
+    v = np.fft.irfft(2j * np.pi * spec.freqs * gain, n=spec.n)[: spec.samples]
+    return r, v
+
+
+def nonlinear_columns(spec: Spectra, pass_edge: float) -> tuple[np.ndarray, np.ndarray]:
+    """Coulomb friction's sign(r') and the cubic spring's (r - mean r)^3, formed at the series rate
+    from the band-limited motion and then filtered exactly as the load is (so their harmonics above
+    the pass edge go where the load's go), on the grid of `filtered(spec, pass_edge)`.
+
+    The sign is the mean of sign(r') over each sample's interval with r' linear in it, so a
+    reversal between samples counts by where it falls. Scaled units (r in units of `scale_r`).
+    """
+    bins, nd = _grid(spec, pass_edge)
+    r, v = series_motion(spec, pass_edge)
+    a, b = spec.r_line
+    deflection = r + a + (b - a) * np.linspace(0.0, 1.0, spec.samples)
+    deflection -= deflection.mean()
+    step = np.abs(np.gradient(v))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sign = np.where(step > 0, np.clip(2 * v / step, -1.0, 1.0), np.sign(v))
+    cols = np.fft.rfft(np.stack([sign, deflection**3]), n=spec.n, axis=1)[:, :bins]
+    out = np.fft.irfft(cols * lowpass(spec.freqs[:bins], pass_edge), n=nd, axis=1) * (nd / spec.n)
+    return out[0], out[1]
 
 
 def filtered(
@@ -303,9 +368,7 @@ def filtered(
     With `skew_s`, `y_skew` is that load advanced by `skew_s` as well.
     """
     stop = STOP_RATIO * pass_edge
-    bins = min(int(np.ceil(stop * spec.n / spec.rate)) + 1, spec.position.size)
-    nd = min(fast_len(max(int(np.ceil(GRID_RATIO * stop * spec.n / spec.rate)), 2 * bins)), spec.n)
-    nd += nd % 2
+    bins, nd = _grid(spec, pass_edge)
     freqs = spec.freqs[:bins]
     w = 2 * np.pi * freqs
     gain = lowpass(freqs, pass_edge)
@@ -325,7 +388,7 @@ def filtered(
     with np.errstate(divide="ignore", invalid="ignore"):
         inst = (dz * z.conj()).imag / (2 * np.pi * (z.real**2 + z.imag**2))
     reach = int(np.ceil(GUARD_TRANSITIONS / (stop - pass_edge) * grid_rate))
-    keep = ~_guard(spec.filled, spec.n, nd, spec.samples, reach)
+    keep = ~_guard(_long_gaps(spec.filled, fill_tolerant(spec)), spec.n, nd, spec.samples, reach)
     keep[int(np.floor((spec.samples - 1) * nd / spec.n)) + 1 :] = False
     # covariance of white noise through gain x (iw)^p, p = 2, 1, 0: sum over the two-sided spectrum
     response = np.stack([-(w**2) * gain, 1j * w * gain, gain])

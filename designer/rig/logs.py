@@ -311,9 +311,19 @@ def _time_step(t: np.ndarray, source: str) -> tuple[float, np.ndarray]:
     dt = np.diff(t)
     if (dt <= 0).any():
         row = int(np.flatnonzero(dt <= 0)[0]) + 2
+        what = "repeated" if dt[row - 2] == 0 else "going backwards"
+        backwards = int(np.count_nonzero(dt < 0))
+        reversed_log = backwards > dt.size // 2
         raise DesignerError(
-            f"{source}: time not increasing at row {row} (t = {t[row - 1]:g} s after {t[row - 2]:g} s)",
-            "sort the log by t and remove repeated rows",
+            f"{source}: time {what} at row {row} (t = {t[row - 1]:g} s after {t[row - 2]:g} s)"
+            + (
+                f"; it decreases in {backwards} of {dt.size} steps (the log is reversed)"
+                if reversed_log
+                else ""
+            ),
+            "sort the log by t and remove repeated rows"
+            if not reversed_log
+            else "reverse the rows (sort by t)",
         )
     step = float(np.median(dt))
     gaps = dt > GAP_FACTOR * step
@@ -337,13 +347,15 @@ def _dropouts(
     for col in (a, LOAD[a]):
         v = cols[col]
         if not np.isfinite(v).any():
-            raise DesignerError(f"{source}: column '{col}' is all NaN", f"drop axis {a} or fix the sensor")
+            what = "infinite" if np.isinf(v).all() else "NaN or infinite" if np.isinf(v).any() else "NaN"
+            raise DesignerError(f"{source}: column '{col}' is all {what}", f"drop axis {a} or fix the sensor")
         absent = missing(v)
         fractions[col] = float(absent.mean())
         flagged |= absent
     if flagged.all():
         raise DesignerError(
-            f"{source}: axis {a} ('{a}', '{LOAD[a]}') has no valid samples (all NaN or stuck at zero)",
+            f"{source}: axis {a} ('{a}', '{LOAD[a]}') has no valid samples "
+            "(all NaN, infinite or stuck at zero)",
             f"drop axis {a} or fix the sensor",
         )
     return flagged
