@@ -418,6 +418,59 @@ def test_hand_edited_sweep(name, workdir, inputs, capsys):
     _bad(["sweep", f"in/sw_{name}.toml", "-o", "sw", "--workers", "1"], workdir, inputs, capsys, allowed=(2,))
 
 
+# --- rig logs (identification's readers, issue 23: on main) ------------------------------------------
+
+
+def _write_logs(folder: Path) -> None:
+    """A clean simulated log and its variants: each with the same sidecar (print settings)."""
+    from designer.rig.logs import write_log
+    from designer.rig.simulate import simulate
+
+    df = simulate({"x": {"m": 1e-3, "c": 2e-3, "k": 0.8}}, duration=20, rate=200, seed=1)
+    write_log(df, folder / "lg_clean.csv", {"density": 60, "length": 24, "width": 4.5, "height": 9, **LAYER})
+    side = (folder / "lg_clean.json").read_text()
+    variants = {
+        "huge": df.assign(x=df["x"] * 1e300, Fx=df["Fx"] * 1e300),
+        "reversed_t": df.assign(t=df["t"].iloc[::-1].to_numpy()),
+        "duplicated_t": df.assign(t=df["t"].where(df.index != 10, df["t"][9])),
+        "nan_t": df.assign(t=df["t"].where(df.index != 10, np.nan)),
+        "subnormal": df.assign(x=df["x"] * 5e-324),
+        "one_inf": df.assign(Fx=df["Fx"].where(df.index != 50, np.inf)),
+        "negzero": df.assign(x=df["x"].where(df.index != 0, -0.0)),
+    }
+    for name, frame in variants.items():
+        frame.to_csv(folder / f"lg_{name}.csv", index=False)
+        (folder / f"lg_{name}.json").write_text(side)
+
+
+LAYER = {"layer": 0.16, "raster": 0}
+#: log -> the exit code it must give: 2 refused as bad input, 1 a failed identification (no row),
+#: 0 identified (a single Inf sample is a dropout; -0.0 is 0) with k within 1 % of the true 0.8 N/mm
+LOGS = {
+    "huge": 2,
+    "reversed_t": 2,
+    "duplicated_t": 2,
+    "nan_t": 2,
+    "subnormal": 1,
+    "one_inf": 0,
+    "negzero": 0,
+}
+
+
+@pytest.mark.parametrize("name", sorted(LOGS))
+def test_hostile_logs(name, workdir, inputs, capsys):
+    if not (inputs / "lg_clean.csv").exists():
+        _write_logs(inputs)
+    args = ["identify", f"in/lg_{name}.csv", "--json"]
+    if LOGS[name]:
+        _bad(args, workdir, inputs, capsys, allowed=(LOGS[name],))
+        return
+    code, out, err = run_inprocess(args, capsys)
+    assert code == 0, err
+    (log,) = json.loads(out)["logs"]
+    assert log["ok"] and abs(log["axes"]["x"]["k"] / 0.8 - 1) < 0.01, log
+
+
 # --- aliasing, unreachable targets, degenerate tables ---------------------------------------------
 
 IMPOSSIBLE = [
@@ -616,6 +669,7 @@ def test_the_campaign_has_at_least_300_cases_with_the_earlier_rounds():
         + len(IMPOSSIBLE)
         + len(API_CASES)
         + len(REAL)
+        + len(LOGS)
     )
     real = test_cli_interrupts.CASE_COUNT + test_files_hostile.CASE_COUNT
     earlier = len(test_cli_campaign.CASES) + len(test_cli_campaign.REAL)
