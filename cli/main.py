@@ -17,6 +17,7 @@ import errno
 import os
 import signal
 import sys
+import threading
 import traceback
 import warnings
 from typing import Annotated
@@ -101,11 +102,37 @@ class Stopped(BaseException):
         self.signum = signum
 
 
+#: the stop signals received, in order (a Stopped that a C extension turned into another exception,
+#: such as "ImportError: initialization failed" when it landed in a module's import, is still a stop)
+RECEIVED: list[int] = []
+
+
 def _stop(signum: int, frame) -> None:
     # later signals are ignored so that the cleanup they interrupt runs to its end
     for s in _signals():
         signal.signal(s, signal.SIG_IGN)
+    RECEIVED.append(signum)
     raise Stopped(signum)
+
+
+def _unraisable(hook):
+    """sys.unraisablehook: a Stopped raised while Python ran a weakref callback, a __del__ or the
+    garbage collector is swallowed there ("Exception ignored in ..."), and the command would go on
+    to exit 0 with a traceback printed; instead the signal is delivered again, to the main flow."""
+
+    def handle(unraisable) -> None:
+        exc = unraisable.exc_value
+        if isinstance(exc, Stopped):
+            # sent again from another thread a moment later, when the main thread has left the
+            # callback (raised here, it would land in this hook and be swallowed again)
+            signal.signal(exc.signum, _stop)
+            again = threading.Timer(0.02, os.kill, (os.getpid(), exc.signum))
+            again.daemon = True  # never holds up the interpreter's exit
+            again.start()
+            return
+        hook(unraisable)
+
+    return handle
 
 
 def _signals() -> list[int]:
@@ -156,11 +183,9 @@ def _run(args: list[str], debug: bool) -> int:
         code = chosen(args=args, prog_name="designer", standalone_mode=False)
         return code if isinstance(code, int) else 0
     except Stopped as exc:
-        print(f"stopped by {signal.Signals(exc.signum).name}; partial files removed", file=sys.stderr)
-        return 128 + exc.signum
+        return _stopped(exc.signum)
     except (KeyboardInterrupt, typer.Abort):
-        print("stopped by SIGINT; partial files removed", file=sys.stderr)
-        return 130
+        return _stopped(signal.SIGINT)
     except typer.Exit as exc:
         return exc.exit_code
     except _click_errors.ClickException as exc:
@@ -180,7 +205,14 @@ def _run(args: list[str], debug: bool) -> int:
             return _internal(exc, debug)
         return _fail(*_os_message(exc), 2)
     except Exception as exc:  # noqa: BLE001 - the one place that turns any bug into exit 3
+        if RECEIVED:  # the stop, converted on its way out: not a bug
+            return _stopped(RECEIVED[0])
         return _internal(exc, debug)
+
+
+def _stopped(signum: int) -> int:
+    print(f"stopped by {signal.Signals(signum).name}; partial files removed", file=sys.stderr)
+    return 128 + signum
 
 
 def _closed_stdout() -> int:
@@ -199,11 +231,24 @@ def _internal(exc: BaseException, debug: bool) -> int:
     return _fail(f"internal error: {type(exc).__name__}: {first}", REPORT_HINT, 3)
 
 
-def main() -> None:
-    """The console script: SIGTERM and SIGHUP stop the command like Ctrl-C; exit with run()'s code."""
+def install_signal_handlers() -> None:
+    """SIGINT, SIGTERM and SIGHUP raise Stopped in the main thread, also when they land in a finaliser."""
     for s in _signals():
         signal.signal(s, _stop)
-    code = run()
+    sys.unraisablehook = _unraisable(sys.unraisablehook)
+
+
+def main() -> None:
+    """The console script: SIGTERM and SIGHUP stop the command like Ctrl-C; exit with run()'s code."""
+    install_signal_handlers()
+    try:
+        code = run()
+    except Stopped as exc:  # landed just outside the command's own handling (before or after it)
+        code = _stopped(exc.signum)
+    # the command's work is over (its files complete, or removed): a signal arriving from here on,
+    # while the interpreter shuts down, would kill it with -signum; ignored, the exit code stands
+    for s in _signals():
+        signal.signal(s, signal.SIG_IGN)
     try:
         sys.stdout.flush()
     except BrokenPipeError:

@@ -11,7 +11,7 @@ import typer
 
 from designer.errors import DesignerError
 
-from .common import console, print_json, progress
+from .common import console, err_console, print_json, progress
 
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print the summary as JSON only.")]
 WorkersOpt = Annotated[
@@ -54,11 +54,17 @@ def sweep(
         if path not in ("fmu", "engine"):
             raise DesignerError(f"--path {path} is not allowed", "use --path fmu or --path engine")
         s = replace(s, path=path)
+    made = _missing_folders(out)
     out.mkdir(parents=True, exist_ok=True)
-    with executor(workers=workers if workers else s.workers, scheduler=scheduler, cluster=s.cluster) as ex:
-        with progress(f"sweeping {spec.name}", enabled=not json_out) as bar:
-            result = sw.run(s, executor=ex, journal=out / "cases.jsonl", progress=bar)
-    files = sw.write_results(result, out, plot=plot)
+    workers = workers if workers else s.workers
+    try:
+        with executor(workers=workers, scheduler=scheduler, cluster=s.cluster) as ex:
+            with progress(f"sweeping {spec.name}", enabled=not json_out) as bar:
+                result = sw.run(s, executor=ex, journal=out / "cases.jsonl", progress=bar)
+        files = sw.write_results(result, out, plot=plot)
+    except BaseException:  # stopped or failed: keep the finished cases for a rerun, nothing else
+        _keep_journal(out / "cases.jsonl", made)
+        raise
     summary = result.summary | {"resumed": result.resumed, "files": [str(f) for f in files]}
     if json_out:
         print_json(summary)
@@ -66,6 +72,26 @@ def sweep(
         _print_sweep(summary)
     if summary["ok"] == 0:
         raise typer.Exit(1)
+
+
+def _missing_folders(folder: Path) -> list[Path]:
+    """`folder` and those of its parents that do not exist yet, innermost first."""
+    return [p for p in [folder, *folder.parents] if not p.exists()]
+
+
+def _keep_journal(journal: Path, made: list[Path]) -> None:
+    """After an interrupted or failed sweep: the journal of finished cases stays for a rerun to resume
+    (and stderr says so); one with no finished case is removed, with the folders this run created."""
+    lines = journal.read_bytes().count(b"\n") if journal.is_file() else 0
+    if lines:
+        err_console.print(f"{lines} finished cases kept in {journal}: rerun the same command to resume")
+        return
+    journal.unlink(missing_ok=True)
+    for folder in made:
+        try:
+            folder.rmdir()
+        except OSError:  # not empty: something else was put there meanwhile
+            return
 
 
 def _number(v: float | None, unit: str) -> str:

@@ -35,11 +35,13 @@ import casadi as ca
 import numpy as np
 
 from . import space
-from .errors import DesignerError
+from .errors import DesignerError, number_argument
 from .surrogate import Prediction, ResponseSurface, Surrogate, _as_printed
 
 #: prior standard deviation of log(printer factor): filaments of one grade and printers differ
 PRINTER_SD = 0.3
+#: the largest prior sd accepted: log-factor sd 3 already allows factors of e^±6 (x/÷ 400)
+MAX_PRINTER_SD = 3.0
 #: the smallest print-to-print scatter assumed (relative, log space)
 MIN_NOISE = 0.025
 #: length scales tried for the local correction (coded factor units, each factor spans [-1, 1])
@@ -308,8 +310,9 @@ def _runs_table(runs: Any, surrogate: Surrogate) -> Any:
     the surrogate has; raise for a table that shares no response or no factor with it."""
     import pandas as pd
 
-    from .data import load_table
+    from .data import check_table_argument, load_table
 
+    check_table_argument(runs, "runs")
     if runs is None:
         return pd.DataFrame()
     if isinstance(runs, pd.DataFrame) and runs.empty:
@@ -402,8 +405,11 @@ def calibrate(surrogate: Surrogate, runs: Any, *, printer_sd: float = PRINTER_SD
             f"surrogate={type(surrogate).__name__} is not a fitted Surrogate",
             "give Surrogate.load() or a fitted Surrogate",
         )
-    if not printer_sd > 0:
-        raise DesignerError(f"printer_sd={printer_sd} must be positive", "give e.g. printer_sd=0.3")
+    if not 0 < number_argument(printer_sd, "printer_sd", example="0.3") <= MAX_PRINTER_SD:
+        raise DesignerError(
+            f"printer_sd={printer_sd} is not in (0, {MAX_PRINTER_SD:g}]",
+            "give e.g. printer_sd=0.3 (a printer factor within about x/÷ 1.8 at 95 %)",
+        )
     prior = surrogate.prior if surrogate.calibration else surrogate
     table = _runs_table(runs, prior)
     if prior is not surrogate and len(surrogate.calibration["table"]):

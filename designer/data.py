@@ -9,6 +9,7 @@ suffixes (`density_pct`, `k_x_N_per_mm`, ...); a suffix naming another unit is r
 from __future__ import annotations
 
 import hashlib
+import os
 import re
 from importlib import resources
 from pathlib import Path
@@ -17,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from . import space, units
-from .errors import DesignerError
+from .errors import DesignerError, describe
 
 BUNDLED_NAME = "study_table3_x.csv"
 #: the widest a printed joint's coefficients can be, per (quantity, rotational), rig units: far
@@ -138,10 +139,7 @@ def normalise(raw: pd.DataFrame, source: str = "table") -> pd.DataFrame:
         bad = values.isna() | ~np.isfinite(values.to_numpy(dtype=float, na_value=np.nan))
         if bad.any():
             row = int(np.flatnonzero(bad.to_numpy())[0])
-            raise DesignerError(
-                f"{source}: column '{col}' row {row + 1} is '{out[col].iloc[row]}', not a finite number",
-                "fix or remove that row (designer clean drops runs with missing sensor data)",
-            )
+            raise not_a_number(source, col, row, out[col].iloc[row])
         out[col] = values.astype(float)
     for col in coefficient_columns(out):
         q, axis = col.split("_", 1)
@@ -196,6 +194,7 @@ def load_table(source: str | Path | pd.DataFrame | None = None) -> pd.DataFrame:
         DesignerError: naming the first problem with its column and row (missing factor, no
             coefficient column, a value that is not a finite number, k <= 0, c < 0, an untested level).
     """
+    check_table_argument(source, "source")
     if isinstance(source, pd.DataFrame):
         return normalise(source, source="table")
     p = bundled_path() if source is None else Path(source)
@@ -210,6 +209,49 @@ def load_table(source: str | Path | pd.DataFrame | None = None) -> pd.DataFrame:
             f"cannot read {p}: {str(exc).splitlines()[0]}", "give a CSV or Parquet coefficient table"
         ) from None
     return normalise(raw, source=p.name)
+
+
+def not_a_number(source: str, col: str, row: int, cell: object) -> DesignerError:
+    """The error for a cell that is not a finite number (0-based `row`); a decimal comma is named."""
+    if isinstance(cell, str) and re.fullmatch(r"\s*[-+]?\d*,\d+\s*", cell):
+        return DesignerError(
+            f"{source}: column '{col}' row {row + 1} is '{cell}': a decimal comma",
+            "save the table with a decimal point (0.8, not 0,8) and commas between columns",
+        )
+    return DesignerError(
+        f"{source}: column '{col}' row {row + 1} is '{cell}', not a finite number",
+        "fix or remove that row (designer clean drops runs with missing sensor data)",
+    )
+
+
+def check_text_cells(raw: pd.DataFrame, columns: list[str], source: str) -> None:
+    """Raise for the first cell of `columns` holding text that is not a number ('stiff', '0,8'); empty
+    cells and NaN pass (missing sensor data, which designer clean drops as dropouts).
+
+    Raises:
+        DesignerError: naming the column, the row and the cell (a decimal comma by name).
+    """
+    for col in columns:
+        values = pd.to_numeric(raw[col], errors="coerce")
+        text = values.isna() & raw[col].notna()
+        if text.any():
+            row = int(np.flatnonzero(text.to_numpy())[0])
+            raise not_a_number(source, col, row, raw[col].iloc[row])
+
+
+def check_table_argument(value: object, name: str) -> None:
+    """Raise unless `value` can be a table for `load_table`: a path, a DataFrame or None.
+
+    Raises:
+        DesignerError: naming the argument `name` (a numpy array, a list, a number...).
+    """
+    if value is None or isinstance(value, (str, os.PathLike, pd.DataFrame)):
+        return
+    raise DesignerError(
+        f"{name} is {describe(value)}, not a table",
+        f"give {name} as a pandas DataFrame with named columns (the six factors, then c_x, k_x...: "
+        "pd.DataFrame(array, columns=[...])) or the path of a CSV or Parquet file",
+    )
 
 
 def is_parquet(path: str | Path) -> bool:

@@ -4,7 +4,13 @@ Output paths are probed before any work (`check_output`): a folder where a file 
 reverse), a folder that does not exist or cannot be written (read-only, /proc), and too little free
 space for the estimated size are reported up front instead of after a long computation. Files are
 written to a temporary name beside the target and renamed over it (`atomic_write`, `atomic_path`); a
-folder of results is staged beside its target and moved in at the end (`atomic_folder`).
+folder of results is staged beside its target and moved in at the end (`atomic_folder`); a cached build
+appears as a whole folder or not at all (`cache_entry`).
+
+Concurrent writers: each one writes its own temporary file, so two processes writing one output leave
+the last complete one, never a mix; two writing one results folder move their files in one after the
+other under a lock on its parent folder. An output path that is a symbolic link is followed: the file
+it points to is replaced atomically (the link stays), never truncated and rewritten in place.
 """
 
 from __future__ import annotations
@@ -19,7 +25,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import IO
 
-from .errors import DesignerError
+from .errors import DesignerError, path_argument
 
 # head room kept free on the target's disk beyond the estimated size (file system metadata, temp files)
 _SPARE_BYTES = 1 << 20
@@ -109,6 +115,12 @@ def check_output(
     return p
 
 
+def _followed(path: str | Path) -> Path:
+    """`path` with symbolic links followed (the file to replace), unchanged when it is no link."""
+    path = Path(path)
+    return Path(os.path.realpath(path)) if path.is_symlink() else path
+
+
 def _check_dir(path: Path) -> Path:
     parent = path.absolute().parent
     if not parent.is_dir():
@@ -146,10 +158,13 @@ def atomic_write(path: str | Path, mode: str = "w", **kwargs) -> Iterator[IO]:
 def atomic_path(path: str | Path) -> Iterator[Path]:
     """A temporary path beside `path` for writers that want a file name (zip, parquet, savefig).
 
+    When `path` is a symbolic link, the file it points to is the one replaced (the temporary file is
+    made beside that file, so the rename stays on its disk and is atomic).
+
     Raises:
         DesignerError: the folder is missing or not writable, `path` is a folder, or the disk is full.
     """
-    path = Path(path)
+    path = _followed(path)
     parent = _check_dir(path)
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part" + path.suffix, dir=parent)
@@ -194,7 +209,7 @@ def atomic_folder(path: str | Path) -> Iterator[Path]:
     Raises:
         DesignerError: `path` is a file, or its folder cannot be created or written.
     """
-    target = check_output(path, kind="folder")
+    target = _followed(check_output(path, kind="folder"))
     target.parent.mkdir(parents=True, exist_ok=True)
     stage = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent))
     try:
@@ -202,14 +217,77 @@ def atomic_folder(path: str | Path) -> Iterator[Path]:
         os.chmod(stage, 0o755)
         old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
         try:
-            if target.is_dir() and any(target.iterdir()):
-                _move_in(stage, target)
-            else:
-                os.replace(stage, target)
+            with _locked(target.parent):  # another process moving into the same folder waits
+                if target.is_dir() and any(target.iterdir()):
+                    _move_in(stage, target)
+                else:
+                    os.replace(stage, target)
         finally:
             signal.pthread_sigmask(signal.SIG_SETMASK, old)
     except OSError as exc:
         raise _space_error(target, exc) from None
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def _locked(folder: Path) -> Iterator[None]:
+    """An exclusive lock between processes on `folder` itself (flock, released with the descriptor:
+    no lock file to leave behind); no lock where flock does not exist (Windows)."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - Windows
+        yield
+        return
+    fd = os.open(folder, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)
+
+
+@contextlib.contextmanager
+def private_tempdir(prefix: str) -> Iterator[Path]:
+    """A temporary folder, removed whole at the end, that is also where third-party code makes its
+    temporary files meanwhile (tempfile.tempdir): fmpy's extract and simulate_fmu remove their folders
+    only when they succeed, so an error or an interrupt inside them left unpacked FMUs in /tmp."""
+    with tempfile.TemporaryDirectory(prefix=prefix) as tmp:
+        old = tempfile.tempdir
+        tempfile.tempdir = tmp
+        try:
+            yield Path(tmp)
+        finally:
+            tempfile.tempdir = old
+
+
+@contextlib.contextmanager
+def cache_entry(target: str | Path) -> Iterator[Path]:
+    """A path to build the cached file `target` at, in a staging folder that becomes `target`'s folder
+    (named for the cache key) in one rename when the block succeeds: the entry exists whole or not at
+    all, whatever interrupts the build. A concurrent build of the same key that finished first is kept
+    (ours is dropped: the same sources, the same file).
+
+    Raises:
+        DesignerError: the cache folder cannot be created or written, or the disk is full.
+    """
+    target = Path(target)
+    entry = target.parent
+    try:
+        entry.parent.mkdir(parents=True, exist_ok=True)
+        stage = Path(tempfile.mkdtemp(prefix=f".{entry.name}.", suffix=".part", dir=entry.parent))
+    except OSError as exc:
+        raise _space_error(entry, exc) from None
+    try:
+        yield stage / target.name
+        os.chmod(stage, 0o755)
+        try:
+            os.rename(stage, entry)  # replaces an empty folder (an older version's leftover) too
+        except OSError as exc:
+            if exc.errno not in (errno.EEXIST, errno.ENOTEMPTY) or not target.is_file():
+                raise
+    except OSError as exc:
+        raise _space_error(entry, exc) from None
     finally:
         shutil.rmtree(stage, ignore_errors=True)
 
@@ -246,10 +324,17 @@ def check_table_file(path: str | Path, *, parquet: bool) -> None:
     if parquet:
         return
     line = head.splitlines()[0] if head.splitlines() else head
+    if head.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise DesignerError(f"cannot read {p}: it is UTF-16 text", "save it as UTF-8 comma-separated CSV")
     try:
         text = line.decode("utf-8-sig")
     except UnicodeDecodeError:
-        text = "\0"
+        text = "\0" if b"\0" in head else ""
+        if not text:
+            raise DesignerError(
+                f"cannot read {p}: it is not UTF-8 text (Latin-1 or Windows-1252, from an old spreadsheet?)",
+                "save it as UTF-8 comma-separated CSV",
+            ) from None
     if "\0" in text or b"\0" in head:
         raise DesignerError(
             f"cannot read {p}: it is not a text CSV file (it holds binary data)",
@@ -279,7 +364,7 @@ def check_suffix(path: str | Path, suffixes: tuple[str, ...], *, what: str) -> P
     Raises:
         DesignerError: naming the `path` argument, the format and the suffixes it takes.
     """
-    path = Path(path)
+    path = path_argument(path, "path", what=f"{what} file")
     if path.suffix.lower() not in suffixes:
         raise DesignerError(
             f"path={str(path)!r} does not name {what} file", f"give a path ending in {' or '.join(suffixes)}"

@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from . import space, units
-from .errors import DesignerError
+from .errors import DesignerError, check_type, describe, number_argument, path_argument
 from .mass import specimen_mass
 
 if TYPE_CHECKING:
@@ -27,6 +27,9 @@ PRB_GAMMA = 0.85
 #: largest m, c or k in rig units a joint may have (1e9 N/mm is 1e12 N/m, stiffer than a 10 mm steel
 #: cube, ~2e9 N/m); above it a number is a unit mistake, and squared in a simulation it overflows
 MAX_COEFFICIENT = 1e9
+#: smallest non-zero m, c or k in rig units (as for coefficient tables): below it, a subnormal such as
+#: 5e-324 is a typing or unit mistake, not a joint (its natural frequency and time step underflow)
+MIN_COEFFICIENT = 1e-12
 
 
 @dataclass(frozen=True)
@@ -52,6 +55,14 @@ class AxisCoefficients:
                 raise DesignerError(
                     f"{q} on axis {self.axis} = {v:g} {units.rig_unit(q, self.axis)} is not a valid value",
                     f"give a finite, {'non-negative' if q == 'c' else 'positive'} number",
+                )
+            object.__setattr__(self, q, v + 0.0)  # -0.0 is 0: never written as "-0" into an FMU
+            if 0 < v < MIN_COEFFICIENT:
+                unit = units.rig_unit(q, self.axis)
+                raise DesignerError(
+                    f"{q} on axis {self.axis} = {v:g} {unit} is below any physical joint",
+                    f"give it in rig units, at least {MIN_COEFFICIENT:g} {unit}"
+                    + (" (or 0 for no damping)" if q == "c" else ""),
                 )
             if v > MAX_COEFFICIENT:
                 unit = units.rig_unit(q, self.axis)
@@ -80,6 +91,7 @@ class Joint:
     def __post_init__(self) -> None:
         if not self.axes:
             raise DesignerError("a joint needs at least one axis", "give axes={'x': JointAxis(...)}")
+        check_type(self.name, str, "name", expected="a str", fix="give e.g. name='knee'")
         if not self.name.isidentifier():
             raise DesignerError(
                 f"joint name '{self.name}' is not an identifier",
@@ -97,6 +109,8 @@ class Joint:
         Raises:
             DesignerError: an unknown axis, a missing k or c, or a value that is not finite and positive.
         """
+        fix = "give coefficients={'x': {'k': 0.8, 'c': 2e-3}} in rig units"
+        check_type(coefficients, Mapping, "coefficients", expected="a mapping of axes", fix=fix)
         axes = {}
         for a, v in coefficients.items():
             if not isinstance(v, Mapping) or not {"k", "c"} <= set(v):
@@ -138,11 +152,17 @@ class Joint:
             DesignerError: a factor missing or out of its tested range (unless `allow_extrapolation`),
                 an axis the surrogate cannot give.
         """
+        if not hasattr(params, "items"):  # a Mapping or a pandas Series of the six factors
+            fix = "give params={'density': 60, 'length': 24, 'width': 4.5, ...} with all six factors"
+            raise DesignerError(f"params is {describe(params)}, not a mapping of factors", fix)
         params = space.check_design(params, allow_extrapolation)
-        if surrogate is None:
-            from .surrogate import Surrogate
+        from .surrogate import Surrogate
 
+        if surrogate is None:
             surrogate = Surrogate.load()
+        if not callable(getattr(surrogate, "predict", None)):  # any object with Surrogate's interface
+            fix = "give Surrogate.load() (the shipped one) or Surrogate().fit(table)"
+            raise DesignerError(f"surrogate is {describe(surrogate)}, not a Surrogate", fix)
         pred = surrogate.predict({n: [v] for n, v in params.items()}, allow_extrapolation=True)
         base = {
             a: AxisCoefficients(
@@ -182,10 +202,11 @@ class Joint:
 
         where = "the suggestion"
         if not isinstance(suggestion, Suggestion):
-            where = f"suggestion {Path(suggestion).name}"
-            suggestion = Suggestion.load(suggestion)
+            path = path_argument(suggestion, "suggestion", what="a suggestion (designer suggest --json)")
+            where = f"suggestion {path.name}"
+            suggestion = Suggestion.load(path)
         n = len(suggestion.candidates)
-        if not 1 <= candidate <= n:
+        if not 1 <= number_argument(candidate, "candidate", example="1 (the best)") <= n:
             raise DesignerError(
                 f"candidate {candidate} does not exist in {where}",
                 f"choose 1 to {n}" if n else "the suggestion has no candidates",
@@ -293,10 +314,23 @@ def _number(value: Any, where: str) -> float:
     return float(value)
 
 
+def check_joint(value: Any, name: str = "joint") -> None:
+    """Raise unless `value` is a Joint.
+
+    Raises:
+        DesignerError: naming the argument `name` (e.g. `export_fmu(None, ...)`).
+    """
+    fix = "make one with Joint.from_coefficients, Joint.from_design or Joint.from_suggestion"
+    check_type(value, Joint, name, expected="a Joint", fix=fix)
+
+
 def _axes_from(
     base: Mapping[str, AxisCoefficients], wanted: Sequence[str], length_mm: float
 ) -> dict[str, AxisCoefficients]:
     """The wanted axes from the predicted ones; a rotational axis not predicted comes from the PRB model."""
+    if isinstance(wanted, str):  # axes="theta": one axis
+        wanted = [wanted]
+    check_type(wanted, Sequence, "axes", expected="a list of axes", fix="give e.g. axes=['x', 'theta']")
     out: dict[str, AxisCoefficients] = {}
     for a in wanted:
         a = units.check_axis(a)

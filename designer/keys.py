@@ -13,7 +13,7 @@ if sys.version_info >= (3, 11):
 else:
     import tomli as tomllib
 
-from .errors import DesignerError
+from .errors import DesignerError, path_argument
 
 
 def check_keys(table: Mapping[str, Any], allowed: Iterable[str], *, where: str) -> None:
@@ -39,10 +39,10 @@ def read_toml(path: str | Path, *, what: str) -> tuple[Path, dict[str, Any]]:
     Raises:
         DesignerError: the file does not exist or is not valid TOML.
     """
-    path = Path(path).resolve()
+    path = path_argument(path, "path", what=f"a .toml {what} file").resolve()
     if not path.is_file():
         raise DesignerError(f"{what} file {path} does not exist", f"give the path of a .toml {what} file")
     try:
-        return path, tomllib.loads(path.read_text())
+        return path, tomllib.loads(path.read_text(encoding="utf-8-sig"))  # a BOM (Windows editors) is fine
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise DesignerError(f"{path.name} is not valid TOML: {exc}", "fix the syntax") from None

@@ -24,9 +24,9 @@ import numpy as np
 
 from . import space
 from .calibration import calibrate, new_printer
-from .errors import DesignerError
+from .errors import DesignerError, number_argument
 from .suggestions import DISTINCT, TOLERANCE, Candidate, _distance, probability_within, suggest
-from .surrogate import Prediction, Surrogate
+from .surrogate import Prediction, Surrogate, check_surrogate
 
 #: quadrature nodes of the fantasised measurement
 NODES = 9
@@ -191,9 +191,9 @@ def _predictable_targets(sug: Any) -> dict[str, float]:
 
 
 def _check_arguments(n: int, stop: float) -> None:
-    if not 1 <= int(n) <= 10 or int(n) != n:
+    if not 1 <= number_argument(n, "n", example="3") <= 10 or int(n) != n:
         raise DesignerError(f"n={n} is not a whole number from 1 to 10", "give a whole number such as 3")
-    if not 0 < stop <= 1:
+    if not 0 < number_argument(stop, "stop", example="0.9") <= 1:
         raise DesignerError(f"stop={stop} is not in (0, 1]", "give a probability such as 0.9")
 
 
@@ -272,6 +272,7 @@ def next_prints(
             given, n is not in 1..10, or stop is not in (0, 1]. An unreachable target is not an
             error: the result has `reachable` False, the reason in `statements`, and no print.
     """
+    check_surrogate(surrogate)
     _check_arguments(n, stop)
     statements = []
     if surrogate.calibration is None:

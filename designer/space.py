@@ -16,6 +16,9 @@ NOZZLE_MM = 0.4
 PRINTABLE_MIN_MM = 2 * WALL_MM + NOZZLE_MM
 #: Infill density limits of a slicer, % (the power law needs a density above zero).
 DENSITY_LIMITS = (1.0, 100.0)
+#: no printer makes a specimen longer than this (mm): a value beyond it is a unit or typing error
+#: (k_x fitted on width = 1e308 mm ended as 'SVD did not converge')
+BUILD_MAX_MM = 1000.0
 
 
 @dataclass(frozen=True)
@@ -89,6 +92,8 @@ def check_value(name: str, value: float, allow_extrapolation: bool = False) -> f
             "height": f"two {WALL_MM:g} mm walls and one {NOZZLE_MM:g} mm line need {PRINTABLE_MIN_MM:g} mm",
             "density": "a slicer's infill runs from 1 to 100 %",
         }.get(name, "a length must be positive")
+        if v > hi and name != "density":
+            why = f"larger than a printer's build volume, {BUILD_MAX_MM:g} mm"
         raise DesignerError(
             f"{name} = {v:g} {f.unit} cannot be printed ({why})", f"give {lo:g} to {hi:g} {f.unit}"
         )
@@ -98,10 +103,10 @@ def check_value(name: str, value: float, allow_extrapolation: bool = False) -> f
 def printable_limits(f: Factor) -> tuple[float, float]:
     """What a printer can make of a continuous factor, beyond any tested range (mm or %)."""
     if f.name in ("width", "height"):
-        return PRINTABLE_MIN_MM, math.inf
+        return PRINTABLE_MIN_MM, BUILD_MAX_MM
     if f.name == "density":
         return DENSITY_LIMITS
-    return 1e-9, math.inf
+    return 1e-9, BUILD_MAX_MM
 
 
 def extended_range(f: Factor) -> tuple[float, float]:

@@ -16,6 +16,7 @@ from __future__ import annotations
 import functools
 import itertools
 import math
+import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,8 +26,8 @@ import casadi as ca
 import numpy as np
 
 from . import space, units
-from .errors import DesignerError
-from .surrogate import Prediction, Surrogate
+from .errors import DesignerError, check_type, describe, number_argument
+from .surrogate import Prediction, Surrogate, check_surrogate
 
 #: default tolerance around a target within which a printed joint counts as meeting it
 TOLERANCE = 0.10
@@ -210,7 +211,7 @@ def make_target(
         value = None
         lo, hi = (obs_lo if low is None else low), (obs_hi if high is None else high)
     else:
-        kind, value = "target", float(goal)
+        kind, value = "target", number_argument(goal, quantity)
         if not np.isfinite(value) or value <= 0:
             raise DesignerError(f"target {quantity} = {value:g} {unit} must be positive", "give a value > 0")
         if value > 1e6 * obs_hi:  # the desirability scale (bounds squared) would overflow
@@ -371,7 +372,7 @@ class Suggestion:
 
         path = Path(path)
         try:
-            data = json.loads(path.read_text())
+            data = json.loads(path.read_text(encoding="utf-8-sig"))  # a BOM (Windows editors) is fine
         except (OSError, ValueError) as exc:
             raise DesignerError(
                 f"cannot read a suggestion from path={str(path)!r}: {exc}",
@@ -407,12 +408,55 @@ def _check_schema(d: Any, where: str) -> None:
         absent = ", ".join(map(repr, missing))
         raise DesignerError(f"{where} is not a suggestion: no {absent} (it has {has})", fix)
     check_keys(d, _SUGGESTION_KEYS, where=where)
+    _check_types(d, _SUGGESTION_TYPES, where, fix)
     if not isinstance(d["candidates"], list) or not d["candidates"]:
         raise DesignerError(f"{where}: 'candidates' is not a non-empty list", fix)
     for i, c in enumerate(d["candidates"], 1):
         if not isinstance(c, Mapping) or "params" not in c or "predicted" not in c:
             raise DesignerError(f"{where}: candidate {i} has no 'params' and 'predicted'", fix)
         check_keys(c, _CANDIDATE_KEYS, where=f"candidate {i} of {where}")
+        _check_types(c, _CANDIDATE_TYPES, f"candidate {i} of {where}", fix)
+        for name, v in c["params"].items():  # float() would take "60" and true (1 %) silently
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                raise DesignerError(
+                    f"candidate {i} of {where}: {name} = {json_text(v)} is {describe(v)}, not a number",
+                    "write the number without quotes, e.g. 60",
+                )
+
+
+#: the JSON types of a suggestion's entries (hand-edited files: "targets": [0.8], "axis": 3)
+_SUGGESTION_TYPES = {
+    "axis": str, "units": dict, "targets": dict, "goals": dict, "tolerance": (int, float), "fixed": dict,
+    "reachable": bool, "statements": list, "predictability": dict, "ranges": dict, "nearest_runs": list,
+    "surrogate_id": str, "candidates": list,
+}  # fmt: skip
+_CANDIDATE_TYPES = {
+    "params": dict, "any": list, "predicted": dict, "p_within": (int, float, type(None)),
+    "probability": dict, "desirability": (int, float, type(None)), "rel_error": dict,
+    "extrapolated": (list, bool), "notes": list,
+}  # fmt: skip
+_JSON_NAMES = {str: "a string", dict: "an object", list: "a list", bool: "true or false", int: "a number"}
+
+
+def _check_types(d: Mapping[str, Any], types: Mapping[str, Any], where: str, fix: str) -> None:
+    """Raise for the first entry of `d` whose JSON type is not the one `types` gives."""
+    for key, want in types.items():
+        if key not in d:
+            continue
+        v = d[key]
+        wants = want if isinstance(want, tuple) else (want,)
+        numeric = float in wants or int in wants
+        if not isinstance(v, wants) or (isinstance(v, bool) and bool not in wants and numeric):
+            expected = " or ".join(dict.fromkeys(_JSON_NAMES.get(t, "null") for t in wants))
+            raise DesignerError(f"{where}: '{key}' is {json_text(v)}, not {expected}", fix)
+
+
+def json_text(v: Any) -> str:
+    """A JSON value as written in the file, shortened: 3, "x", [0.8], {...}."""
+    import json
+
+    text = json.dumps(v, default=str)
+    return text if len(text) <= 40 else text[:37] + "..."
 
 
 class _Problem:
@@ -560,6 +604,10 @@ def suggest(
             tolerance not in (0, 1).
     """
     _check_request(surrogate, axis, k is None and c is None, top, tolerance)
+    for name, value in (("fixed", fixed), ("importance", importance), ("bounds", bounds), ("weight", weight)):
+        if value is not None:
+            fix = f"give {name} as a dict, e.g. {name}={MAPPING_EXAMPLES[name]}"
+            check_type(value, Mapping, name, expected="a mapping", fix=fix)
     importance, bounds, weight = importance or {}, bounds or {}, weight or {}
     targets = {
         q: make_target(
@@ -594,8 +642,19 @@ def suggest(
     return sug
 
 
+MAPPING_EXAMPLES = {
+    "fixed": "{'width': 3.0}",
+    "importance": "{'k': 2.0}",
+    "bounds": "{'k': (0.5, 1.2)}",
+    "weight": "{'k': 1.0}",
+}
+
+
 def _check_request(surrogate: Surrogate, axis: str, no_goal: bool, top: int, tolerance: float) -> None:
     """Raise DesignerError for an axis the surrogate lacks, no goal, top < 1 or a tolerance not in (0, 1)."""
+    check_surrogate(surrogate)
+    check_type(top, numbers.Integral, "top", expected="a whole number", fix="give e.g. top=5")
+    number_argument(tolerance, "tolerance", example="0.1")
     units.check_axis(axis)
     if axis not in surrogate.axes:
         raise DesignerError(

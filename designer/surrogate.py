@@ -29,7 +29,7 @@ import casadi as ca
 import numpy as np
 
 from . import space, units
-from .errors import DesignerError
+from .errors import DesignerError, check_type, names_argument, path_argument
 from .files import atomic_write
 
 FORMAT = "flexjoint-surrogate/1"
@@ -663,12 +663,14 @@ class Surrogate:
             DesignerError: a malformed table (missing factor, NaN, non-positive k), an unknown
                 response, fewer than 8 runs, or a factor that takes one value in every run.
         """
-        from .data import axes_present, coefficient_columns, load_table, table_hash
+        from .data import axes_present, check_table_argument, coefficient_columns, load_table, table_hash
 
+        check_table_argument(table, "table")
         table = load_table(table)
         axes = axes_present(table)
         if responses is None:
             responses = [f"{q}_{a}" for a in axes for q in ("c", "k")]
+        responses = names_argument(responses, "responses", example='["k_x"]')
         unknown = [r for r in responses if r not in coefficient_columns(table)]
         if unknown or not responses:
             raise DesignerError(
@@ -725,6 +727,8 @@ class Surrogate:
         if not self.models:
             raise DesignerError("the surrogate is not fitted", "call fit(table) or Surrogate.load() first")
         X = _as_printed(_check_designs(designs, allow_extrapolation))
+        if responses is not None:
+            responses = names_argument(responses, "responses", example='["k_x"]')
         return {r: self.model(r).predict(X) for r in (responses or self.responses)}
 
     def _payload_json(self, include_id: bool = True) -> str:
@@ -779,6 +783,7 @@ class Surrogate:
         }
 
     def save(self, path: str | Path) -> Path:
+        path = path_argument(path, "path", what="a .json file")
         with atomic_write(path) as fh:
             fh.write(self._payload_json() + "\n")
         return Path(path)
@@ -790,7 +795,7 @@ class Surrogate:
         Raises:
             DesignerError: the file is missing, unreadable or not a surrogate.
         """
-        p = default_path() if path is None else Path(path)
+        p = default_path() if path is None else path_argument(path, "path", what="a surrogate .json file")
         try:
             d = json.loads(p.read_text())
         except FileNotFoundError:
@@ -899,3 +904,15 @@ def _check_designs(designs: Any, allow_extrapolation: bool) -> dict[str, np.ndar
 
 def default_path() -> Path:
     return Path(str(resources.files("designer.surrogates") / DEFAULT_NAME))
+
+
+def check_surrogate(value: Any, name: str = "surrogate") -> None:
+    """Raise unless `value` is a fitted Surrogate.
+
+    Raises:
+        DesignerError: naming the argument `name`, e.g. for `designer.suggest(None)`.
+    """
+    fix = "give Surrogate.load() (the shipped one) or Surrogate().fit(table)"
+    check_type(value, Surrogate, name, expected="a Surrogate", fix=fix)
+    if not value.models:
+        raise DesignerError(f"{name} is not fitted", fix)

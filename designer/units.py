@@ -40,7 +40,7 @@ TPU_DENSITY = 1210.0
 
 def check_axis(axis: str) -> str:
     """Return `axis` if it is one of the six, else raise a DesignerError listing them."""
-    if axis not in AXES:
+    if not isinstance(axis, str) or axis not in AXES:
         raise DesignerError(f"unknown axis '{axis}'", f"use one of: {', '.join(AXES)}")
     return axis
 

@@ -3,6 +3,7 @@ snapshot to prove nothing is left behind, and the malformed input files of the b
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import subprocess
@@ -28,6 +29,32 @@ def run_inprocess(args: list[str], capsys) -> tuple[int, str, str]:
 def run_process(args: list[str], cwd: Path, **kwargs) -> subprocess.CompletedProcess:
     """The command line `args` as a real `python -I` process (the installed package)."""
     return subprocess.run([*CLI, *map(str, args)], cwd=cwd, capture_output=True, text=True, **kwargs)
+
+
+@contextlib.contextmanager
+def tmpfs(folder: Path, size: str):
+    """A tmpfs of `size` (e.g. "2m") mounted on the new folder `folder` for the block; pytest.skip with
+    the reason where mounting is not allowed (not root). Unmounted lazily: a process still writing
+    there cannot make the unmount fail."""
+    import pytest
+
+    folder.mkdir()
+    mount = ["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(folder)]
+    r = subprocess.run(mount, capture_output=True)
+    if r.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here (needs root): {r.stderr.decode().strip()}")
+    try:
+        yield folder
+    finally:
+        subprocess.run(["umount", "--lazy", str(folder)], check=True)
+
+
+def enter_workdir(tmp_path: Path, inputs: Path, monkeypatch) -> Path:
+    """`tmp_path` as the working folder, the campaign's inputs linked in as in/, a private build cache."""
+    (tmp_path / "in").symlink_to(inputs, target_is_directory=True)
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path.parent / "cache"))
+    return tmp_path
 
 
 def snapshot(*folders: Path) -> dict[str, tuple[int, float]]:

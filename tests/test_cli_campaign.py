@@ -11,7 +11,7 @@ import os
 from pathlib import Path
 
 import pytest
-from clitools import assert_clean_failure, make_inputs, run_inprocess, run_process, snapshot
+from clitools import assert_clean_failure, enter_workdir, make_inputs, run_inprocess, run_process, snapshot
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -244,10 +244,7 @@ def inputs(tmp_path_factory):
 
 @pytest.fixture()
 def workdir(tmp_path, inputs, monkeypatch):
-    (tmp_path / "in").symlink_to(inputs, target_is_directory=True)
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path.parent / "cache"))
-    return tmp_path
+    return enter_workdir(tmp_path, inputs, monkeypatch)
 
 
 def test_campaign_has_at_least_200_cases():

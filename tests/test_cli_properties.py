@@ -247,3 +247,66 @@ def test_scenarios(text):
         if code == 0:
             for joint in json.loads(out)["metrics"].values():
                 assert math.isfinite(joint["tracking_rms_rad"])
+
+
+SWEEP_TABLES = {
+    "sweep": ["path", "check", "duration", "limits", "workers", "batch"],
+    "cases": ["type", "joints", "n", "seed", "candidates"],
+}
+TYPOS = {"sweep": ["limts", "duraton"], "cases": ["sed", "typ"]}
+#: values each key takes in a working sweep: drawn most of the time, so random files run cases too
+VALID = {
+    "path": ['"engine"', '"fmu"'], "check": ["0", "1"], "duration": ["0.03"],
+    "limits": ['["overshoot<=50%"]'], "workers": ["1"], "batch": ["2"], "type": ['"montecarlo"'],
+    "joints": ['["j1"]'], "n": ["2", "3"],
+    "seed": ["1"], "candidates": ["[1]"],
+}  # fmt: skip
+ONE_LINK = f"""[simulation]
+duration = 0.05
+step = 1e-3
+[robot]
+model = "{Path(__file__).resolve().parents[1] / "examples" / "one_link.xml"}"
+[joints.j1]
+axis = "theta"
+design = {{ density = 60, length = 24, width = 4.5, height = 9, layer = 0.16, raster = 0 }}
+reference = {{ type = "step", amplitude = 0.5, at = 0.01 }}
+"""
+
+
+@st.composite
+def sweeps(draw):
+    """A sweep TOML over a tiny one-link scenario: random keys (sometimes misspelt) with working values
+    or, one time in six, random ones of any TOML type, nested tables included."""
+    values = st.one_of(
+        st.integers(-2, 3),
+        st.floats(allow_nan=True, allow_infinity=True),
+        st.sampled_from(['"engine"', '"fmu"', '"montecarlo"', '"grid"', '"suggestion"', "true", '"x"']),
+        st.sampled_from(['["j1"]', '["overshoot<=5%"]', "[1, 2]", "{ a = 1 }", "{ j1 = { k = [3e2] } }"]),
+    )
+    lines = ['scenario = "one_link.toml"']
+    for table, keys in SWEEP_TABLES.items():
+        lines.append(f"[{table}]")
+        chosen = draw(st.lists(st.sampled_from(keys), max_size=3, unique=True))
+        if table == "cases" and draw(st.integers(0, 4)) > 0:  # most files name their cases
+            chosen = ["type", "n", *(k for k in chosen if k not in ("type", "n"))]
+        if draw(st.integers(0, 4)) == 0:
+            chosen.append(draw(st.sampled_from(TYPOS[table])))
+        for key in chosen:
+            valid = st.sampled_from(VALID.get(key, ["1"]))
+            value = draw(valid if draw(st.integers(0, 5)) else values)  # mostly working values
+            lines.append(f"{key} = {value if isinstance(value, str) else json.dumps(value)}")
+    return "\n".join(lines).replace("NaN", "nan").replace("Infinity", "inf") + "\n"
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(text=sweeps())
+def test_sweeps(text):
+    with tempfile.TemporaryDirectory() as tmp:
+        Path(tmp, "one_link.toml").write_text(ONE_LINK)
+        Path(tmp, "s.toml").write_text(text)
+        code, out = check(["sweep", "s.toml", "-o", "sw", "--workers", "1", "--json", "--no-plot"], Path(tmp))
+        if code == 0:
+            summary = json.loads(out)
+            assert summary["ok"] >= 1 and summary["cases"] >= summary["ok"]
+        elif code == 2:  # refused before any case ran: no results folder
+            assert not Path(tmp, "sw").exists()

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
-from clitools import CLI, run_inprocess, snapshot
+from clitools import CLI, run_inprocess, snapshot, tmpfs
 
 FACTORS = ["--density", "60", "--length", "24", "--width", "4.5", "--height", "9", "--layer", "0.16"]
 SIMULATE = ["rig", "simulate", "--k", "0.8", "--c", "2e-3", "--duration", "150", *FACTORS, "--raster", "0"]
@@ -130,13 +130,8 @@ def test_result_folder_is_staged_and_swapped(tmp_path):
 @pytest.fixture()
 def small_disk(tmp_path):
     """A 2 MiB tmpfs (skipped where mounting is not allowed)."""
-    mnt = tmp_path / "small"
-    mnt.mkdir()
-    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=2m", "tmpfs", str(mnt)], capture_output=True)
-    if r.returncode != 0:
-        pytest.skip("cannot mount a tmpfs here")
-    yield mnt
-    subprocess.run(["umount", str(mnt)], check=True)
+    with tmpfs(tmp_path / "small", "2m") as mnt:
+        yield mnt
 
 
 def test_full_disk_before_and_during_a_write(small_disk, capsys, monkeypatch):

@@ -133,9 +133,19 @@ def test_interrupted_run_leaves_complete_files_or_none(tmp_path, monkeypatch):
     monkeypatch.setattr(cosim_run, "plot_result", interrupt)
     with pytest.raises(KeyboardInterrupt):
         write_outputs(run(sc), out)
-    names = sorted(p.name for p in out.iterdir())
-    assert names == ["metrics.json", "timeseries.csv", "timeseries.parquet"]
+    # the files are staged and moved in together: none of them (issue 26: a lone timeseries.csv)
+    assert not out.exists()
+    write_outputs(run(sc), out, plot=False)  # into an existing folder: the old set stays whole
     assert len(np.loadtxt(out / "timeseries.csv", delimiter=",", skiprows=1)) == 201
+    (out / "notes.txt").write_text("the user's")
+    with pytest.raises(KeyboardInterrupt):
+        write_outputs(run(sc), out)
+    assert sorted(p.name for p in out.iterdir()) == [
+        "metrics.json",
+        "notes.txt",
+        "timeseries.csv",
+        "timeseries.parquet",
+    ]
     monkeypatch.setattr(cosim_session, "run_master", interrupt)
     with pytest.raises(KeyboardInterrupt):
         write_outputs(run(sc), tmp_path / "none")

@@ -17,7 +17,7 @@ from pathlib import Path
 from ..errors import DesignerError
 from ..export.build import FLAGS as BUILD_FLAGS
 from ..export.build import cache_dir, compile_c, find_compiler, source_dir
-from ..files import atomic_path
+from ..files import cache_entry
 
 #: the FMU binary's flags, plus -ffp-contract=off and no sin/cos builtins: the arithmetic of the
 #: Python master, bit for bit
@@ -84,9 +84,8 @@ def build_kernel() -> Path:
     target = cache_dir().parent / "kernel" / _key(compiler, include, lib) / name
     if target.is_file():
         return target
-    target.parent.mkdir(parents=True, exist_ok=True)
     root = source_dir()
-    with atomic_path(target) as tmp:
+    with cache_entry(target) as tmp:
         cmd = [
             *compiler,
             *FLAGS,

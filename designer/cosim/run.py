@@ -15,8 +15,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .. import units
-from ..errors import DesignerError
-from ..files import atomic_path, atomic_write
+from ..errors import DesignerError, check_type, path_argument
+from ..files import atomic_folder, atomic_path, atomic_write
 from .kernel import run_master
 from .master import Master, Trace
 from .metrics import joint_metrics
@@ -263,24 +263,20 @@ def write_outputs(
     parquet: bool | None = None,
     plot: bool | None = None,
 ) -> list[Path]:
-    """Write a result into `folder`, each file atomically; returns the paths written.
+    """Write a result into `folder`, all files or none; returns the paths written.
 
     `timeseries.csv` and `timeseries.parquet` (column `t` [s], then the signals in SI), `metrics.json`
     (`Result.summary()`), `plot.png`; for the rig also `rig_log.csv` and its sidecar. `csv`,
-    `parquet`, `plot` default to the scenario's `outputs` switches.
+    `parquet`, `plot` default to the scenario's `outputs` switches. The files are written into a
+    staging folder beside `folder` and moved in together, so an interrupt leaves the folder as it was.
 
     Raises:
-        DesignerError: `folder` is a file or cannot be created or written.
+        DesignerError: `folder` is a file or cannot be created or written; `result` is not a Result.
     """
-    out = Path(folder)
+    check_type(result, Result, "result", expected="a Result", fix="give what designer.cosim.run returns")
+    out = path_argument(folder, "folder", what="a folder")
     if out.exists() and not out.is_dir():
         raise DesignerError(f"folder={str(out)!r} is a file", "give a folder for the results")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise DesignerError(
-            f"cannot create folder {out}: {exc.strerror}", "choose a writable folder"
-        ) from None
     switches = result.scenario.outputs
     want = {
         "csv": switches["csv"] if csv is None else csv,
@@ -288,20 +284,21 @@ def write_outputs(
         "plot": switches["plot"] if plot is None else plot,
     }
     written = []
-    if want["csv"] or want["parquet"]:
-        written += _write_series(result, out, want["csv"], want["parquet"])
-    with atomic_write(out / "metrics.json") as fh:
-        json.dump(result.summary(), fh, indent=2, default=float)
-    written.append(out / "metrics.json")
-    if want["plot"]:
-        from ..plots.common import save_figure
+    with atomic_folder(out) as stage:
+        if want["csv"] or want["parquet"]:
+            written += _write_series(result, stage, want["csv"], want["parquet"])
+        with atomic_write(stage / "metrics.json") as fh:
+            json.dump(result.summary(), fh, indent=2, default=float)
+        written.append(stage / "metrics.json")
+        if want["plot"]:
+            from ..plots.common import save_figure
 
-        written.append(save_figure(plot_result(result), out / "plot.png"))
-    if result.scenario.kind == "rig":
-        from ..rig.logs import write_log
+            written.append(save_figure(plot_result(result), stage / "plot.png"))
+        if result.scenario.kind == "rig":
+            from ..rig.logs import write_log
 
-        written.append(write_log(rig_log(result), out / "rig_log.csv", result.scenario.factors))
-    return written
+            written.append(write_log(rig_log(result), stage / "rig_log.csv", result.scenario.factors))
+    return [out / Path(f).name for f in written]
 
 
 def _write_series(result: Result, out: Path, csv: bool, parquet: bool) -> list[Path]:

@@ -431,6 +431,8 @@ def _joint_source(spec: Any, key: str, d: _Doc, name: str) -> JointSource:
         raise DesignerError(f"{d.where(key)} must be a table", "see the scenario format in the README")
     check_keys(spec, KEYS["joint"], where=f"[{key}] of {d.path.name}")
     axis = spec.get("axis", "theta")
+    if not isinstance(axis, str):
+        raise DesignerError(f"{d.where(key)}.axis = {axis!r} is not an axis name", 'give e.g. axis = "theta"')
     has = [k for k in SOURCES if k in spec]
     if len(has) != 1:
         raise DesignerError(

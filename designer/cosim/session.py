@@ -24,7 +24,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..errors import DesignerError
+from ..errors import DesignerError, check_type
 from .fmu import FmuDescription, FmuSystem, unpack
 from .kernel import ENGINES, Bound, bind, run_master
 from .master import Master, Trace
@@ -299,6 +299,8 @@ def prepare(scenario: Scenario) -> Session:
         DesignerError: a bad scenario, an FMU that cannot be read or refuses its parameters (with its
             log line), a robot model MuJoCo cannot compile. Whatever was built is freed first.
     """
+    fix = "read one with designer.cosim.load(path)"
+    check_type(scenario, Scenario, "scenario", expected="a Scenario", fix=fix)
     sc = scenario if scenario.checked else scenario.check()
     stack = contextlib.ExitStack()
     try:

@@ -28,8 +28,8 @@ from collections.abc import Sequence
 from importlib import resources
 from pathlib import Path
 
-from ..errors import DesignerError
-from ..files import atomic_path
+from ..errors import DesignerError, check_type
+from ..files import cache_entry
 
 #: no fused multiply-add contraction: aarch64 would fuse a*b+c where x86_64 cannot, and a joint's
 #: numbers would then differ by platform (1e-12 after 300 steps, measured under qemu-user)
@@ -125,6 +125,10 @@ def resolve_platforms(platforms: str | Sequence[str]) -> list[str]:
     """
     if isinstance(platforms, str):
         platforms = [p.strip() for p in platforms.split(",") if p.strip()]
+    fix = f'give platforms="all", "host" or a list of: {", ".join(PLATFORMS)}'
+    check_type(platforms, (list, tuple), "platforms", expected="a str or a list of str", fix=fix)
+    for p in platforms:
+        check_type(p, str, "platforms", expected="a list of str", fix=fix)
     if list(platforms) == ["all"]:
         names = list(PLATFORMS)
     elif list(platforms) == ["host"]:
@@ -263,8 +267,7 @@ def build_binary(
     target = cache_dir() / f"fmi{fmi_version}-{platform}-{key}" / library_name(platform)
     if target.is_file():
         return target
-    target.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(target) as out:
+    with cache_entry(target) as out:
         compile_binary(fmi_version, platform, compiler, extra, out)
     return target
 
@@ -294,14 +297,30 @@ def compile_c(cmd: list[str], *, name: str, what: str, instead: str, cwd: Path |
 
     `instead` says what the caller can do without a compiler (e.g. "export with source_only=True").
     """
-    try:
-        done = subprocess.run(cmd, capture_output=True, text=True, check=False, cwd=cwd)
-    except OSError as exc:
+    # the compiler's own temporary files (gcc's cc*.s, cc*.o) go to a folder removed afterwards, so an
+    # interrupt that kills the compiler cannot leave them in the user's temporary folder
+    with tempfile.TemporaryDirectory(prefix="designer-cc-") as scratch:
+        env = {**os.environ, "TMPDIR": scratch, "TMP": scratch, "TEMP": scratch}
+        try:
+            proc = subprocess.Popen(
+                cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=cwd, env=env
+            )
+        except OSError as exc:
+            raise DesignerError(
+                f"could not run the C compiler '{name}': {exc}", f"check $CC, or {instead}"
+            ) from None
+        try:
+            _, stderr = proc.communicate()
+        except BaseException:  # interrupted: stop the compiler (its driver removes its files) first
+            proc.terminate()
+            try:
+                proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+            raise
+    if proc.returncode != 0:
         raise DesignerError(
-            f"could not run the C compiler '{name}': {exc}", f"check $CC, or {instead}"
-        ) from None
-    if done.returncode != 0:
-        raise DesignerError(
-            f"compiling {what} failed:\n{done.stderr.strip()}",
+            f"compiling {what} failed:\n{stderr.strip()}",
             f"check the compiler with '{name} --version', or {instead}",
         )

@@ -96,10 +96,9 @@ def _libcosim_row(body: Path, t: np.ndarray, exact: np.ndarray) -> dict:
 def check_fmus(ctx: Context) -> CheckResult:
     """FMI 2 and 3 archives pass validate_fmu; the body step response matches the analytic one in fmpy
     (co-simulation and model exchange) and in libcosimpy."""
-    import tempfile
-
     from fmpy.validation import validate_fmu
 
+    from ..files import private_tempdir
     from ..joint import Joint
     from ..plots.common import save_figure
     from ..plots.timeseries import plot_timeseries
@@ -110,7 +109,7 @@ def check_fmus(ctx: Context) -> CheckResult:
     rows, curves = [], {}
     t = np.linspace(0.0, FMU_STOP, int(round(FMU_STOP / 1e-3)) + 1)
     exact = step_response(m, c, k, FMU_LOAD, t)
-    with tempfile.TemporaryDirectory(prefix="designer-report-") as tmp:
+    with private_tempdir("designer-report-") as tmp:  # fmpy's unpacked FMUs go in there too
         for version in (2, 3):
             for interface in ("force", "body"):
                 path = Path(tmp) / f"joint{version}{interface}.fmu"

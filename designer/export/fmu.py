@@ -20,7 +20,7 @@ from xml.sax.saxutils import quoteattr
 from .. import __version__, units
 from ..errors import DesignerError
 from ..files import atomic_path, check_suffix
-from ..joint import AxisCoefficients, Joint
+from ..joint import AxisCoefficients, Joint, check_joint
 from . import build
 from .layout import layout
 
@@ -432,9 +432,9 @@ def _start_values(joint: Joint, interface: str, variables: list[Variable]) -> st
 
 
 def _check(joint: Joint, fmi_version: int, interface: str) -> None:
-    if fmi_version not in FMI_VERSIONS:
+    if isinstance(fmi_version, bool) or not isinstance(fmi_version, int) or fmi_version not in FMI_VERSIONS:
         raise DesignerError(f"fmi_version={fmi_version!r} is not supported", "use fmi_version=2 or 3")
-    if interface not in INTERFACES:
+    if not isinstance(interface, str) or interface not in INTERFACES:
         raise DesignerError(f"interface={interface!r} is not an interface", "use interface='force' or 'body'")
     if interface == "body":
         missing = [a for a, ac in joint.axes.items() if ac.m is None]
@@ -513,6 +513,7 @@ def export_fmu(
         DesignerError: bad arguments, or a binary that cannot be built.
     """
     path = check_suffix(path, (".fmu",), what="an FMU")
+    check_joint(joint)
     entries = archive_entries(joint, fmi_version, interface, source_only, platforms, rebuild)
     if progress:
         progress(0.5)

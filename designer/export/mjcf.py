@@ -11,9 +11,9 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .. import units
-from ..errors import DesignerError
+from ..errors import DesignerError, check_type
 from ..files import atomic_write, check_suffix
-from ..joint import Joint
+from ..joint import Joint, check_joint
 from . import robot
 from .mjcf_into import into_parallel, into_series
 from .stability import StepAdvice, step_advice
@@ -196,11 +196,13 @@ def export_mjcf(
         DesignerError: a wrong suffix, unknown form, missing mass, or an `into` problem.
     """
     path = check_suffix(path, (".xml", ".mjcf"), what="an MJCF")
+    check_joint(joint)
     if form not in FORMS:
         raise DesignerError(f"form={form!r} is not a form", f"use one of: {', '.join(FORMS)}")
     if into is not None:
         if joint_name is None:
             raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
+        check_type(joint_name, str, "joint_name", expected="a name", fix="give e.g. joint_name='knee'")
         with _mujoco_warnings() as warned:
             advice, notes = _into(
                 joint,

@@ -13,7 +13,7 @@ from pathlib import Path
 from .. import units
 from ..errors import DesignerError
 from ..files import atomic_write, check_suffix
-from ..joint import Joint
+from ..joint import Joint, check_joint
 
 #: supported MSL versions and the package holding their SI types
 MSL_UNITS = {"4.0.0": "Modelica.Units.SI", "3.2.3": "Modelica.SIunits"}
@@ -41,7 +41,7 @@ def modelica_text(joint: Joint, *, msl: str = "4.0.0") -> str:
     Raises:
         DesignerError: `msl` is not a supported MSL version.
     """
-    if msl not in MSL_UNITS:
+    if not isinstance(msl, str) or msl not in MSL_UNITS:
         raise DesignerError(f"msl={msl!r} is not supported", f"use one of: {', '.join(MSL_UNITS)}")
     si_types = MSL_UNITS[msl]
     decl, eqs = [], []
@@ -93,6 +93,7 @@ def export_modelica(joint: Joint, path: str | Path, *, msl: str = "4.0.0") -> Pa
         DesignerError: a path not ending in .mo, or an unsupported `msl`.
     """
     path = check_suffix(path, (".mo",), what="a Modelica")
+    check_joint(joint)
     text = modelica_text(joint, msl=msl)
     with atomic_write(path) as fh:
         fh.write(text)

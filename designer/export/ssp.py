@@ -19,11 +19,13 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 from .. import units
-from ..errors import DesignerError
+from ..errors import DesignerError, check_type
 from ..files import atomic_path, check_suffix
-from ..joint import Joint
+from ..joint import Joint, check_joint
 from . import fmu
 from .robot import with_masses
+
+JOINTS_FIX = "give a Joint (Joint.from_coefficients, from_design, from_suggestion) or a list of Joints"
 
 NS = {
     "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
@@ -175,6 +177,10 @@ def export_ssp(
     """
     path = check_suffix(path, (".ssp",), what="an SSP")
     why = "the body interface needs a mass (or use interface='force')"
+    if not isinstance(joints, Joint):
+        check_type(joints, (list, tuple), "joints", expected="a Joint or a list of them", fix=JOINTS_FIX)
+        for i, j in enumerate(joints):
+            check_joint(j, f"joints[{i}]")
     joints = [joints] if isinstance(joints, Joint) else list(joints)
     if interface == "body":
         joints = [with_masses(j, why) for j in joints]

@@ -14,9 +14,9 @@ import re
 from pathlib import Path
 
 from .. import units
-from ..errors import DesignerError
+from ..errors import DesignerError, check_type
 from ..files import atomic_path, atomic_write, check_suffix
-from ..joint import Joint
+from ..joint import Joint, check_joint
 from . import robot, urdf_drake, xmltext
 from .stability import step_advice
 from .urdf_inertia import moved_inertia
@@ -313,9 +313,11 @@ def export_urdf(
         DesignerError: a wrong suffix, a missing mass, or an `into` problem.
     """
     path = check_suffix(path, (".urdf",), what="a URDF")
+    check_joint(joint)
     if into is not None:
         if joint_name is None:
             raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
+        check_type(joint_name, str, "joint_name", expected="a name", fix="give e.g. joint_name='knee'")
         data, advice, notes = _into_urdf(joint, Path(into), joint_name=joint_name, axis=axis, rest=rest)
         with atomic_path(path) as tmp:
             tmp.write_bytes(data)
@@ -333,6 +335,7 @@ def export_sdf(joint: Joint, path: str | Path) -> robot.RobotExport:
         DesignerError: a wrong suffix or a missing mass.
     """
     path = check_suffix(path, (".sdf",), what="an SDFormat")
+    check_joint(joint)
     text, advice = sdf_text(robot.with_masses(joint))
     with atomic_write(path) as fh:
         fh.write(text)

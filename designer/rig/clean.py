@@ -16,8 +16,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from .. import units
-from ..data import canonical_columns, coefficient_columns, normalise
+from .. import space, units
+from ..data import canonical_columns, check_text_cells, coefficient_columns, normalise
 from ..errors import DesignerError
 
 EPS = 0.5
@@ -118,6 +118,7 @@ def clean(
     if len(raw) == 0:
         raise DesignerError(f"{source}: the table has no runs", "give a table with at least one data row")
     raw = raw.reset_index(drop=True)
+    check_text_cells(raw, [c for c in (*space.FACTOR_NAMES, *cols) if c in raw.columns], source)
     sensor_bad, reasons = _sensor_failures(raw[cols].apply(pd.to_numeric, errors="coerce"))
     rows = np.flatnonzero(~sensor_bad)
     if len(rows) == 0:

@@ -35,7 +35,7 @@ import numpy as np
 import pandas as pd
 
 from .. import space, units
-from ..errors import DesignerError
+from ..errors import DesignerError, describe, names_argument, number_argument
 from ..mass import specimen_mass
 from . import band as bandlib
 from . import channel, departures
@@ -489,11 +489,15 @@ def identify_log(
             is not a finite number.
     """
     log = _as_log(source)
-    chosen = log.axes if axes is None else list(axes)
+    chosen = log.axes if axes is None else names_argument(axes, "axes", example='["x"]')
+    if not chosen:
+        raise DesignerError("axes=[] names no axis", f"give some of {', '.join(log.axes)}, or None for all")
     absent = [a for a in chosen if a not in log.axes]
     if absent:
         raise DesignerError(f"axes={absent} not in the log", f"the log has {', '.join(log.axes)}")
-    delay = load_delay_s if load_delay_s is not None else (log.load_delay_s or 0.0)
+    delay = log.load_delay_s or 0.0
+    if load_delay_s is not None:
+        delay = number_argument(load_delay_s, "load_delay_s", example="0.002 (s)")
     if not np.isfinite(delay):
         raise DesignerError(f"load_delay_s={load_delay_s} is not finite", "give the delay in seconds")
     lowpass = channel.parse(load_filter if load_filter is not None else log.load_filter)
@@ -543,7 +547,13 @@ def identify(
         DesignerError: a log cannot be read or validated (names the column and row), axes names an
             axis not in a log, or load_delay_s is not finite.
     """
-    sources = [logs] if isinstance(logs, (str, Path, pd.DataFrame, RigLog)) else list(logs)
+    one = (str, os.PathLike, pd.DataFrame, RigLog)
+    if not isinstance(logs, (*one, Iterable)) or isinstance(logs, np.ndarray):
+        raise DesignerError(
+            f"logs is {describe(logs)}, not a log or a list of logs",
+            "give paths of rig logs (CSV or Parquet), DataFrames in the log schema, or a list of them",
+        )
+    sources = [logs] if isinstance(logs, one) else list(logs)
     out = []
     for i, source in enumerate(sources):
         out.append(identify_log(source, axes=axes, load_delay_s=load_delay_s, load_filter=load_filter))

@@ -16,6 +16,7 @@ import pandas as pd
 from .. import units
 from ..chirp import F0, F1, HUB_AMPLITUDE, SWEEP, Chirp
 from ..errors import DesignerError
+from ..joint import AxisCoefficients
 from ..limits import check_memory
 from .logs import LOAD, STUCK_SAMPLES
 
@@ -95,6 +96,7 @@ def simulate(
         m = units.from_si("m_log", axis, _check(f"m on axis {axis}", coef.get("m", 0.0), False))
         c = _check(f"c on axis {axis}", coef["c"], False)
         k = _check(f"k on axis {axis}", coef["k"])
+        AxisCoefficients(axis=axis, k=k, c=c)  # a joint's bounds: k = 5e-324 or 1e308 N/mm is refused
         r = amplitude * q
         load = m * amplitude * ddq + c * amplitude * dq + k * r
         load = load + noise * np.sqrt(np.mean(load**2)) * rng.standard_normal(n)

@@ -13,6 +13,7 @@ from typing import IO
 
 import pandas as pd
 
+from ..errors import DesignerError, describe
 from .cases import Case, make_cases
 from .evaluate import Task, batches, evaluate, holding
 from .spec import Spec, check
@@ -59,6 +60,11 @@ def _batch_size(spec: Spec, n_cases: int, workers: int) -> int:
 @contextlib.contextmanager
 def _default_executor(spec: Spec, given: Executor | None) -> Iterator[Executor]:
     if given is not None:
+        if not callable(getattr(given, "submit", None)):
+            raise DesignerError(
+                f"executor is {describe(given)}, not a concurrent.futures Executor",
+                "give e.g. concurrent.futures.ProcessPoolExecutor(), or None for local processes",
+            )
         yield given
         return
     from .executors import executor

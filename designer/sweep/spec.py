@@ -16,8 +16,8 @@ import numpy as np
 
 from ..cosim.scenario import Scenario
 from ..cosim.session import sources  # noqa: F401  (the joints a sweep can vary, by name)
-from ..errors import DesignerError
-from ..keys import read_toml
+from ..errors import DesignerError, check_type
+from ..keys import check_keys, read_toml
 from .limits import Limit, parse_limit
 
 CASE_TYPES = ("grid", "suggestion", "montecarlo")
@@ -169,6 +169,7 @@ def load(path: str | Path) -> Spec:
     from .. import cosim
 
     path, doc = read_toml(path, what="sweep")
+    _check_sweep_keys(doc, path)
     if not isinstance(doc.get("scenario"), str):
         raise DesignerError(f"{path.name} names no scenario", 'add scenario = "arm.toml" at the top')
     scenario = cosim.load((path.parent / doc["scenario"]).resolve())
@@ -199,6 +200,23 @@ def load(path: str | Path) -> Spec:
     return check(spec)
 
 
+#: the keys a sweep file may have, per table (a misspelt one, e.g. `limts`, was ignored silently)
+SWEEP_KEYS = {
+    "": ("scenario", "sweep", "cases", "cluster"),
+    "sweep": ("path", "check", "duration", "limits", "surrogate", "workers", "batch"),
+    "cases": ("type", "joints", "designs", "n", "seed", "file", "candidates"),
+    "cluster": ("scheduler", "workers", "slurm"),
+}
+
+
+def _check_sweep_keys(doc: dict, path: Path) -> None:
+    """Raise for an unknown key (with the nearest valid one) in the file or one of its tables."""
+    check_keys(doc, SWEEP_KEYS[""], where=path.name)
+    for table in ("sweep", "cases", "cluster"):
+        if isinstance(doc.get(table), dict):
+            check_keys(doc[table], SWEEP_KEYS[table], where=f"[{table}] of {path.name}")
+
+
 def with_duration(scenario: Scenario, duration: Any) -> Scenario:
     """The scenario run for another duration (s)."""
     if isinstance(duration, bool) or not isinstance(duration, (int, float)) or not duration >= scenario.step:
@@ -212,8 +230,10 @@ def check(spec: Spec) -> Spec:
 
     Raises:
         DesignerError: a rig scenario with the engine path or limits, a case naming an unknown
-            joint, or a Monte Carlo sweep without its count; a bad scenario (Scenario.check).
+            joint, or a Monte Carlo sweep without its count; a bad scenario (Scenario.check); `spec`
+            not a Spec.
     """
+    check_type(spec, Spec, "spec", expected="a sweep Spec", fix="read one with designer.sweep.load(path)")
     sc = spec.scenario if spec.scenario.checked else spec.scenario.check()
     spec = dataclasses.replace(spec, scenario=sc)
     if sc.kind == "rig" and (spec.path != "fmu" or spec.limits):

@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 
 from .. import space, units
-from ..files import atomic_path, atomic_write
+from ..files import atomic_folder, atomic_path, atomic_write
 from .cases import Case
 from .evaluate import RIG_METRICS
 from .limits import METRICS, applies
@@ -151,18 +151,18 @@ def write_results(result, folder: str | Path, *, plot: bool = True) -> list[Path
     import pyarrow.parquet as pq
 
     folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
     arrow = pa.Table.from_pandas(result.table, preserve_index=False)
     meta = dict(arrow.schema.metadata or {})
     meta[b"designer.units"] = json.dumps(result.summary["units"]).encode()
-    with atomic_path(folder / "results.parquet") as tmp:
-        pq.write_table(arrow.replace_schema_metadata(meta), tmp)
-    with atomic_write(folder / "summary.json") as fh:
-        json.dump(result.summary, fh, indent=2, default=float)
-    files = [folder / "results.parquet", folder / "summary.json"]
-    if plot and result.summary["ok"]:
-        files.append(plot_metrics(result, folder / "metrics.png"))
-    return files
+    with atomic_folder(folder) as stage:  # moved in together: an interrupt leaves none of them
+        with atomic_path(stage / "results.parquet") as tmp:
+            pq.write_table(arrow.replace_schema_metadata(meta), tmp)
+        with atomic_write(stage / "summary.json") as fh:
+            json.dump(result.summary, fh, indent=2, default=float)
+        names = ["results.parquet", "summary.json"]
+        if plot and result.summary["ok"]:
+            names.append(plot_metrics(result, stage / "metrics.png").name)
+    return [folder / name for name in names]
 
 
 def plot_metrics(result, path: str | Path) -> Path:
