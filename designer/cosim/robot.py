@@ -183,6 +183,7 @@ class Robot:
         step: float,
         integrator: str = "euler",
         in_engine: Mapping[str, SpringDamper] | None = None,
+        notes: tuple[str, ...] = (),
     ) -> None:
         import mujoco
 
@@ -192,6 +193,7 @@ class Robot:
         spec = spec.copy()
         spec.option.timestep = step
         spec.option.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{integrator.upper()}")
+        self.notes = tuple(notes)  # what the reader should know of how the host model was changed
         self.in_engine = dict(in_engine or {})
         for name, law in self.in_engine.items():
             law.actuator(spec, name)

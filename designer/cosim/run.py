@@ -202,9 +202,8 @@ def result(
     else:
         metrics, check = robot_metrics(sc, trace, laws), _validate_robot
     validation = check(session, case, laws, part(share, 1.0 - share)) if validate else None
-    return Result(
-        sc, trace.time, trace.columns, trace.values, metrics, laws, validation, trace.delays, trace.engine
-    )
+    notes = (*trace.delays, *(session.master.systems["robot"].notes if sc.kind == "robot" else ()))
+    return Result(sc, trace.time, trace.columns, trace.values, metrics, laws, validation, notes, trace.engine)
 
 
 def run(

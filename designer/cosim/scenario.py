@@ -35,6 +35,8 @@ class JointSource:
     """Where a joint FMU comes from: an FMU file, or a `Joint` exported on the fly.
 
     `parameters` overrides FMU parameters in SI, keyed "axis.field" (e.g. {"theta.k": 0.3}).
+    `keep_host` (robots): keep the host joint's own stiffness, damping and armature in parallel with
+    the flexure; by default they are zeroed, since the flexible joint replaces them (and said so).
     Building one stores the values; `check()` (called by `load` and `prepare`) checks them.
 
     Check raises:
@@ -47,6 +49,7 @@ class JointSource:
     joint: Joint | None = None
     fmi_version: int = 2
     parameters: Mapping[str, float] = field(default_factory=dict)
+    keep_host: bool = False
 
     def check(self) -> JointSource:
         """This source checked, its path a Path (construction only stores; load/prepare check).
@@ -272,6 +275,7 @@ KEYS = {
         "fmi_version",
         "parameters",
         "reference",
+        "keep_host",
     ),
     "rig": ("joint", "amplitude", "f0", "f1", "sweep", "factors"),
     "validation": ("steps", "duration"),
@@ -452,7 +456,12 @@ def _joint_source(spec: Any, key: str, d: _Doc, name: str) -> JointSource:
         raise DesignerError(
             f"{d.where(key)}.parameters must be a table or an SSV file", 'e.g. {"theta.k" = 0.3} or "j1.ssv"'
         )
-    common = dict(axis=axis, fmi_version=spec.get("fmi_version", 2), parameters=params)
+    keep_host = spec.get("keep_host", False)
+    if not isinstance(keep_host, bool):
+        raise DesignerError(
+            f"{d.where(key)}.keep_host = {keep_host!r} is not true or false", "give keep_host = true"
+        )
+    common = dict(axis=axis, fmi_version=spec.get("fmi_version", 2), parameters=params, keep_host=keep_host)
     if "fmu" in spec:
         return JointSource(fmu=d.file(spec["fmu"], f"{key}.fmu"), **common)
     for table in ("coefficients", "design"):
