@@ -324,6 +324,10 @@ def _masses(spec: bandlib.Spectra, ch, sol, correct, axis: str) -> tuple[list[di
     return rows, stable, wide[-1][0]
 
 
+#: the longest load-channel delay taken: a tenth of the study's shortest excitation period (0.54 s)
+MAX_LOAD_DELAY_S = 0.05
+
+
 def fit_axis(
     log: RigLog, axis: str, *, load_delay_s: float = 0.0, load_filter: channel.LoadFilter | None = None
 ) -> AxisFit:
@@ -500,6 +504,11 @@ def identify_log(
         delay = number_argument(load_delay_s, "load_delay_s", example="0.002 (s)")
     if not np.isfinite(delay):
         raise DesignerError(f"load_delay_s={load_delay_s} is not finite", "give the delay in seconds")
+    if abs(delay) >= MAX_LOAD_DELAY_S:  # beyond that, the lag is no channel's: c would mean nothing
+        raise DesignerError(
+            f"load_delay_s={delay:g} s is not a sensor channel's delay (|delay| < {MAX_LOAD_DELAY_S:g} s)",
+            "give the load channel's delay in seconds, e.g. 0.002",
+        )
     lowpass = channel.parse(load_filter if load_filter is not None else log.load_filter)
 
     def one(axis: str) -> AxisFit | _Still | str:
