@@ -88,6 +88,39 @@ def check_joints(spec, names: Sequence[str]) -> None:
             )
 
 
+#: a host joint's own parallel elements the flexible joint replaces: (MjSpec attribute, SI unit of a
+#: hinge, of a slide)
+HOST_ELEMENTS = (
+    ("stiffness", "N.m/rad", "N/m"),
+    ("damping", "N.m.s/rad", "N.s/m"),
+    ("armature", "kg.m^2", "kg"),
+)
+
+
+def free_host_joints(spec, names: Sequence[str]) -> tuple[str, ...]:
+    """Zero the stiffness, damping and armature the host model gives the joints `names` (in `spec`),
+    since the flexible joint takes their place; returns one note per joint changed (old -> 0, SI)."""
+    import mujoco
+
+    notes = []
+    for name in names:
+        joint = spec.joint(name)
+        hinge = joint.type == mujoco.mjtJoint.mjJNT_HINGE
+        changed = []
+        for attr, hinge_unit, slide_unit in HOST_ELEMENTS:
+            value = getattr(joint, attr)  # newer MuJoCo: stiffness, damping as coefficient arrays
+            old = np.array(value, dtype=float)  # a copy: the spec writes through its arrays
+            if np.any(old != 0.0):
+                setattr(joint, attr, np.zeros_like(old) if old.ndim else 0.0)
+                changed.append(f"{attr} {old.ravel()[0]:.4g} -> 0 {hinge_unit if hinge else slide_unit}")
+        if changed:
+            notes.append(
+                f"the robot's joint '{name}' had its own {', '.join(changed)}: the flexible joint replaces "
+                f"them (keep_host = true in [joints.{name}] keeps them in parallel)"
+            )
+    return tuple(notes)
+
+
 def constraint_free(model) -> bool:
     """True if the compiled model can have no constraint: no equality, joint or tendon limit, friction
     loss, flex, or geom pair that may touch. MuJoCo's constraint stage then only costs time."""

@@ -24,14 +24,12 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from ..errors import DesignerError, check_type
 from .fmu import FmuDescription, FmuSystem, unpack
 from .kernel import ENGINES, Bound, bind, run_master
 from .master import Master, Trace
 from .rig import HubServo
-from .robot import Robot, SpringDamper, load_spec
+from .robot import Robot, SpringDamper, free_host_joints, load_spec
 from .scenario import PARAMETER_FIELDS, JointSource, Scenario
 
 if TYPE_CHECKING:
@@ -54,39 +52,6 @@ def robot_system(
     spec = load_spec(sc.model, sc.lengths, sc.masses)
     notes = free_host_joints(spec, [j for j, src in sc.joints.items() if not src.keep_host])
     return Robot(spec, sc.motors, step, integrator or sc.integrator, in_engine=in_engine, notes=notes)
-
-
-#: a host joint's own parallel elements the flexible joint replaces: (MjSpec attribute, SI unit of a
-#: hinge, of a slide)
-HOST_ELEMENTS = (
-    ("stiffness", "N.m/rad", "N/m"),
-    ("damping", "N.m.s/rad", "N.s/m"),
-    ("armature", "kg.m^2", "kg"),
-)
-
-
-def free_host_joints(spec: Any, names: list[str]) -> tuple[str, ...]:
-    """Zero the stiffness, damping and armature the host model gives the joints `names` (in `spec`),
-    since the flexible joint takes their place; returns one note per joint changed (old -> 0, SI)."""
-    import mujoco
-
-    notes = []
-    for name in names:
-        joint = spec.joint(name)
-        hinge = joint.type == mujoco.mjtJoint.mjJNT_HINGE
-        changed = []
-        for attr, hinge_unit, slide_unit in HOST_ELEMENTS:
-            value = getattr(joint, attr)  # newer MuJoCo: stiffness, damping as coefficient arrays
-            old = np.array(value, dtype=float)  # a copy: the spec writes through its arrays
-            if np.any(old != 0.0):
-                setattr(joint, attr, np.zeros_like(old) if old.ndim else 0.0)
-                changed.append(f"{attr} {old.ravel()[0]:.4g} -> 0 {hinge_unit if hinge else slide_unit}")
-        if changed:
-            notes.append(
-                f"the robot's joint '{name}' had its own {', '.join(changed)}: the flexible joint replaces "
-                f"them (keep_host = true in [joints.{name}] keeps them in parallel)"
-            )
-    return tuple(notes)
 
 
 def sources(sc: Scenario) -> dict[str, JointSource]:
