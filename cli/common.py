@@ -18,6 +18,20 @@ from rich.console import Console
 from designer.errors import DesignerError
 from designer.space import FACTOR_NAMES
 
+#: set by `finishing()`, cleared by each `run()`: the command is writing its outputs and a stop signal
+#: no longer interrupts it; LATE_STOP is the signal that came meanwhile (None: none did)
+FINISHING = False
+LATE_STOP: int | None = None
+
+
+def finishing() -> None:
+    """Mark the command's last step, writing its outputs and printing what it wrote: a stop signal
+    from here on is recorded, not raised, so the outputs are whole and the exit code is the command's
+    own (stopped at this point, it would say "partial files removed" of files that are complete)."""
+    global FINISHING
+    FINISHING = True
+
+
 # the options many commands share, spelled once: -o/--output, --data, --json, --surrogate, --fix
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print machine-readable JSON only.")]
 DataOpt = Annotated[

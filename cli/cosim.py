@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from .common import console, print_json, progress, quiet_mujoco
+from .common import console, finishing, print_json, progress, quiet_mujoco
 
 
 def cosim(
@@ -39,6 +39,7 @@ def cosim(
     check_output_folder(out)
     with progress(f"co-simulating {scenario.name}", enabled=not json_out) as bar:
         result = run(sc, validate=validate, progress=bar, engine=engine)
+    finishing()
     files = write_outputs(result, out)
     summary = result.summary() | {"files": [str(f) for f in files]}
     passed = _verdict(summary["validation"])[1] if summary.get("validation") else True

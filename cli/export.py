@@ -15,7 +15,7 @@ import typer
 
 from designer.errors import DesignerError
 
-from .common import console, err_console, print_json, progress
+from .common import console, err_console, finishing, print_json, progress
 
 export_app = typer.Typer(
     help="Export a joint: FMU (FMI 2/3), Modelica, MJCF, URDF, SDF or SSP.", no_args_is_help=True
@@ -165,6 +165,7 @@ def _snippet(
             allow_extrapolation,
         )
         result = write(joint, output, (from_, candidate) if from_ else None, **options)
+        finishing()
         advice = getattr(result, "advice", {})
         if json_out:
             written = result.to_dict() if hasattr(result, "to_dict") else {"path": str(result)}

@@ -9,6 +9,8 @@ Every failure ends as one line on stderr naming the problem and the fix, never a
 | 2 | bad input or environment (a file, a flag, a full disk, too little memory) |
 | 3 | internal error (a bug: the line says so; `--debug` shows the traceback) |
 | 129, 130, 143 | stopped by SIGHUP, Ctrl-C (SIGINT) or SIGTERM; part files are removed |
+
+A stop that comes while a command writes its outputs (`common.finishing`) lets it finish them.
 """
 
 from __future__ import annotations
@@ -108,6 +110,9 @@ RECEIVED: list[int] = []
 
 
 def _stop(signum: int, frame) -> None:
+    if common.FINISHING:  # the outputs are being written: the command ends on its own, in a moment
+        common.LATE_STOP = signum
+        return
     # later signals are ignored so that the cleanup they interrupt runs to its end
     for s in _signals():
         signal.signal(s, signal.SIG_IGN)
@@ -169,6 +174,7 @@ def run(argv: list[str] | None = None) -> int:
         args.remove("--debug")
     head = args[: args.index("--")] if "--" in args else args
     common.QUIET = "--quiet" in head  # like --debug, accepted in any position
+    common.FINISHING, common.LATE_STOP = False, None
     if common.QUIET:
         args.remove("--quiet")
     with warnings.catch_warnings():
@@ -181,12 +187,14 @@ def _run(args: list[str], debug: bool) -> int:
     try:
         chosen = design_app if args[:1] and args[0] in DESIGN_COMMANDS else app
         code = chosen(args=args, prog_name="designer", standalone_mode=False)
+        _late_stop()
         return code if isinstance(code, int) else 0
     except Stopped as exc:
         return _stopped(exc.signum)
     except (KeyboardInterrupt, typer.Abort):
         return _stopped(signal.SIGINT)
     except typer.Exit as exc:
+        _late_stop()
         return exc.exit_code
     except _click_errors.ClickException as exc:
         if type(exc).__name__ == "NoArgsIsHelpError":
@@ -208,6 +216,13 @@ def _run(args: list[str], debug: bool) -> int:
         if RECEIVED:  # the stop, converted on its way out: not a bug
             return _stopped(RECEIVED[0])
         return _internal(exc, debug)
+
+
+def _late_stop() -> None:
+    """Say so when a stop signal came while the command wrote its outputs (it finished them)."""
+    if common.LATE_STOP is not None:
+        name = signal.Signals(common.LATE_STOP).name
+        print(f"{name} came while the outputs were written: they are complete", file=sys.stderr)
 
 
 def _stopped(signum: int) -> int:

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from .common import DataOpt, FixOpt, console, parse_fix, print_json, quiet_mujoco
+from .common import DataOpt, FixOpt, console, finishing, parse_fix, print_json, quiet_mujoco
 from .common import progress as progress_bar
 
 plot_app = typer.Typer(
@@ -295,6 +295,7 @@ def validate_cmd(
     quiet_mujoco()
     with progress_bar("validating") as bar:
         results, page, md, seconds = validate(output, table=table, progress=bar)
+    finishing()
     failed = [r for r in results if not r.passed]
     if as_json:
         print_json(

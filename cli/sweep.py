@@ -11,7 +11,7 @@ import typer
 
 from designer.errors import DesignerError
 
-from .common import console, err_console, print_json, progress
+from .common import console, err_console, finishing, print_json, progress
 
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print the summary as JSON only.")]
 WorkersOpt = Annotated[
@@ -61,6 +61,7 @@ def sweep(
         with executor(workers=workers, scheduler=scheduler, cluster=s.cluster) as ex:
             with progress(f"sweeping {spec.name}", enabled=not json_out) as bar:
                 result = sw.run(s, executor=ex, journal=out / "cases.jsonl", progress=bar)
+        finishing()
         files = sw.write_results(result, out, plot=plot)
     except BaseException:  # stopped or failed: keep the finished cases for a rerun, nothing else
         _keep_journal(out / "cases.jsonl", made)
@@ -208,6 +209,7 @@ def tune(
                 seed=seed,
                 progress=bar,
             )
+    finishing()
     data = result.to_dict()
     if out is not None:
         out.parent.mkdir(parents=True, exist_ok=True)

@@ -8,7 +8,7 @@ cold too). Whatever the moment:
 - stopped: nothing is left in the working folder (a sweep keeps its journal of finished cases, whole
   lines, for a rerun to resume, and says so), in the temporary folder (the compiler's files
   included) or in the build cache (an entry is whole or absent);
-- finished: every output is complete.
+- finished: every output is complete (also when the stop came while the outputs were written).
 """
 
 from __future__ import annotations
@@ -55,7 +55,8 @@ COMMANDS = {
 }
 SEEDS = {"cosim": 3, "sweep": 3, "sweep-workers": 2, "tune": 3, "validate": 2, "export": 4}
 RUNS = [(name, seed) for name, n in SEEDS.items() for seed in range(n)]
-CASE_COUNT = len(RUNS) + 4  # + the compiler running, a sweep resumed, a finaliser, a converted stop
+# + the compiler running, a sweep resumed, a finaliser, a converted stop, a stop while writing
+CASE_COUNT = len(RUNS) + 5
 
 
 def _env(tmp_path: Path) -> dict[str, str]:
@@ -250,3 +251,31 @@ def test_a_stop_turned_into_another_exception_is_still_a_stop(tmp_path, monkeypa
         for s, handler in saved.items():
             signal.signal(s, handler)
     assert code == 143 and err.strip() == STOPPED, err
+
+
+def test_a_stop_while_the_outputs_are_moved_in_lets_the_command_finish(tmp_path):
+    """SIGTERM held back while a sweep's results were moved into its folder was delivered the moment
+    the move ended: the command said "partial files removed" (143) of complete results (CI, seed 0 of
+    sweep-workers). Once a command writes its outputs a stop lets it finish: exit 0, and it says so."""
+    code = f"""
+import os, signal, sys
+import designer.files as files
+from designer_cli import main as m
+
+move_in = files._move_in
+
+def interrupted(stage, target):
+    os.kill(os.getpid(), signal.SIGTERM)  # arrives during the move, held back until its end
+    move_in(stage, target)
+
+files._move_in = interrupted
+m.install_signal_handlers()
+sys.exit(m.run(["sweep", {str(EXAMPLES / "sweep_arm.toml")!r}, "-o", "sw", "--workers", "1", "--json"]))
+"""
+    env = _env(tmp_path)
+    cwd = tmp_path / "cwd"
+    r = subprocess.run([*CLI[:-2], "-c", code], cwd=cwd, env=env, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert r.stderr.strip() == "SIGTERM came while the outputs were written: they are complete", r.stderr
+    _check_finished("sweep", cwd)
+    assert json.loads(r.stdout)["cases"] == 200
