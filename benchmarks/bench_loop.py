@@ -1,7 +1,11 @@
 """The design loop against simulated printers: prints until a recommended joint lands on target.
 
 Truth: `tests/printers.py` (independent of `designer`): smooth k and c over the six settings, each
-printer's own factors in 0.6-1.5, 2.5 % print-to-print scatter. Per printer and target (targets
+printer's own factors in 0.6-1.5, 2.5 % print-to-print scatter. `--truth spline`: k is the spline
+through the study's runs (the smoothest surface through them, calmer between the runs than any real
+one); `--truth drawn` (default): each printer's log k adds its own draw of a smooth departure field,
+about zero at the study's runs and as large between them as a Gaussian process fitted to the study
+allows. Per printer and target (targets
 log-spaced across the study's measured k; every third run also has a c goal, every third holds raster
 at 0 deg), three policies, each printing the tool's recommended design and counting prints until one
 lands within +-10 % of every predictable target (k; c is not predictable from the factors):
@@ -162,6 +166,12 @@ def main() -> None:
         help="next: print what designer next proposes; recommend: print suggest's #1 each round",
     )
     parser.add_argument("--seed", type=int, default=1000, help="seed of the first printer")
+    parser.add_argument(
+        "--truth",
+        choices=("drawn", "spline"),
+        default="drawn",
+        help="drawn: each printer's k departs from the spline between the study's runs; spline: it does not",
+    )
     args = parser.parse_args()
     if args.quick:
         args.printers, args.targets, args.augment = 3, 3, 1
@@ -174,7 +184,7 @@ def main() -> None:
     unreachable = 0
     t0 = time.perf_counter()
     for p in range(args.printers):
-        printer = truth.Printer(args.seed + p)
+        printer = truth.Printer(args.seed + p, drawn=args.truth == "drawn")
         for i, k in enumerate(targets):
             goals, fixed = _goals(i, float(k))
             if not printer.best(k=k, fixed=fixed, tolerance=TOLERANCE)[1]:
@@ -188,6 +198,7 @@ def main() -> None:
             if p < args.augment:
                 results["augment"].append(augment(study, table, printer, goals, fixed, rng, args.max_prints))
     out = {
+        "truth": args.truth,
         "printers": args.printers,
         "targets_per_printer": args.targets,
         "unreachable_skipped": unreachable,
@@ -203,7 +214,9 @@ def main() -> None:
     if args.json:
         print(json.dumps(out, indent=1))
         return
-    print(f"{out['loop']['runs']} reachable runs ({unreachable} unreachable skipped), {out['seconds']} s")
+    runs = out["loop"]["runs"]
+    seconds = out["seconds"]
+    print(f"{args.truth} truth: {runs} reachable runs ({unreachable} unreachable skipped), {seconds} s")
     for name in ("loop", "augment"):
         s = out[name]
         if s:

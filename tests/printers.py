@@ -16,14 +16,21 @@ The truth:
   the study's measurements, smoothed. No response-surface form of the tool is used. The smoothing
   of c is heavy (the study cannot predict c from the factors; its truth varies mildly around the
   study's mean).
+- Drawn truths (``Truth(draw=seed)``, ``Printer(seed, drawn=True)``): the spline is the smoothest
+  surface through the runs, the mean of every plausible one, so between the runs it departs from a
+  fitted model less than a real printer's k would. A drawn truth adds to log k a departure field: a
+  draw of a Gaussian process (Matern 5/2, one length per setting) fitted to the study's log k by
+  scikit-learn (maximum likelihood), conditioned on the study's runs (Matheron's rule, random
+  Fourier features). It is about zero at the runs, where the data pin k, and as large as the data
+  allow between them. c keeps the spline (the factors do not predict it).
 - A printer multiplies k by ``factor_k`` and c by ``factor_c``, each drawn uniformly in 0.6-1.5.
 - A print scatters log-normally around its printer's truth: 2.5 % for k and for c (the study's
   replicate pair, runs 28 and 35, differs by 2.5 % in k).
 
 API (designs are mappings or DataFrames with the columns ``FACTORS``, in the study's units: density %,
 length/width/height mm, layer mm, raster deg):
-- ``Truth()``: ``k(designs)`` N/mm, ``c(designs)`` N.s/mm, ``solid_fraction(designs)`` (arrays).
-- ``Printer(seed)``: ``factor_k``, ``factor_c``, ``k(designs)``, ``c(designs)`` (its truth),
+- ``Truth(draw=None)``: ``k(designs)`` N/mm, ``c(designs)`` N.s/mm, ``solid_fraction(designs)`` (arrays).
+- ``Printer(seed, drawn=False)``: ``factor_k``, ``factor_c``, ``k(designs)``, ``c(designs)`` (its truth),
   ``prints(designs, rng)`` -> a coefficient table (``density_pct, length_mm, width_mm, height_mm,
   layer_mm, raster_deg, k_x_N_per_mm, c_x_Ns_per_mm``), one row per print.
 - ``printers(n, seed=0)``: n printers with independent factors.
@@ -41,6 +48,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 from scipy.interpolate import RBFInterpolator
+from sklearn.gaussian_process import GaussianProcessRegressor
+from sklearn.gaussian_process.kernels import ConstantKernel, Matern, WhiteKernel
 
 FACTORS = ("density", "length", "width", "height", "layer", "raster")
 COLUMNS = {
@@ -64,6 +73,9 @@ STUDY = Path(__file__).resolve().parents[1] / "designer" / "bundled" / "study_ta
 # kinder than the data. c: heavy, the truth stays within about +-35 % of the study's mean.
 SMOOTHING_K = 0.05
 SMOOTHING_C = 50.0
+# random Fourier features of a drawn departure field (its covariance error is about 1/sqrt(FEATURES))
+FEATURES = 4000
+MATERN_NU = 2.5
 
 
 def _frame(designs) -> pd.DataFrame:
@@ -112,11 +124,66 @@ def _splines() -> tuple[RBFInterpolator, RBFInterpolator]:
     )
 
 
+@lru_cache(maxsize=1)
+def _process() -> tuple[GaussianProcessRegressor, np.ndarray]:
+    """The Gaussian process of log k over the spline coordinates, fitted to the study's runs, and the
+    runs' coordinates."""
+    study = pd.read_csv(STUDY)
+    x = _coordinates(study)
+    kernel = ConstantKernel(0.1, (1e-4, 10.0)) * Matern(np.ones(6), (0.05, 20.0), nu=MATERN_NU)
+    kernel += WhiteKernel(1e-3, (1e-5, 1.0))
+    gp = GaussianProcessRegressor(kernel, normalize_y=True, n_restarts_optimizer=5, random_state=0)
+    return gp.fit(x, np.log(study["k_x_N_per_mm"].to_numpy())), x
+
+
+class Departure:
+    """One draw of log k's departure from its conditional mean: a smooth random field, about zero at
+    the study's runs, with the fitted process's posterior variance elsewhere (log units).
+
+    Matheron's rule: with f a prior draw (random Fourier features of the Matern kernel) and e a draw
+    of the runs' scatter, f(x) - K(x, X) (K(X, X) + s2 I)^-1 (f(X) + e) has the posterior's
+    covariance whatever the data.
+    """
+
+    def __init__(self, seed: int):
+        gp, x = _process()
+        signal, white = gp.kernel_.k1, gp.kernel_.k2
+        scale = float(np.atleast_1d(gp._y_train_std)[0])  # normalize_y: the kernel is in units of sd(log k)
+        self._amplitude = scale * np.sqrt(signal.k1.constant_value)
+        self._kernel = signal.k2
+        rng = np.random.default_rng(seed)
+        length = np.asarray(self._kernel.length_scale, dtype=float)
+        chi2 = rng.chisquare(2 * MATERN_NU, size=FEATURES)
+        self._omega = rng.standard_normal((FEATURES, 6)) * np.sqrt(2 * MATERN_NU / chi2)[:, None] / length
+        self._phase = rng.uniform(0.0, 2 * np.pi, FEATURES)
+        self._weights = rng.standard_normal(FEATURES)
+        self._runs = x
+        noise = white.noise_level / signal.k1.constant_value  # the runs' scatter over the field's variance
+        prior_at_runs = self._prior(x) + self._amplitude * rng.normal(0.0, np.sqrt(noise), len(x))
+        gram = self._kernel(x) + noise * np.eye(len(x))
+        self._alpha = np.linalg.solve(gram, prior_at_runs)
+
+    def _prior(self, coords: np.ndarray) -> np.ndarray:
+        features = np.sqrt(2.0 / FEATURES) * np.cos(coords @ self._omega.T + self._phase)
+        return self._amplitude * (features @ self._weights)
+
+    def __call__(self, coords: np.ndarray) -> np.ndarray:
+        return self._prior(coords) - self._kernel(coords, self._runs) @ self._alpha
+
+
 class Truth:
-    """The study printer's true mean k (N/mm) and c (N.s/mm) at any design in the printable box."""
+    """The study printer's true mean k (N/mm) and c (N.s/mm) at any design in the printable box:
+    the splines, or with `draw` (a seed) log k plus one drawn `Departure`."""
+
+    def __init__(self, draw: int | None = None):
+        self._departure = None if draw is None else Departure(draw)
 
     def k(self, designs) -> np.ndarray:
-        return np.exp(_splines()[0](_coordinates(designs)))
+        coords = _coordinates(designs)
+        log_k = _splines()[0](coords)
+        if self._departure is not None:
+            log_k = log_k + self._departure(coords)
+        return np.exp(log_k)
 
     def c(self, designs) -> np.ndarray:
         return np.exp(_splines()[1](_coordinates(designs)))
@@ -141,12 +208,12 @@ def grid(fixed: Mapping[str, float] | None = None, points: int = 9) -> pd.DataFr
 class Printer:
     """One user's printer and spool: the study's truth times its own factors, and its print scatter."""
 
-    def __init__(self, seed: int, *, noise: float = PRINT_NOISE):
+    def __init__(self, seed: int, *, noise: float = PRINT_NOISE, drawn: bool = False):
         rng = np.random.default_rng(seed)
         self.seed = seed
         self.factor_k, self.factor_c = rng.uniform(*PRINTER_FACTORS, size=2)
         self.noise = noise
-        self._truth = Truth()
+        self._truth = Truth(draw=seed if drawn else None)
 
     def k(self, designs) -> np.ndarray:
         return self.factor_k * self._truth.k(designs)
@@ -184,6 +251,6 @@ class Printer:
         return {f: float(g.iloc[i][f]) for f in FACTORS}, bool(miss[i] <= tolerance)
 
 
-def printers(n: int, seed: int = 0) -> list[Printer]:
-    """`n` printers with independent factors (seeds seed, seed + 1, ...)."""
-    return [Printer(seed + i) for i in range(n)]
+def printers(n: int, seed: int = 0, *, drawn: bool = False) -> list[Printer]:
+    """`n` printers with independent factors (seeds seed, seed + 1, ...), and drawn truths if `drawn`."""
+    return [Printer(seed + i, drawn=drawn) for i in range(n)]
