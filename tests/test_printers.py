@@ -64,3 +64,22 @@ def test_best_design_is_reachable_in_truth():
     assert ok and design["raster"] == 0.0 and abs(p.k(design)[0] / 0.8 - 1) <= 0.1
     _, ok = p.best(k=50.0)
     assert not ok
+
+
+def test_drawn_truths_keep_the_study_and_vary_as_the_fitted_process_says():
+    """A drawn truth passes the study's runs within their scatter, and across draws its departure at a
+    design has the variance scikit-learn's own posterior gives there (Matheron's rule, checked)."""
+    study = pd.read_csv(printers.STUDY)
+    drawn = printers.Truth(draw=3)
+    log_ratio = np.log(drawn.k(study) / study["k_x_N_per_mm"])
+    assert abs(log_ratio.mean()) < 0.03 and log_ratio.std() < 0.07
+    assert np.array_equal(drawn.k(study), printers.Truth(draw=3).k(study))  # a seed, one truth
+
+    gp, _ = printers._process()
+    coords = printers._coordinates(printers.grid(points=3).sample(25, random_state=0))
+    draws = np.array([printers.Departure(seed)(coords) for seed in range(150)])
+    _, sd = gp.predict(coords, return_std=True)  # the latent sd plus the runs' scatter
+    scale = float(np.atleast_1d(gp._y_train_std)[0])
+    latent = sd**2 - gp.kernel_.k2.noise_level * scale**2
+    ratio = draws.var(axis=0) / latent
+    assert 0.75 < np.median(ratio) < 1.25 and abs(draws.mean()) < 0.05, (np.median(ratio), draws.mean())
