@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from . import space
-from .calibration import calibrate, new_printer
+from .calibration import new_printer, with_runs
 from .errors import DesignerError, number_argument
 from .suggestions import DISTINCT, TOLERANCE, Candidate, _distance, probability_within, suggest
 from .surrogate import Prediction, Surrogate, check_surrogate
@@ -131,12 +131,6 @@ def _run(design: Mapping[str, float], values: Mapping[str, float]) -> dict[str, 
     return {**{n: float(design[n]) for n in space.FACTOR_NAMES}, **values}
 
 
-def _with_runs(surrogate: Surrogate, runs: list[dict[str, float]]) -> Surrogate:
-    import pandas as pd
-
-    return calibrate(surrogate, pd.DataFrame(runs)) if runs else surrogate
-
-
 def _expected_best(
     surrogate: Surrogate, scorer: _Scorer, design: dict[str, float], known: list[dict[str, float]], pool: Any
 ) -> float:
@@ -146,7 +140,7 @@ def _expected_best(
     The measurement is integrated by Gauss-Hermite quadrature in log space; the nodes where the
     print lands are left out of the second term's average (renormalised over the missing nodes).
     """
-    base = _with_runs(surrogate, known)
+    base = with_runs(surrogate, known)
     p_lands = scorer.best(base, {n: np.array([design[n]]) for n in space.FACTOR_NAMES})
     nodes, weights = np.polynomial.hermite_e.hermegauss(NODES)
     weights = weights / weights.sum()
@@ -157,7 +151,7 @@ def _expected_best(
         values = {
             r: float(np.exp(mu + (z * s if r in scorer.responses else 0.0))) for r, (mu, s) in moments.items()
         }
-        best.append(scorer.best(_with_runs(surrogate, known + [_run(design, values)]), pool))
+        best.append(scorer.best(with_runs(surrogate, known + [_run(design, values)]), pool))
         missed.append(not scorer.lands(values))
     miss = weights * np.array(missed, dtype=float)
     after_miss = float(miss @ best / miss.sum()) if miss.sum() > 0 else float(weights @ best)
@@ -172,13 +166,13 @@ def _batch_p(surrogate: Surrogate, scorer: _Scorer, designs: list[dict[str, floa
     for _ in range(DRAWS):
         runs: list[dict[str, float]] = []
         for d in designs:
-            current = _with_runs(surrogate, runs)
+            current = with_runs(surrogate, runs)
             values = {}
             for r in scorer.measured:
                 mu, s = _log_predictive(current, r, d)
                 values[r] = float(np.exp(mu + s * rng.standard_normal()))
             runs.append(_run(d, values))
-        total += scorer.best(_with_runs(surrogate, runs), pool)
+        total += scorer.best(with_runs(surrogate, runs), pool)
     return total / DRAWS
 
 
@@ -232,7 +226,7 @@ def _greedy_batch(
             else "tests the model where another near-target design may do better than the current one"
         )
         chosen.append(NextPrint(pick.params, pick.predicted, float(scores[i]), recommended, reason))
-        base = _with_runs(surrogate, known)
+        base = with_runs(surrogate, known)
         predicted = {r: float(np.exp(_log_predictive(base, r, pick.params)[0])) for r in scorer.measured}
         known.append(_run(pick.params, predicted))
     return chosen
