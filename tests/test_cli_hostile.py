@@ -382,6 +382,8 @@ SWEEPS = {
         scenario="sc_good.toml", body='[cases]\ntype = "montecarlo"\nn = 2\n[cluster]\nworker = 2\n'
     ),
     "aliased_rig": SWEEP.format(scenario="sc_rig_f1_1e6.toml", body='[cases]\ntype = "montecarlo"\nn = 2\n'),
+    # another case type's key was ignored: a Monte Carlo sweep ran its draws, not candidate 1
+    "other_types_key": SWEEP.format(scenario="sc_good.toml", body=f"{MC}candidates = [1]\n"),
 }
 
 

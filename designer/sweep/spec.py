@@ -21,6 +21,12 @@ from ..keys import check_keys, read_toml
 from .limits import Limit, parse_limit
 
 CASE_TYPES = ("grid", "suggestion", "montecarlo")
+#: the [cases] keys each type reads (`type` itself aside): another type's key is refused, not ignored
+CASE_KEYS = {
+    "grid": ("joints", "designs"),
+    "suggestion": ("joints", "file", "candidates"),
+    "montecarlo": ("joints", "designs", "n", "seed"),
+}
 PATHS = ("fmu", "engine")
 
 
@@ -107,6 +113,13 @@ def _cases(doc: dict, path: Path, scenario: Scenario) -> Cases:
             f"{path.name} needs a [cases] table with a type", f"type = one of {', '.join(CASE_TYPES)}"
         )
     kind = table["type"]
+    for key in table:
+        if key != "type" and key not in CASE_KEYS[kind]:
+            owners = " or ".join(f'"{t}"' for t in CASE_TYPES if key in CASE_KEYS[t])
+            raise DesignerError(
+                f'{_where(path, "cases." + key)} is read by type = {owners}, not by type = "{kind}"',
+                f"remove {key} or change the type",
+            )
     designs = table.get("designs", {})
     if not isinstance(designs, dict) or not all(isinstance(d, dict) for d in designs.values()):
         raise DesignerError(
