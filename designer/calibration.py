@@ -122,9 +122,10 @@ def fit_length(base: ResponseSurface, X: Mapping[str, Any], y: np.ndarray, noise
     if held is None:
         return LENGTHS[0]
     r = np.log(y) - np.log(np.asarray(held.value, dtype=float))
-    _, s0 = _log_moments(base, X)
+    printed = _as_printed(dict(X))  # as the evidence and fit_amplitude see the runs
+    _, s0 = _log_moments(base, printed)
     sg = _local_sd(s0, noise)
-    Z = coded(X)
+    Z = coded(printed)
     ll = []
     for length in LENGTHS:
         K = np.outer(sg, sg) * _correlation(Z, Z, length) + noise**2 * np.eye(len(r))
