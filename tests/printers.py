@@ -214,6 +214,7 @@ class Printer:
         self.factor_k, self.factor_c = rng.uniform(*PRINTER_FACTORS, size=2)
         self.noise = noise
         self._truth = Truth(draw=seed if drawn else None)
+        self._grids: dict[tuple, tuple[pd.DataFrame, np.ndarray]] = {}
 
     def k(self, designs) -> np.ndarray:
         return self.factor_k * self._truth.k(designs)
@@ -241,10 +242,14 @@ class Printer:
     ) -> tuple[dict[str, float], bool]:
         """The grid design closest to the targets in truth (largest relative miss smallest), and
         whether every given target is within `tolerance` there (the target is reachable)."""
-        g = grid(fixed, points)
+        key = (tuple(sorted((fixed or {}).items())), points)
+        if key not in self._grids:  # a drawn truth costs seconds on a grid: once per grid and printer
+            g = grid(fixed, points)
+            self._grids[key] = (g, self.k(g))
+        g, true_k = self._grids[key]
         miss = np.zeros(len(g))
         if k is not None:
-            miss = np.maximum(miss, np.abs(self.k(g) / k - 1.0))
+            miss = np.maximum(miss, np.abs(true_k / k - 1.0))
         if c is not None:
             miss = np.maximum(miss, np.abs(self.c(g) / c - 1.0))
         i = int(np.argmin(miss))
