@@ -4,8 +4,9 @@ Truth: `tests/printers.py` (independent of `designer`): smooth k and c over the 
 printer's own factors in 0.6-1.5, 2.5 % print-to-print scatter. `--truth spline`: k is the spline
 through the study's runs (the smoothest surface through them, calmer between the runs than any real
 one); `--truth drawn` (default): each printer's log k adds its own draw of a smooth departure field,
-about zero at the study's runs and as large between them as a Gaussian process fitted to the study
-allows. Per printer and target (targets
+about zero at the study's runs and, between them, as large as the study surrogate's nested
+cross-validation says it errs there (`--scale` times that of a Gaussian process fitted to the study;
+default printers.DEPARTURE_SCALE). Per printer and target (targets
 log-spaced across the study's measured k; every third run also has a c goal, every third holds raster
 at 0 deg), three policies, each printing the tool's recommended design and counting prints until one
 lands within +-10 % of every predictable target (k; c is not predictable from the factors):
@@ -23,6 +24,7 @@ one-shot hits; and the calibration of the stated P (recommendations grouped by s
 0.2, realised hit rate per bin).
 
 Usage: python benchmarks/bench_loop.py [--printers 20] [--targets 15] [--max-prints 10] [--quick]
+       [--truth drawn|spline] [--scale S] [--json]
 """
 
 from __future__ import annotations
@@ -172,6 +174,12 @@ def main() -> None:
         default="drawn",
         help="drawn: each printer's k departs from the spline between the study's runs; spline: it does not",
     )
+    parser.add_argument(
+        "--scale",
+        type=float,
+        default=truth.DEPARTURE_SCALE,
+        help="a drawn departure's size, relative to the process fitted to the study",
+    )
     args = parser.parse_args()
     if args.quick:
         args.printers, args.targets, args.augment = 3, 3, 1
@@ -184,7 +192,7 @@ def main() -> None:
     unreachable = 0
     t0 = time.perf_counter()
     for p in range(args.printers):
-        printer = truth.Printer(args.seed + p, drawn=args.truth == "drawn")
+        printer = truth.Printer(args.seed + p, drawn=args.truth == "drawn", scale=args.scale)
         for i, k in enumerate(targets):
             goals, fixed = _goals(i, float(k))
             if not printer.best(k=k, fixed=fixed, tolerance=TOLERANCE)[1]:
@@ -199,6 +207,7 @@ def main() -> None:
                 results["augment"].append(augment(study, table, printer, goals, fixed, rng, args.max_prints))
     out = {
         "truth": args.truth,
+        "scale": args.scale if args.truth == "drawn" else None,
         "printers": args.printers,
         "targets_per_printer": args.targets,
         "unreachable_skipped": unreachable,

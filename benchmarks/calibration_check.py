@@ -7,7 +7,7 @@ right). Then, as the loop does: print the study's recommendation for a target, c
 z at the new recommendation and at designs near it that were not chosen (a larger sd at the chosen
 ones than at their neighbours would be the cost of choosing the best of many).
 
-Usage: python benchmarks/calibration_check.py [--truth drawn|spline] [--printers 30]
+Usage: python benchmarks/calibration_check.py [--truth drawn|spline] [--scale S] [--printers 30]
 """
 
 from __future__ import annotations
@@ -48,6 +48,7 @@ def _line(name: str, z: list, t95: float) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--truth", choices=("drawn", "spline"), default="drawn")
+    parser.add_argument("--scale", type=float, default=truth.DEPARTURE_SCALE, help="a drawn departure's size")
     parser.add_argument("--printers", type=int, default=30)
     args = parser.parse_args()
     study = designer.Surrogate.load()
@@ -56,7 +57,7 @@ def main() -> None:
     around_runs: dict[int, list] = {1: [], 3: []}
     chosen, neighbours, first = [], [], {}
     for p in range(args.printers):
-        printer = truth.Printer(3000 + p, drawn=args.truth == "drawn")
+        printer = truth.Printer(3000 + p, drawn=args.truth == "drawn", scale=args.scale)
         centre = {f: rng.uniform(*truth.RANGES[f]) for f in truth.RANGES}
         centre |= {f: rng.choice(truth.LEVELS[f]) for f in truth.LEVELS}
         for n in (1, 3):
@@ -70,7 +71,8 @@ def main() -> None:
             model = calibrated.model("k_x")
             chosen.extend(_z(model, printer, pd.DataFrame([rec])[FACTORS]))
             neighbours.extend(_z(model, printer, _around(rec, 10, 0.1, rng)))
-    print(f"{args.truth} truth, {args.printers} printers, log k standardized errors")
+    size = f" (scale {args.scale:g})" if args.truth == "drawn" else ""
+    print(f"{args.truth} truth{size}, {args.printers} printers, log k standardized errors")
     for n, z in around_runs.items():
         print(_line(f"  {n} print(s) near a random design, designs around it", z, t95))
     print(_line("  one print at the study's recommendation, at the new recommendation", chosen, t95))
