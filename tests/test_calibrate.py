@@ -184,11 +184,12 @@ def test_simulated_printer_three_prints_pin_the_neighbourhood(study):
 
 
 def test_calibrated_intervals_hold_on_drawn_printers(study):
-    """Against printers whose k departs from the study's spline between the runs as much as a Gaussian
-    process fitted to the study (by scikit-learn) allows: after 1 or 3 prints near a design, the
-    calibrated log k's standardized errors at designs around it have an sd near 1 and the 95 %
-    intervals cover about 95 % (benchmarks/calibration_check.py, 30 printers: sd 1.09 and 1.16,
-    coverage 0.94 and 0.91; on the spline's smoother printers sd 0.35, intervals far too wide)."""
+    """Against printers whose k departs from the study's spline between the runs as much as the study
+    surrogate's nested cross-validation says it errs there (tests/printers.py, DEPARTURE_SCALE): after
+    1 or 3 prints near a design, the calibrated log k's standardized errors at designs around it have
+    an sd near 1 and the 95 % intervals cover about 95 % (here sd 0.93, coverage 0.96;
+    benchmarks/calibration_check.py, 30 printers: sd 0.95 and 1.01, coverage 0.97 and 0.94; on the
+    spline's smoother printers sd 0.35, intervals far too wide, and this test fails)."""
     rng = np.random.default_rng(5)
     half = {f: (hi - lo) / 2 for f, (lo, hi) in printers.RANGES.items()}
 
