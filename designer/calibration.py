@@ -9,7 +9,7 @@ response surface gets wrong there. Per response, in log space:
 - ``mu0(x)``: the study surrogate's prediction (its log), the prior mean;
 - ``b ~ N(0, tau^2)``: the printer/material factor exp(b), shared by every design (tau = 0.3: a
   factor between 0.55 and 1.8 at 95 %);
-- ``g ~ GP(0, s_g(x) s_g(x') rho(x, x'))``: the study model's local error, a squared-exponential
+- ``g ~ GP(0, s_g(x) s_g(x') rho(x, x'))``: the study model's local error, a Matern 5/2
   correlation over the coded factors whose length scale is the longest the study's own nested
   leave-one-out residuals do not reject (`fit_length`), and whose size is the study's predictive spread
   ``s_g(x)^2 = s0(x)^2 - sigma_n^2`` times an amplitude that makes it as large as those residuals
@@ -49,6 +49,8 @@ MIN_NOISE = 0.025
 LENGTHS = (0.25, 0.35, 0.5, 0.7, 1.0, 1.4, 2.0, 3.0)
 #: log-likelihood drop that still counts as "not rejected" (about a 95 % profile interval)
 LIKELIHOOD_DROP = 2.0
+#: added to a squared distance before its square root (see `matern52`)
+MATERN_FLOOR = 1e-24
 #: the largest size of the local correction, as a multiple of the study's predictive spread
 MAX_AMPLITUDE = 4.0
 
@@ -105,9 +107,21 @@ def _local_sd(s0: np.ndarray, noise: float) -> np.ndarray:
     return np.sqrt(np.maximum(s0**2 - noise**2, 0.25 * s0**2))
 
 
+def matern52(d2: Any, length: float) -> Any:
+    """Matern 5/2 correlation at squared coded distance d2 (numpy array or CasADi expression).
+
+    Twice differentiable but not infinitely smooth: near a run it decorrelates faster than a
+    squared exponential of the same length, which over-trusts a print at designs around it. The
+    tiny floor keeps the square root's derivative finite at a run itself (IPOPT starts there); it
+    changes the correlation by less than 1e-11.
+    """
+    exp = ca.exp if isinstance(d2, ca.SX | ca.MX) else np.exp
+    r = 5.0**0.5 * (d2 + MATERN_FLOOR) ** 0.5 / length
+    return (1.0 + r + r * r / 3.0) * exp(-r)
+
+
 def _correlation(A: np.ndarray, B: np.ndarray, length: float) -> np.ndarray:
-    d2 = np.sum((A[:, None, :] - B[None, :, :]) ** 2, axis=2)
-    return np.exp(-0.5 * d2 / length**2)
+    return matern52(np.sum((A[:, None, :] - B[None, :, :]) ** 2, axis=2), length)
 
 
 def fit_length(base: ResponseSurface, X: Mapping[str, Any], y: np.ndarray, noise: float) -> float:
@@ -268,7 +282,7 @@ class CalibratedSurface(ResponseSurface):
         if len(self._Zu):
             z = ca.vertcat(*_coded_symbolic(x))
             d2 = ca.sum1((ca.repmat(z, 1, len(self._Zu)) - ca.DM(self._Zu.T)) ** 2).T
-            local = self.amplitude * sg * ca.DM(self._sgu) * ca.exp(-0.5 * d2 / self.length**2)
+            local = self.amplitude * sg * ca.DM(self._sgu) * matern52(d2, self.length)
             c = self.printer_sd**2 * ca.DM(self.own) + local
             var, mu = var - ca.bilin(ca.DM(self._Kinv), c, c), mu + ca.dot(c, ca.DM(self._alpha))
         half = self.t95 * ca.sqrt(ca.fmax(var, self.noise**2))
