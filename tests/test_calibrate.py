@@ -192,9 +192,10 @@ def test_calibrated_intervals_hold_on_drawn_printers(study):
     surrogate's nested cross-validation says it errs there (tests/printers.py, DEPARTURE_SCALE): after
     1 or 3 prints near a design, the calibrated log k's standardized errors at designs around it have
     an sd a little under 1 and the 95 % intervals cover at least about 95 % (here sd 0.80, coverage
-    0.98: the Matern correlation is cautious at designs around a print, which is where the loop's
-    recommendations are right, sd 1.0 there; on the spline's smoother printers the intervals are far
-    too wide and this test fails)."""
+    0.98; benchmarks/calibration_check.py, 30 printers: sd 0.84 and 0.85, 98 % and 99 % inside): the
+    Matern correlation is a little cautious at random designs around a print, and right at the loop's
+    recommendations (sd 1.0 there); on the spline's smoother printers the intervals are far too wide
+    (sd 0.36 here) and this test fails."""
     rng = np.random.default_rng(5)
     half = {f: (hi - lo) / 2 for f, (lo, hi) in printers.RANGES.items()}
 
