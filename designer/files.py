@@ -21,6 +21,7 @@ import os
 import shutil
 import signal
 import tempfile
+import threading
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import IO
@@ -215,15 +216,11 @@ def atomic_folder(path: str | Path) -> Iterator[Path]:
     try:
         yield stage
         os.chmod(stage, 0o755)
-        old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
-        try:
-            with _locked(target.parent):  # another process moving into the same folder waits
-                if target.is_dir() and any(target.iterdir()):
-                    _move_in(stage, target)
-                else:
-                    os.replace(stage, target)
-        finally:
-            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        with signals_held(), _locked(target.parent):  # another process moving in waits
+            if target.is_dir() and any(target.iterdir()):
+                _move_in(stage, target)
+            else:
+                os.replace(stage, target)
     except OSError as exc:
         raise _space_error(target, exc) from None
     finally:
@@ -248,15 +245,55 @@ def _locked(folder: Path) -> Iterator[None]:
 
 
 @contextlib.contextmanager
+def signals_held() -> Iterator[None]:
+    """SIGINT, SIGTERM and SIGHUP held back inside the block and delivered when it ends, so a stop
+    never lands halfway through it.
+
+    Python runs signal handlers in the main thread only, so there the handlers are swapped for a
+    recorder for the block's length (blocking the signal with pthread_sigmask would not do: the
+    kernel hands a process-directed signal to any other thread that does not block it, and Python
+    still runs its handler in the main thread). In other threads no handler can interrupt the block.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    came: list[int] = []
+    before = {sig: signal.signal(sig, lambda sig, _frame: came.append(sig)) for sig in _SIGNALS}
+    try:
+        yield
+    finally:
+        for sig, handler in before.items():
+            signal.signal(sig, signal.SIG_DFL if handler is None else handler)
+        for sig in dict.fromkeys(came):
+            signal.raise_signal(sig)
+
+
+@contextlib.contextmanager
+def temporary_folder(prefix: str) -> Iterator[Path]:
+    """A new temporary folder, removed whole at the end. Unlike tempfile.TemporaryDirectory, a stop
+    (SIGTERM, Ctrl-C) that lands while the folder is made or removed cannot leave it behind: both are
+    done with the stop held back (an interrupted rmtree left a half-removed folder in TMPDIR)."""
+    folder = None
+    try:
+        with signals_held():
+            folder = Path(tempfile.mkdtemp(prefix=prefix))
+        yield folder
+    finally:
+        if folder is not None:
+            with signals_held():
+                shutil.rmtree(folder, ignore_errors=True)
+
+
+@contextlib.contextmanager
 def private_tempdir(prefix: str) -> Iterator[Path]:
     """A temporary folder, removed whole at the end, that is also where third-party code makes its
     temporary files meanwhile (tempfile.tempdir): fmpy's extract and simulate_fmu remove their folders
     only when they succeed, so an error or an interrupt inside them left unpacked FMUs in /tmp."""
-    with tempfile.TemporaryDirectory(prefix=prefix) as tmp:
+    with temporary_folder(prefix) as tmp:
         old = tempfile.tempdir
-        tempfile.tempdir = tmp
+        tempfile.tempdir = str(tmp)
         try:
-            yield Path(tmp)
+            yield tmp
         finally:
             tempfile.tempdir = old
 

@@ -14,7 +14,9 @@ import errno
 import json
 import os
 import shutil
+import signal
 import subprocess
+import tempfile
 import time
 import zipfile
 from pathlib import Path
@@ -319,3 +321,28 @@ def test_disk_full_before_the_work_is_refused_up_front(small_disk):
 
 
 CASE_COUNT = len(CONCURRENT) + 3 + len(SYMLINKED) + 1 + len(BAD_LINKS) + 3
+
+
+def test_a_stop_while_a_temporary_folder_is_removed_leaves_nothing(tmp_path, monkeypatch):
+    """SIGTERM in the middle of removing a temporary folder (CI saw a cosim session's folder left in
+    TMPDIR by validate): the stop is held back until the folder is gone, then delivered."""
+    from designer import files
+
+    def stop(*_):
+        raise KeyboardInterrupt
+
+    real = shutil.rmtree
+
+    def rmtree_interrupted(path, **kwargs):
+        os.kill(os.getpid(), signal.SIGTERM)  # lands inside the removal
+        real(path, **kwargs)
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    monkeypatch.setattr(shutil, "rmtree", rmtree_interrupted)
+    old = signal.signal(signal.SIGTERM, stop)
+    try:
+        with pytest.raises(KeyboardInterrupt), files.temporary_folder("designer-test-") as folder:
+            (folder / "unpacked.bin").write_bytes(b"x")
+    finally:
+        signal.signal(signal.SIGTERM, old)
+    assert not list(tmp_path.iterdir())

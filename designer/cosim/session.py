@@ -19,12 +19,12 @@ from __future__ import annotations
 
 import contextlib
 import math
-import tempfile
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import DesignerError, check_type
+from ..files import temporary_folder
 from .fmu import FmuDescription, FmuSystem, unpack
 from .kernel import ENGINES, Bound, bind, run_master
 from .master import Master, Trace
@@ -307,7 +307,7 @@ def prepare(scenario: Scenario) -> Session:
     sc = scenario if scenario.checked else scenario.check()
     stack = contextlib.ExitStack()
     try:
-        folder = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="designer-cosim-")))
+        folder = stack.enter_context(temporary_folder("designer-cosim-"))
         session = Session(sc, stack, folder)
     except BaseException:
         stack.close()
