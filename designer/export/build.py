@@ -23,13 +23,12 @@ import shlex
 import shutil
 import subprocess
 import sys
-import tempfile
 from collections.abc import Sequence
 from importlib import resources
 from pathlib import Path
 
 from ..errors import DesignerError, check_type
-from ..files import cache_entry
+from ..files import cache_entry, temporary_folder
 
 #: no fused multiply-add contraction: aarch64 would fuse a*b+c where x86_64 cannot, and a joint's
 #: numbers would then differ by platform (1e-12 after 300 steps, measured under qemu-user)
@@ -277,7 +276,7 @@ def compile_binary(fmi_version: int, platform: str, compiler: list[str], extra: 
     folder on relative paths, so no path of this machine ends up in the binary."""
     root = source_dir()
     includes = sorted({f"-I{Path(rel).parent}" for rel in source_files(fmi_version)})
-    with tempfile.TemporaryDirectory(prefix="designer-build-") as tmp:
+    with temporary_folder("designer-build-") as tmp:
         built = Path(tmp) / library_name(platform)  # Zig writes .lib/.pdb beside a DLL: keep them out
         cmd = [*compiler, *FLAGS, *extra, *includes, *c_sources(fmi_version)]
         libs = ["-lm"] if not platform.endswith(("windows", "darwin")) else []
@@ -299,8 +298,8 @@ def compile_c(cmd: list[str], *, name: str, what: str, instead: str, cwd: Path |
     """
     # the compiler's own temporary files (gcc's cc*.s, cc*.o) go to a folder removed afterwards, so an
     # interrupt that kills the compiler cannot leave them in the user's temporary folder
-    with tempfile.TemporaryDirectory(prefix="designer-cc-") as scratch:
-        env = {**os.environ, "TMPDIR": scratch, "TMP": scratch, "TEMP": scratch}
+    with temporary_folder("designer-cc-") as scratch:
+        env = {**os.environ, "TMPDIR": str(scratch), "TMP": str(scratch), "TEMP": str(scratch)}
         try:
             proc = subprocess.Popen(
                 cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=cwd, env=env

@@ -227,14 +227,13 @@ def _ssp_runs(tmp: Path, joint) -> tuple[dict[str, np.ndarray], dict[str, float]
 def check_ssp(ctx: Context) -> CheckResult:
     """An exported SSP runs in libcosim and in fmpy, and both apply its SSV: doubling k in the bound
     SSV alone halves the static deflection in each."""
-    import tempfile
-
+    from ..files import temporary_folder
     from ..joint import Joint
     from ..plots.common import save_figure
     from ..plots.timeseries import plot_timeseries
 
     joint = Joint.from_coefficients({"x": FMU_JOINT}, name="report_joint")
-    with tempfile.TemporaryDirectory(prefix="designer-report-") as tmp:
+    with temporary_folder("designer-report-") as tmp:
         runs, ks = _ssp_runs(Path(tmp), joint)
     rows = []
     for name, x in runs.items():
@@ -326,17 +325,17 @@ def check_mjcf_into(ctx: Context) -> CheckResult:
     """MJCF --into mujoco's test model, in parallel and in series: the joint's k and c exact in SI,
     every other joint's numbers and every body's pose (keyframes too) as the host had them."""
     import shutil
-    import tempfile
 
     import mujoco
 
+    from ..files import temporary_folder
     from ..joint import Joint
     from .mjcf import export_mjcf
 
     joint = Joint.from_coefficients({"theta": {"k": 50.0, "c": 0.5, "m": 1e-5}}, name="report_joint")
     si = joint.axes["theta"].si()
     rows = []
-    with tempfile.TemporaryDirectory(prefix="designer-report-") as tmp:
+    with temporary_folder("designer-report-") as tmp:
         host = Path(tmp) / "model.xml"
         shutil.copy(Path(mujoco.__file__).parent / MJCF_HOST, host)
         before = mujoco.MjModel.from_xml_path(str(host))

@@ -20,7 +20,7 @@ from xml.sax.saxutils import quoteattr
 
 from .. import units
 from ..errors import DesignerError, check_type
-from ..files import atomic_path, check_suffix
+from ..files import atomic_path, check_suffix, temporary_folder
 from ..joint import Joint, check_joint
 from . import fmu
 from .robot import with_masses
@@ -230,9 +230,7 @@ def candidate_sets(suggestion, *, axes: list[str] | None = None, name: str = "Fl
 
 def _fmu_bytes(joint: Joint, interface: str) -> bytes:
     """The joint's FMI 2 FMU as bytes, written through `fmu.export_fmu` into a temporary folder."""
-    import tempfile
-
-    with tempfile.TemporaryDirectory() as tmp:
+    with temporary_folder("designer-ssp-") as tmp:
         out = Path(tmp) / f"{joint.name}.fmu"
         fmu.export_fmu(joint, out, fmi_version=2, interface=interface)
         return out.read_bytes()
