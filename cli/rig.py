@@ -48,8 +48,9 @@ def identify(
     Example: designer identify run1.csv run2.parquet --load-delay 0.002 -o table.csv
     """
     from designer.files import check_output
-    from designer.rig.identify import ESTIMATOR, results_table
+    from designer.rig.axis_fit import ESTIMATOR
     from designer.rig.identify import identify as run
+    from designer.rig.identify import results_table
 
     if output is not None:
         check_output(output, suffixes=TABLE_SUFFIXES)
