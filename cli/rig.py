@@ -125,6 +125,8 @@ def _print_identification(res) -> None:
             for r in f.c_frequency["rows"]
         )
         console.print(f"  {f.axis}: c(frequency) [{cu}] {freq} (p equal {f.c_frequency['p_equal']:.2g})")
+    for note in res.notes:
+        console.print(f"  note: {note}")
     for w in res.warnings:
         console.print(f"  warning: {_as_flags(w)}")
     for a, why in res.failures.items():

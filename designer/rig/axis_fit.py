@@ -32,8 +32,8 @@ import numpy as np
 from .. import units
 from ..mass import specimen_mass
 from . import band as bandlib
-from . import channel, departures
-from .logs import LOAD, RigLog, missing
+from . import channel, departures, saturation
+from .logs import LOAD, UNITS, RigLog, missing
 from .nonlinear import amplitude_table, frequency_table
 from .regress import solve
 
@@ -59,6 +59,9 @@ PLAUSIBLE_DURATION_S = 1e5
 #: warn when one sample of channel skew moves c by more than this fraction: c is then dominated
 #: by the channels' timing (below it, the sensitivity is reported with every fit, not warned about)
 SKEW_WARN = 1.0
+#: a channel with more than this share of its samples on its rails is refused; under it, the
+#: samples on the rails are left out of the fit (as dropouts) and a warning names the saturation
+MAX_RAIL_SHARE = 0.01
 
 
 class AxisFailed(Exception):
@@ -154,6 +157,13 @@ def _spectra(log: RigLog, axis: str) -> bandlib.Spectra:
     """Spectra of the axis: block means at about PRE_RATE, or the full rate when the band needs it."""
     r = log.data[axis].to_numpy()
     f = log.data[LOAD[axis]].to_numpy()
+    clipped = _saturated(log, axis)
+    if clipped and max(sum(r.share for r in found) for _, found in clipped) > MAX_RAIL_SHARE:
+        raise AxisFailed(
+            "; ".join(saturation.describe(col, UNITS[col], found) for col, found in clipped)
+            + ": the fit is refused (a fit through clipped peaks reads them as a softening spring); "
+            "record with a sensor range above the peak, or a smaller amplitude"
+        )
     valid = 1.0 - log.missing_fraction.get(LOAD[axis], float(missing(f).mean()))
     if valid < MIN_VALID:
         raise AxisFailed(
@@ -174,6 +184,11 @@ def _spectra(log: RigLog, axis: str) -> bandlib.Spectra:
     if spec.band is None or not np.isfinite([spec.scale_r, spec.scale_f]).all():
         raise StillAxis(f"no motion on {axis}: the position is constant, only noise, or not finite")
     return spec
+
+
+def _saturated(log: RigLog, axis: str) -> list[tuple[str, list[saturation.Rail]]]:
+    """The axis's columns that sit on a rail, with their rails."""
+    return [(col, log.rails[col]) for col in (axis, LOAD[axis]) if col in log.rails]
 
 
 def _design(ch: bandlib.Channels) -> tuple[np.ndarray, np.ndarray]:
@@ -334,6 +349,10 @@ def fit_axis(
         c_frequency=freq.to_dict(),
         departures={name: d.to_dict() for name, d in tests.items()},
         departure=None if found is None else departures.describe(found, main, scale, spec, axis, freq.rows),
+    )
+    fit.warnings.extend(
+        saturation.describe(col, UNITS[col], found) + ": those samples are left out of the fit"
+        for col, found in _saturated(log, axis)
     )
     fit.warnings.extend(_warnings(fit, stable, amp.varies, freq.varies, log.rate))
     return fit

@@ -43,6 +43,8 @@ class Identification:
     failures: dict[str, str] = field(default_factory=dict)
     #: axes logged but not moving (only noise): not identified, and no reason to fail the log
     still: dict[str, str] = field(default_factory=dict)
+    #: what reading changed in the log (`RigLog.notes`), for people: not warnings
+    notes: list[str] = field(default_factory=list)
 
     @property
     def ok(self) -> bool:
@@ -61,6 +63,7 @@ class Identification:
             "failures": self.failures,
             "still": self.still,
             "warnings": self.warnings,
+            "notes": self.notes,
             "factors": self.factors,
             "rate_hz": self.rate,
             "axes": {a: f.to_dict() for a, f in self.axes.items()},
@@ -132,7 +135,13 @@ def identify_log(
     if not fits:  # nothing moved: the still axes are why the log fails
         failures, still = failures | still, {}
     return Identification(
-        path=log.path, factors=log.factors, rate=log.rate, axes=fits, failures=failures, still=still
+        path=log.path,
+        factors=log.factors,
+        rate=log.rate,
+        axes=fits,
+        failures=failures,
+        still=still,
+        notes=list(log.notes),
     )
 
 
