@@ -32,7 +32,7 @@ import numpy as np
 from .. import units
 from ..mass import specimen_mass
 from . import band as bandlib
-from . import channel, departures, saturation
+from . import channel, departures, plausibility, saturation
 from .logs import LOAD, UNITS, RigLog, missing
 from .nonlinear import amplitude_table, frequency_table
 from .regress import solve
@@ -274,6 +274,9 @@ def _checked(log: RigLog, axis: str, load_delay_s: float, load_filter: channel.L
             f"R2 = {main.r2:.3g} (needs k > 0, c >= 0, R2 >= {MIN_R2:g})"
             + ("" if lag is None else "; " + _lag_text(lag.to_dict(), k * lag.delay_s, cu))
         )
+    unit_error = plausibility.scale_failure(axis, k, spec.scale_r, spec.scale_f, log.factors)
+    if unit_error is not None:
+        raise AxisFailed(unit_error)
     return spec, ch, main, correct, lag
 
 
@@ -350,6 +353,7 @@ def fit_axis(
         departures={name: d.to_dict() for name, d in tests.items()},
         departure=None if found is None else departures.describe(found, main, scale, spec, axis, freq.rows),
     )
+    fit.warnings.extend(plausibility.range_warnings(axis, spec.scale_r, spec.scale_f))
     fit.warnings.extend(
         saturation.describe(col, UNITS[col], found) + ": those samples are left out of the fit"
         for col, found in _saturated(log, axis)
