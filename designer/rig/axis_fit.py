@@ -307,7 +307,7 @@ def fit_axis(
     spec, ch, main, correct, lag = _checked(log, axis, load_delay_s, load_filter)
     scale = spec.scale_f / spec.scale_r
     x, noise = _design(ch)
-    tests = departures.test(spec, ch, x, noise, _lags(ch), scale)
+    tests = departures.test(spec, ch, x, noise, _lags(ch), scale, _other_loads(log, axis, spec, ch, correct))
     found = departures.supported(tests)
     sol = found.solution if found is not None and found.name in departures.ADOPTED else main
     if found is not None and found.name == "friction" and lag is not None:
@@ -360,6 +360,23 @@ def fit_axis(
     )
     fit.warnings.extend(_warnings(fit, stable, amp.varies, freq.varies, log.rate))
     return fit
+
+
+def _other_loads(
+    log: RigLog, axis: str, spec: bandlib.Spectra, ch: bandlib.Channels, correct
+) -> dict[str, tuple[np.ndarray, float, str]]:
+    """The other axes' loads through this axis's filter, with their peaks and units: the sources of
+    cross-talk a departure test tries."""
+    out = {}
+    factor = max(1, int(round(log.rate / spec.rate)))
+    for other in log.axes:
+        col = LOAD[other]
+        values = log.data[col].to_numpy(dtype=np.float64)
+        bad = log.dropouts[axis] | ~np.isfinite(values)
+        if other != axis and not bad.all():
+            column, peak = bandlib.another_load(spec, values, bad, factor, ch.pass_edge, correct)
+            out[col] = column, peak, UNITS[col]
+    return out
 
 
 def _unknown_lowpass(

@@ -1,18 +1,27 @@
 """Which departure from the linear joint the log supports: friction, a nonlinear spring, viscoelastic
-damping, or a drift of k in time, each fitted and tested on its own.
+damping, a drift of k in time, backlash in the drive, or cross-talk from another axis's load, each
+fitted and tested on its own.
 
-The linear fit's band tables (`nonlinear`) say that k or c is not constant, but four different
-physics move them: Coulomb friction in the clamp (its first harmonic is a damping falling as
+The linear fit's band tables (`nonlinear`) say that k or c is not constant, but different physics
+move them: Coulomb friction in the clamp (its first harmonic is a damping falling as
 1 / (amplitude x frequency), so a linear fit takes it for a larger c), a stiffening or softening
-spring (k depends on the deflection), viscoelastic damping (c falls with frequency), and k drifting
-in time (temperature, creep: along a chirp it takes a fake mass). Each candidate adds one column to
-the linear model's design, on the same filtered rows:
+spring (k depends on the deflection), viscoelastic damping (c falls with frequency), k drifting
+in time (temperature, creep: along a chirp it takes a fake mass), a dead band in the drive seen by
+an encoder on the motor (the specimen stands still while the motor crosses the play: a secant
+stiffness rising with amplitude, which a cubic spring fits only roughly), and the load sensor
+reading a share of another axis's load (out of phase, a damping falling with frequency). Each
+candidate adds one column to the linear model's design, on the same filtered rows:
 
 - friction: sign(r') formed at the series rate and filtered as the load is (`band.nonlinear_columns`),
   coefficient Fc (N or N.mm);
 - spring: (r - mean r)^3, likewise, coefficient k3 (N/mm^3 or N.mm/rad^3);
 - viscoelastic: r' x ln(f / f_mid), f the motion's instantaneous frequency: c's slope per e-fold;
-- drift: r x (time scaled to [-1, 1] over the log): half k's change over the run.
+- drift: r x g(time), g -1 at the start, 0 at mid-run and 1 at the end of the log: a straight line,
+  or exponential settling exp(-t / tau) (a warm-up) with tau the best of `SETTLING`; the
+  coefficient is half k's change over the run, and k's own the mid-run value;
+- backlash: sign(r - mean r), formed and filtered as friction's: coefficient -k x half the play;
+- crosstalk: another axis's load, through the same filter (`band.another_load`): the share of it
+  this load sensor reads.
 
 Each is tested by the HAC Wald statistic of its coefficient. Among those beyond `Z_CRIT`, the one
 whose model leaves the least residual is named. Along one chirp time and frequency go together: a
@@ -22,7 +31,7 @@ k that depends only on frequency looks like a drift; viscoelastic damping moves 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -38,12 +47,20 @@ P_CRIT = math.erfc(Z_CRIT / math.sqrt(2))
 #: departures whose model gives the headline m, c, k (the linear ones are then biased: friction
 #: doubles c, a drift takes a fake mass and moves k); a nonlinear spring or viscoelastic damping keeps
 #: the linear fit's k and c, the averages over this excitation that a linear joint model can carry
-ADOPTED = ("friction", "drift")
+ADOPTED = ("friction", "drift", "backlash", "crosstalk")
+#: another axis's load whose course this axis's motion explains beyond this R2 (the same chirp in
+#: phase) is no cross-talk candidate: its share cannot be told apart from this axis's k and c
+CROSSTALK_R2 = 0.99
+#: time constants of the exponential settling a drift may follow, as fractions of the log's length
+#: (besides a straight line)
+SETTLING = (0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5, 0.8, 1.2, 2.0)
 
 
 @dataclass(frozen=True)
 class Departure:
-    """One candidate's test: its coefficient and standard error (rig units), z, p, and the fit."""
+    """One candidate's test: its coefficient and standard error (rig units), z, p, and the fit;
+    `detail` says which form it took (a drift's `tau_s`, None for a straight line; cross-talk's
+    source column `from`)."""
 
     name: str
     value: float
@@ -52,25 +69,40 @@ class Departure:
     p: float
     rss: float
     solution: Solution
+    detail: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
-        return {"value": self.value, "se": self.se, "z": self.z, "p": self.p, "rss": self.rss}
+        return {"value": self.value, "se": self.se, "z": self.z, "p": self.p, "rss": self.rss} | self.detail
+
+
+def drift_shapes(s: np.ndarray) -> list[tuple[float | None, np.ndarray]]:
+    """k's course in time, s the time over the log's length: a straight line and, per u in
+    SETTLING, exp(-s / u), each scaled to -1 at the start, 0 at mid-run and 1 at the end (so a
+    coefficient is half k's change over the run, and k's own is its mid-run value)."""
+    out: list[tuple[float | None, np.ndarray]] = [(None, 2 * s - 1)]
+    for u in SETTLING:
+        out.append((u, (np.exp(-s / u) - np.exp(-0.5 / u)) * 2 / np.expm1(-1 / u)))
+    return out
 
 
 def columns(spec: bandlib.Spectra, ch: bandlib.Channels) -> dict[str, np.ndarray]:
-    """The candidates' extra columns on the grid of `ch` (scaled units)."""
-    sign, cube = bandlib.nonlinear_columns(spec, ch.pass_edge)
+    """The candidates' extra columns on the grid of `ch` (scaled units); the drift's, a straight line."""
+    sign, cube, dead = bandlib.nonlinear_columns(spec, ch.pass_edge)
     band = spec.band
     mid = np.sqrt(band.low * band.high)
     freq = np.clip(ch.inst_freq, band.low, band.high)
-    record = max((spec.samples - 1) / spec.rate, 1e-300)  # the log's span (the grid runs on into padding)
-    ramp = 2 * ch.t / record - 1
     return {
         "friction": sign,
         "spring": cube,
         "viscoelastic": ch.x[:, 1] * np.log(freq / mid),
-        "drift": (ch.x[:, 2] + ch.r_line) * ramp,  # the deflection: the line taken out of r is in the load
+        "drift": (ch.x[:, 2] + ch.r_line) * (2 * ch.t / _record(spec) - 1),
+        "backlash": dead,
     }
+
+
+def _record(spec: bandlib.Spectra) -> float:
+    """The log's span, s (the grid runs on into padding)."""
+    return max((spec.samples - 1) / spec.rate, 1e-300)
 
 
 def _units(spec: bandlib.Spectra, scale: float) -> dict[str, float]:
@@ -80,7 +112,61 @@ def _units(spec: bandlib.Spectra, scale: float) -> dict[str, float]:
         "spring": scale / spec.scale_r**2,
         "viscoelastic": scale,
         "drift": scale,
+        "backlash": spec.scale_f,
     }
+
+
+def _one(name, col, x, y, keep, noise, lags, to_rig, detail=None) -> Departure:
+    """Fit the design `x` plus `col` and test its coefficient."""
+    sol = solve(np.column_stack([x, col]), y, keep, noise, lags)
+    beta, se = float(sol.beta[-1]), float(sol.se[-1])
+    z = beta / se if se > 0 else 0.0
+    return Departure(
+        name=name,
+        value=beta * to_rig,
+        se=se * to_rig,
+        z=z,
+        p=math.erfc(abs(z) / math.sqrt(2)),  # two-sided normal tail
+        rss=sol.rss,
+        solution=sol,
+        detail=detail or {},
+    )
+
+
+def _explained(x: np.ndarray, column: np.ndarray, keep: np.ndarray) -> float:
+    """R2 of `column` on the columns of `x` (ordinary least squares over the kept rows)."""
+    beta, *_ = np.linalg.lstsq(x[keep], column[keep], rcond=None)
+    resid = column[keep] - x[keep] @ beta
+    centred = column[keep] - column[keep].mean()
+    return 1.0 - float(resid @ resid) / max(float(centred @ centred), 1e-300)
+
+
+def _drift(
+    spec: bandlib.Spectra, ch: bandlib.Channels, base: np.ndarray, noise: np.ndarray, lags: int, to_rig: float
+) -> Departure:
+    """The drift's test: a straight line, unless the best exponential settling (least residual)
+    has a curvature the line does not: its coefficient beside the line's beyond Z_CRIT. (Along a
+    chirp a fake mass, r'' = -w(t)^2 r, is also r times a curve in time: without that test a
+    straight drift would pass for a slow settling plus a negative mass.)"""
+    deflection, record = ch.x[:, 2] + ch.r_line, _record(spec)
+    (_, line), *settling = drift_shapes(ch.t / record)
+    args = (ch.y, ch.keep, noise, lags, to_rig)
+    straight = _one("drift", deflection * line, base, *args, {"tau_s": None})
+    tries = [(_one("drift", deflection * g, base, *args, {"tau_s": u * record}), g) for u, g in settling]
+    best, shape = min(tries, key=lambda pair: pair[0].rss)
+    padded = np.zeros((noise.shape[0] + 1, noise.shape[0] + 1))
+    padded[:-1, :-1] = noise
+    both = _one(
+        "drift",
+        deflection * shape,
+        np.column_stack([base, deflection * line]),
+        ch.y,
+        ch.keep,
+        padded,
+        lags,
+        1.0,
+    )
+    return best if abs(both.z) > Z_CRIT else straight
 
 
 def test(
@@ -90,10 +176,14 @@ def test(
     noise: np.ndarray,
     lags: int,
     scale: float,
+    others: dict[str, tuple[np.ndarray, float, str]] | None = None,
 ) -> dict[str, Departure]:
     """Fit the linear design `x` (rows, p) plus each candidate's column; the tests by name.
 
     noise: the (p, p) regressor-noise covariance of `x` (the candidates' columns count as exact).
+    others: other axes' loads on the grid of `ch` (`band.another_load`) with their peaks and
+    units, by column name: each a cross-talk candidate ("crosstalk from <column>"). A drift is tested in
+    each of its shapes (`drift_shapes`) and the one leaving the least residual stands for it.
     Raises:
         numpy.linalg.LinAlgError: a candidate's design is singular.
     """
@@ -101,23 +191,24 @@ def test(
     padded = np.zeros((p + 2, p + 2))
     padded[:p, :p] = noise
     to_rig = _units(spec, scale)
-    cols = columns(spec, ch)
     # a slow quadratic below the band: a drifting position offset times the drift's ramp is one
     bend = (2 * ch.t / max(ch.t[ch.keep].max(), 1e-300) - 1) ** 2
+    base = np.column_stack([x, bend])
     out = {}
-    for name, col in cols.items():
-        sol = solve(np.column_stack([x, bend, col]), ch.y, ch.keep, padded, lags)
-        beta, se = float(sol.beta[p + 1]), float(sol.se[p + 1])
-        z = beta / se if se > 0 else 0.0
-        out[name] = Departure(
-            name=name,
-            value=beta * to_rig[name],
-            se=se * to_rig[name],
-            z=z,
-            p=math.erfc(abs(z) / math.sqrt(2)),  # two-sided normal tail
-            rss=sol.rss,
-            solution=sol,
-        )
+    for name, col in columns(spec, ch).items():
+        if name != "drift":
+            out[name] = _one(name, col, base, ch.y, ch.keep, padded, lags, to_rig[name])
+            continue
+        out[name] = _drift(spec, ch, base, padded, lags, to_rig[name])
+    for col, (load, peak, unit) in (others or {}).items():
+        detail = {"from": col, "from_unit": unit}
+        if _explained(x, load, ch.keep) > CROSSTALK_R2:
+            continue  # that axis moves as this one: its load cannot be told from this k and c
+        try:
+            found = _one("crosstalk", load, base, ch.y, ch.keep, padded, lags, spec.scale_f / peak, detail)
+        except np.linalg.LinAlgError:  # the other load is this axis's motion over again: no test
+            continue
+        out[f"crosstalk from {col}"] = found
     return out
 
 
@@ -138,6 +229,7 @@ def describe(
     c_lin, k_lin = float(linear.beta[1]) * scale, float(linear.beta[2]) * scale
     v, se = found.value, found.se
     out = {"name": found.name, "value": v, "se": se, "z": found.z, "linear_c": c_lin, "linear_k": k_lin}
+    out |= found.detail
     if found.name == "friction":
         share = 100 * abs(v) / spec.scale_f
         text = (
@@ -167,11 +259,44 @@ def describe(
             "frequency); c is the average over this excitation and its standard error does not cover the "
             "frequency dependence"
         )
-    else:
-        change = 200 * v / k_lin
+    elif found.name == "drift":
+        k_mid = float(found.solution.beta[2]) * scale
+        change = 200 * v / (k_mid - v)  # k's change over the run, over its value at the start
+        tau = found.detail.get("tau_s")
+        course = "in time" if tau is None else f"as a warm-up, settling like exp(-t / {tau:.3g} s),"
         text = (
-            f"k drifts in time: {change:+.2g} % from the start to the end of the run (temperature, creep; "
+            f"k drifts {course} {change:+.2g} % from the start to the end of the run (temperature, creep; "
             f"along one chirp a k that depends only on frequency looks the same); k is the mid-run value "
-            f"from the model with the drift (the linear fit gave {k_lin:.4g} {ku})"
+            f"(t = {_record(spec) / 2:.3g} s) from the model with the drift (the linear fit gave "
+            f"{k_lin:.4g} {ku})"
+        )
+    elif found.name == "backlash":
+        k_model = float(found.solution.beta[2]) * scale
+        play = -2 * v / k_model
+        ru = units.rig_unit("r", axis)
+        if play > 0:
+            text = (
+                f"backlash: the drive has a dead band of {play:.3g} {ru} ({100 * play / spec.scale_r:.2g} % "
+                f"of the motion's peak) between the position sensor and the specimen, which stands still "
+                f"while the drive crosses it (an encoder on the motor); m, c, k are from the model with it "
+                f"(the linear fit gave k = {k_lin:.4g} {ku}); put the encoder at the specimen or take the "
+                "play out of the drive"
+            )
+        else:
+            text = (
+                f"the load steps by {-2 * v:.3g} {fu} where the deflection changes sign (a preload or a "
+                f"snap-through, the opposite of a dead band); m, c, k are from the model with it (the "
+                f"linear fit gave k = {k_lin:.4g} {ku})"
+            )
+    else:
+        source, unit = found.detail["from"], found.detail["from_unit"]
+        share = (
+            f"{100 * v:.2g} % (+/- {100 * se:.2g} %)" if unit == fu else f"{v:.3g} +/- {se:.2g} {fu}/{unit}"
+        )
+        text = (
+            f"cross-talk: the load sensor of {axis} reads {share} of {source}, the load of another axis "
+            f"(a departure no material law explains); m, "
+            f"c, k are from the model with it (the linear fit took it for c = {c_lin:.4g} {cu}, k = "
+            f"{k_lin:.4g} {ku}); decouple the load channels (the sensor's cross-talk matrix)"
         )
     return out | {"text": text}
