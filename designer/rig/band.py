@@ -360,6 +360,23 @@ def nonlinear_columns(spec: Spectra, pass_edge: float) -> tuple[np.ndarray, np.n
     return out[0], out[1], out[2]
 
 
+def dead_band_motion(spec: Spectra, pass_edge: float, half_play: float) -> np.ndarray:
+    """r'', r', r of the specimen behind a dead band of +/- `half_play` (scaled units) about the
+    motion's centre, the position sensor before it: sign(d) max(|d| - half_play, 0) of the
+    band-limited deflection d, formed at the series rate, then filtered and differentiated as the
+    position is (`filtered`); (grid rows, 3), the columns of `Channels.x`."""
+    bins, nd = _grid(spec, pass_edge)
+    r, _ = series_motion(spec, pass_edge)
+    a, b = spec.r_line
+    deflection = r + a + (b - a) * np.linspace(0.0, 1.0, spec.samples)
+    deflection -= deflection.mean()
+    specimen = np.sign(deflection) * np.maximum(np.abs(deflection) - half_play, 0.0)
+    freqs = spec.freqs[:bins]
+    w = 2 * np.pi * freqs
+    pos = np.fft.rfft(specimen, n=spec.n)[:bins] * lowpass(freqs, pass_edge)
+    return (np.fft.irfft(np.stack([-(w**2) * pos, 1j * w * pos, pos]), n=nd, axis=1) * (nd / spec.n)).T
+
+
 def another_load(
     spec: Spectra,
     values: np.ndarray,
