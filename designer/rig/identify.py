@@ -17,8 +17,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import space, units
+from .. import units
 from ..errors import DesignerError, describe, names_argument, number_argument
+from ..study import space
 from . import channel
 from .axis_fit import AxisFailed, AxisFit, StillAxis, check_time, fit_axis
 from .logs import RigLog, read_log, validate_frame

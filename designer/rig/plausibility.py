@@ -70,7 +70,7 @@ def range_warnings(axis: str, r_peak: float, f_peak: float) -> list[str]:
 @functools.lru_cache(maxsize=1)
 def _study_k_range() -> tuple[float, float]:
     """The bundled study table's lowest and highest k_x (N/mm)."""
-    from ..data import load_table
+    from ..study.data import load_table
 
     k = load_table()["k_x"]
     return float(k.min()), float(k.max())
@@ -79,7 +79,7 @@ def _study_k_range() -> tuple[float, float]:
 @functools.lru_cache(maxsize=1)
 def _surrogate():
     """The shipped surrogate (read once per process: a fit's scale check needs only its k_x)."""
-    from ..surrogate import Surrogate
+    from ..model.surrogate import Surrogate
 
     return Surrogate.load()
 
