@@ -415,6 +415,18 @@ def _geometric(log: RigLog, axis: str) -> float | None:
     return specimen_mass(log.factors)
 
 
+def _unexplained(q: str, over: str, table: dict, unit: str, band: str, average: str) -> str:
+    """The sentence on a band table (`nonlinear.BandTable.to_dict()`) whose bands differ with no
+    departure to explain it."""
+    rows = table["rows"]
+    ends = "smallest to the largest" if over == "amplitude" else "lowest to the highest"
+    return (
+        f"{q} depends on {over} beyond its uncertainty ({rows[0][q]:.4g} to {rows[-1][q]:.4g} {unit} from "
+        f"the {ends} {band}, p = {table['p_equal']:.2g}), and none of {departures.CANDIDATES} explains "
+        f"it; {q} is {average} average"
+    )
+
+
 def _warnings(fit: AxisFit, stable: bool, k_varies: bool, c_varies: bool, rate: float) -> list[str]:
     """Doubtful but possible fits: skew sensitivity, nonlinearity, an unstable or imprecise m."""
     out = []
@@ -430,21 +442,11 @@ def _warnings(fit: AxisFit, stable: bool, k_varies: bool, c_varies: bool, rate: 
         )
     if fit.departure is not None:
         out.append(fit.departure["text"])
-    if k_varies and fit.departure is None and fit.k_amplitude["p_equal"] < departures.P_CRIT:
-        rows = fit.k_amplitude["rows"]
-        out.append(
-            f"k depends on amplitude beyond its uncertainty ({rows[0]['k']:.4g} to {rows[-1]['k']:.4g} {ku} "
-            f"from the smallest to the largest deflection band, p = {fit.k_amplitude['p_equal']:.2g}), and "
-            "none of friction, a cubic spring, viscoelastic damping or a drift of k explains it; k is an "
-            "amplitude average"
-        )
-    if c_varies and fit.departure is None and fit.c_frequency["p_equal"] < departures.P_CRIT:
-        rows = fit.c_frequency["rows"]
-        out.append(
-            f"c depends on frequency beyond its uncertainty ({rows[0]['c']:.4g} to {rows[-1]['c']:.4g} {cu} "
-            f"from the lowest to the highest band, p = {fit.c_frequency['p_equal']:.2g}), and none of "
-            "friction, a cubic spring, viscoelastic damping or a drift of k explains it; c is a band average"
-        )
+    if fit.departure is None:
+        if k_varies and fit.k_amplitude["p_equal"] < departures.P_CRIT:
+            out.append(_unexplained("k", "amplitude", fit.k_amplitude, ku, "deflection band", "an amplitude"))
+        if c_varies and fit.c_frequency["p_equal"] < departures.P_CRIT:
+            out.append(_unexplained("c", "frequency", fit.c_frequency, cu, "band", "a band"))
     if fit.m > 0 and fit.m_se <= M_REL_SE * fit.m and not stable:
         out.append("m is precise but changes with the derivative bandwidth (biased): not taken as identified")
     if fit.c < 2 * fit.c_se:

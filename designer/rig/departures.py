@@ -48,6 +48,8 @@ P_CRIT = math.erfc(Z_CRIT / math.sqrt(2))
 #: doubles c, a drift takes a fake mass and moves k); a nonlinear spring or viscoelastic damping keeps
 #: the linear fit's k and c, the averages over this excitation that a linear joint model can carry
 ADOPTED = ("friction", "drift", "backlash", "crosstalk")
+#: the candidates, in words
+CANDIDATES = "friction, a cubic spring, viscoelastic damping, a drift of k, backlash or cross-talk"
 #: another axis's load whose course this axis's motion explains beyond this R2 (the same chirp in
 #: phase) is no cross-talk candidate: its share cannot be told apart from this axis's k and c
 CROSSTALK_R2 = 0.99
