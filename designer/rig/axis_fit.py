@@ -15,12 +15,16 @@ How, and why (see `band` and `regress` for the details):
   change of c for one sample of skew is always reported (c shifts by about -k x delay);
 - an unknown low-pass of the load channel is read from the load's noise spectrum (`channel`): warned
   about with its size, which c's standard error then includes;
-- k per amplitude band and c per frequency band test the linear model, and four departures from
-  it (friction, a cubic spring, viscoelastic damping, a drift of k) are fitted and tested each on
-  its own; the one the log supports is named (`departures`), friction and drift corrected;
+- k per amplitude band and c per frequency band test the linear model, and six departures from
+  it (friction, a cubic spring, viscoelastic damping, a drift of k that may settle, backlash in the
+  drive, cross-talk from another axis's load) are fitted and tested each on its own; the one the
+  log supports is named (`departures`), friction, drift, backlash and cross-talk corrected;
+- a sensor saturated at its rails is named (`saturation`): its samples there are left out, or the
+  axis refused when they are many;
 - a log whose fit is impossible (k <= 0, c < 0, R2 < 0.5), or that cannot support a fit (too slow
-  a sampling rate, too few cycles, a mostly missing channel, time not in seconds), is failed with
-  its reason and never becomes a row of the coefficient table.
+  a sampling rate, too few cycles, a mostly missing channel, time not in seconds), or whose scale
+  is a unit error (`plausibility`: a load in kN, a position in m), is failed with its reason and
+  never becomes a row of the coefficient table.
 """
 
 from __future__ import annotations

@@ -77,18 +77,16 @@ class Departure:
         return {"value": self.value, "se": self.se, "z": self.z, "p": self.p, "rss": self.rss} | self.detail
 
 
-def drift_shapes(s: np.ndarray) -> list[tuple[float | None, np.ndarray]]:
-    """k's course in time, s the time over the log's length: a straight line and, per u in
-    SETTLING, exp(-s / u), each scaled to -1 at the start, 0 at mid-run and 1 at the end (so a
-    coefficient is half k's change over the run, and k's own is its mid-run value)."""
-    out: list[tuple[float | None, np.ndarray]] = [(None, 2 * s - 1)]
-    for u in SETTLING:
-        out.append((u, (np.exp(-s / u) - np.exp(-0.5 / u)) * 2 / np.expm1(-1 / u)))
-    return out
+def settling_shapes(s: np.ndarray) -> list[tuple[float, np.ndarray]]:
+    """Per u in SETTLING, exp(-s / u) (s the time over the log's length) scaled to -1 at the start,
+    0 at mid-run and 1 at the end, as the straight line 2 s - 1 of `columns` is (so a coefficient is
+    half k's change over the run, and k's own is its mid-run value)."""
+    return [(u, (np.exp(-s / u) - np.exp(-0.5 / u)) * 2 / np.expm1(-1 / u)) for u in SETTLING]
 
 
 def columns(spec: bandlib.Spectra, ch: bandlib.Channels) -> dict[str, np.ndarray]:
-    """The candidates' extra columns on the grid of `ch` (scaled units); the drift's, a straight line."""
+    """The candidates' extra columns on the grid of `ch` (scaled units); the drift's, a straight
+    line (`_drift` tries the others)."""
     sign, cube, dead = bandlib.nonlinear_columns(spec, ch.pass_edge)
     band = spec.band
     mid = np.sqrt(band.low * band.high)
@@ -150,49 +148,49 @@ def _behind_dead_band(
     noise: np.ndarray,
     lags: int,
     found: Departure,
+    sign: np.ndarray,
 ) -> Departure:
     """The backlash test with the model behind the dead band it sizes: m, c, k on the specimen's
     own motion (it stands still inside the band, so the damping is not there either: the sign
     column alone leaves c about 1.3 % low at a play of 2 % of the amplitude). The test stays the
-    sign column's."""
+    sign column's (`sign`, its column)."""
     k = float(found.solution.beta[2])
     half = -float(found.solution.beta[-1]) / k if k > 0 else 0.0
     if half <= 0:  # a step the other way: no dead band to stand behind
         return found
     x = base.copy()
     x[:, :3] = bandlib.dead_band_motion(spec, ch.pass_edge, half)
-    exact = _one(
-        found.name, bandlib.nonlinear_columns(spec, ch.pass_edge)[2], x, ch.y, ch.keep, noise, lags, 1.0
-    )
+    exact = _one(found.name, sign, x, ch.y, ch.keep, noise, lags, 1.0)
     return replace(found, solution=exact.solution)
 
 
 def _drift(
-    spec: bandlib.Spectra, ch: bandlib.Channels, base: np.ndarray, noise: np.ndarray, lags: int, to_rig: float
+    spec: bandlib.Spectra,
+    ch: bandlib.Channels,
+    base: np.ndarray,
+    noise: np.ndarray,
+    lags: int,
+    to_rig: float,
+    straight: np.ndarray,
 ) -> Departure:
-    """The drift's test: a straight line, unless the best exponential settling (least residual)
-    has a curvature the line does not: its coefficient beside the line's beyond Z_CRIT. (Along a
-    chirp a fake mass, r'' = -w(t)^2 r, is also r times a curve in time: without that test a
-    straight drift would pass for a slow settling plus a negative mass.)"""
+    """The drift's test: the `straight` line's column (`columns`), unless the best exponential
+    settling (least residual) has a curvature the line does not: its coefficient beside the line's
+    beyond Z_CRIT. (Along a chirp a fake mass, r'' = -w(t)^2 r, is also r times a curve in time:
+    without that test a straight drift would pass for a slow settling plus a negative mass.)"""
     deflection, record = ch.x[:, 2] + ch.r_line, _record(spec)
-    (_, line), *settling = drift_shapes(ch.t / record)
     args = (ch.y, ch.keep, noise, lags, to_rig)
-    straight = _one("drift", deflection * line, base, *args, {"tau_s": None})
-    tries = [(_one("drift", deflection * g, base, *args, {"tau_s": u * record}), g) for u, g in settling]
+    line = _one("drift", straight, base, *args, {"tau_s": None})
+    tries = [
+        (_one("drift", deflection * g, base, *args, {"tau_s": u * record}), g)
+        for u, g in settling_shapes(ch.t / record)
+    ]
     best, shape = min(tries, key=lambda pair: pair[0].rss)
     padded = np.zeros((noise.shape[0] + 1, noise.shape[0] + 1))
     padded[:-1, :-1] = noise
     both = _one(
-        "drift",
-        deflection * shape,
-        np.column_stack([base, deflection * line]),
-        ch.y,
-        ch.keep,
-        padded,
-        lags,
-        1.0,
+        "drift", deflection * shape, np.column_stack([base, straight]), ch.y, ch.keep, padded, lags, 1.0
     )
-    return best if abs(both.z) > Z_CRIT else straight
+    return best if abs(both.z) > Z_CRIT else line
 
 
 def test(
@@ -208,8 +206,8 @@ def test(
 
     noise: the (p, p) regressor-noise covariance of `x` (the candidates' columns count as exact).
     others: other axes' loads on the grid of `ch` (`band.another_load`) with their peaks and
-    units, by column name: each a cross-talk candidate ("crosstalk from <column>"). A drift is tested in
-    each of its shapes (`drift_shapes`) and the one leaving the least residual stands for it.
+    units, by column name: each a cross-talk candidate ("crosstalk from <column>"). A drift is
+    tested in each of its shapes (`_drift`); backlash's model is the one behind its dead band.
     Raises:
         numpy.linalg.LinAlgError: a candidate's design is singular.
     """
@@ -222,12 +220,13 @@ def test(
     base = np.column_stack([x, bend])
     out = {}
     for name, col in columns(spec, ch).items():
-        if name != "drift":
+        if name == "drift":
+            out[name] = _drift(spec, ch, base, padded, lags, to_rig[name], col)
+        elif name == "backlash":
+            found = _one(name, col, base, ch.y, ch.keep, padded, lags, to_rig[name])
+            out[name] = _behind_dead_band(spec, ch, base, padded, lags, found, col)
+        else:
             out[name] = _one(name, col, base, ch.y, ch.keep, padded, lags, to_rig[name])
-            continue
-        out[name] = _drift(spec, ch, base, padded, lags, to_rig[name])
-    if "backlash" in out:
-        out["backlash"] = _behind_dead_band(spec, ch, base, padded, lags, out["backlash"])
     for col, (load, peak, unit) in (others or {}).items():
         detail = {"from": col, "from_unit": unit}
         if _explained(x, load, ch.keep) > CROSSTALK_R2:
