@@ -311,8 +311,12 @@ def fit_axis(
     spec, ch, main, correct, lag = _checked(log, axis, load_delay_s, load_filter)
     scale = spec.scale_f / spec.scale_r
     x, noise = _design(ch)
-    tests = departures.test(spec, ch, x, noise, _lags(ch), scale, _other_loads(log, axis, spec, ch, correct))
+    tests = departures.test(spec, ch, x, noise, _lags(ch), scale)
     found = departures.supported(tests)
+    if found is not None:  # something departs: is it another axis's load?
+        others = _other_loads(log, axis, spec, ch, correct)
+        tests |= departures.crosstalk(spec, ch, x, noise, _lags(ch), others)
+        found = departures.supported(tests)
     sol = found.solution if found is not None and found.name in departures.ADOPTED else main
     if found is not None and found.name == "friction" and lag is not None:
         lag = _unknown_lowpass(log, axis, spec, load_delay_s, load_filter, friction=found.value)

@@ -156,7 +156,7 @@ def _behind_dead_band(
     sign column's (`sign`, its column)."""
     k = float(found.solution.beta[2])
     half = -float(found.solution.beta[-1]) / k if k > 0 else 0.0
-    if half <= 0:  # a step the other way: no dead band to stand behind
+    if half <= 0 or abs(found.z) <= Z_CRIT:  # no dead band to stand behind
         return found
     x = base.copy()
     x[:, :3] = bandlib.dead_band_motion(spec, ch.pass_edge, half)
@@ -180,17 +180,34 @@ def _drift(
     deflection, record = ch.x[:, 2] + ch.r_line, _record(spec)
     args = (ch.y, ch.keep, noise, lags, to_rig)
     line = _one("drift", straight, base, *args, {"tau_s": None})
-    tries = [
-        (_one("drift", deflection * g, base, *args, {"tau_s": u * record}), g)
-        for u, g in settling_shapes(ch.t / record)
-    ]
-    best, shape = min(tries, key=lambda pair: pair[0].rss)
+    shapes = settling_shapes(ch.t / record)
+    # the shape that leaves the least residual beside `base`, by projection (ordinary least
+    # squares: one factorisation for all of them), then tested in full
+    q, _ = np.linalg.qr(base[ch.keep])
+    y = ch.y[ch.keep] - q @ (q.T @ ch.y[ch.keep])
+    cols = np.stack([deflection[ch.keep] * g[ch.keep] for _, g in shapes], axis=1)
+    cols -= q @ (q.T @ cols)
+    explained = (cols.T @ y) ** 2 / np.maximum(np.einsum("ij,ij->j", cols, cols), 1e-300)
+    u, shape = shapes[int(np.argmax(explained))]
+    best = _one("drift", deflection * shape, base, *args, {"tau_s": u * record})
+    if abs(best.z) <= Z_CRIT:  # no settling to speak of
+        return line
     padded = np.zeros((noise.shape[0] + 1, noise.shape[0] + 1))
     padded[:-1, :-1] = noise
     both = _one(
         "drift", deflection * shape, np.column_stack([base, straight]), ch.y, ch.keep, padded, lags, 1.0
     )
     return best if abs(both.z) > Z_CRIT else line
+
+
+def _base(ch: bandlib.Channels, x: np.ndarray, noise: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The linear design plus a slow quadratic below the band (a drifting position offset times a
+    drift's ramp is one), and the noise covariance padded for it and one candidate column."""
+    p = x.shape[1]
+    padded = np.zeros((p + 2, p + 2))
+    padded[:p, :p] = noise
+    bend = (2 * ch.t / max(ch.t[ch.keep].max(), 1e-300) - 1) ** 2
+    return np.column_stack([x, bend]), padded
 
 
 def test(
@@ -200,24 +217,17 @@ def test(
     noise: np.ndarray,
     lags: int,
     scale: float,
-    others: dict[str, tuple[np.ndarray, float, str]] | None = None,
 ) -> dict[str, Departure]:
     """Fit the linear design `x` (rows, p) plus each candidate's column; the tests by name.
 
     noise: the (p, p) regressor-noise covariance of `x` (the candidates' columns count as exact).
-    others: other axes' loads on the grid of `ch` (`band.another_load`) with their peaks and
-    units, by column name: each a cross-talk candidate ("crosstalk from <column>"). A drift is
-    tested in each of its shapes (`_drift`); backlash's model is the one behind its dead band.
+    A drift is tested in each of its shapes (`_drift`); backlash's model is the one behind its
+    dead band. Cross-talk is `crosstalk`'s.
     Raises:
         numpy.linalg.LinAlgError: a candidate's design is singular.
     """
-    p = x.shape[1]
-    padded = np.zeros((p + 2, p + 2))
-    padded[:p, :p] = noise
+    base, padded = _base(ch, x, noise)
     to_rig = _units(spec, scale)
-    # a slow quadratic below the band: a drifting position offset times the drift's ramp is one
-    bend = (2 * ch.t / max(ch.t[ch.keep].max(), 1e-300) - 1) ** 2
-    base = np.column_stack([x, bend])
     out = {}
     for name, col in columns(spec, ch).items():
         if name == "drift":
@@ -227,7 +237,24 @@ def test(
             out[name] = _behind_dead_band(spec, ch, base, padded, lags, found, col)
         else:
             out[name] = _one(name, col, base, ch.y, ch.keep, padded, lags, to_rig[name])
-    for col, (load, peak, unit) in (others or {}).items():
+    return out
+
+
+def crosstalk(
+    spec: bandlib.Spectra,
+    ch: bandlib.Channels,
+    x: np.ndarray,
+    noise: np.ndarray,
+    lags: int,
+    others: dict[str, tuple[np.ndarray, float, str]],
+) -> dict[str, Departure]:
+    """Cross-talk tests, "crosstalk from <column>": `others` are other axes' loads on the grid of
+    `ch` (`band.another_load`) with their peaks and units, by column name; each is one candidate
+    column beside the linear design `x` (as `test`), its coefficient the share of that load this
+    load sensor reads. A load this axis's motion explains (the same chirp in phase) is not tested."""
+    base, padded = _base(ch, x, noise)
+    out = {}
+    for col, (load, peak, unit) in others.items():
         detail = {"from": col, "from_unit": unit}
         if _explained(x, load, ch.keep) > CROSSTALK_R2:
             continue  # that axis moves as this one: its load cannot be told from this k and c
