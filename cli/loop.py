@@ -44,7 +44,8 @@ def calibrate(
     (a factor per response with its 95 % interval, width and height offsets, infill, layer and raster
     adhesion: those your runs pin down are printed) and a local correction that is strong near the
     designs you printed and fades away from them. The result is a surrogate file every --surrogate
-    option accepts. The report gives the nested leave-one-out accuracy over your runs (each predicted from the others).
+    option accepts. The report gives the nested leave-one-out accuracy over your runs (each predicted
+    from the others).
 
     Example: designer calibrate my_runs.csv -o mine.json
     """
