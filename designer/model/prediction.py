@@ -12,7 +12,8 @@ import numpy as np
 from .. import units
 from ..errors import DesignerError
 from ..study import space
-from .forms import FORMS, CasadiOps, columns, design_matrix
+from . import stored
+from .forms import CasadiOps, columns, design_matrix
 from .ridge import Fit, fit_arrays, interval
 
 
@@ -174,29 +175,36 @@ class ResponseSurface:
         }
 
     @classmethod
-    def from_dict(cls, response: str, d: Mapping[str, Any]) -> ResponseSurface:
-        if d.get("form") not in FORMS:
-            raise DesignerError(
-                f"surrogate response {response} has unknown form {d.get('form')!r}",
-                "refit it with designer fit",
-            )
+    def from_dict(cls, response: str, d: Mapping[str, Any], n_runs: int | None = None) -> ResponseSurface:
+        """Read back `to_dict` output (a surrogate file's response), every value and shape checked
+        (`designer.model.stored`); `n_runs` is the training runs' count the file's report indexes.
+
+        Raises:
+            DesignerError: naming the key and what it holds, with the fix (refit).
+        """
+        values = stored.surface_values(response, d)
+        stored.report_values(response, d, n_runs)
+
+        def predictions(key: str, required: bool = False) -> Prediction | None:
+            if d.get(key) is None:
+                if required:
+                    raise stored.bad(f"response {response}", f"has no '{key}'")
+                return None
+            p = Prediction.from_dict(d[key], where=f"surrogate response {response} {key}")
+            if n_runs is not None and np.shape(p.value) != (n_runs,):
+                raise stored.bad(
+                    f"response {response} {key}", f"has shape {np.shape(p.value)}, not ({n_runs},)"
+                )
+            return p
+
         return cls(
             response=response,
-            form=d["form"],
-            alpha=float(d["alpha"]),
-            coef=np.asarray(d["coef"], dtype=float),
-            vcov=np.asarray(d["vcov"], dtype=float),
-            sigma=float(d["sigma"]),
-            dof=float(d["dof"]),
-            t95=float(d["t95"]),
-            loo=dict(d["loo"]),
-            loo_predictions=Prediction.from_dict(d["loo_predictions"], where=f"{response} LOO predictions"),
-            candidates=dict(d["candidates"]),
-            observed_range=tuple(d["observed_range"]),
+            loo=dict(d.get("loo") or {}),
+            loo_predictions=predictions("loo_predictions", required=True),
+            candidates=dict(d.get("candidates") or {}),
             loo_nested=dict(d.get("loo_nested") or {}),
-            nested_predictions=None
-            if d.get("nested_predictions") is None
-            else Prediction.from_dict(d["nested_predictions"], where=f"{response} nested predictions"),
+            nested_predictions=predictions("nested_predictions"),
             influence=list(d.get("influence") or []),
             lack_of_fit=d.get("lack_of_fit"),
+            **values,
         )

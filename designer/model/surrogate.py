@@ -20,6 +20,7 @@ from .. import units
 from ..errors import DesignerError, check_type, names_argument, path_argument
 from ..files import atomic_write
 from ..study import space
+from . import stored
 from .correction import calibrated, check_printer_sd, runs_table
 from .forms import as_printed, check_designs, check_varied
 from .prediction import Prediction, ResponseSurface
@@ -230,20 +231,40 @@ class Surrogate:
             d = json.loads(p.read_text())
         except FileNotFoundError:
             raise DesignerError(f"no such surrogate: {p}", "give a file written by designer fit") from None
+        except RecursionError:
+            raise DesignerError(f"surrogate {p} is nested too deeply to be one", stored.FIX) from None
         except (OSError, ValueError) as exc:
-            raise DesignerError(f"cannot read surrogate {p}: {exc}", "refit it with designer fit") from None
+            raise DesignerError(f"cannot read surrogate {p}: {exc}", stored.FIX) from None
         if not isinstance(d, dict) or d.get("format") != FORMAT:
-            raise DesignerError(f"{p} is not a {FORMAT} surrogate", "refit it with designer fit")
+            raise DesignerError(f"{p} is not a {FORMAT} surrogate", stored.FIX)
         try:
-            models = {r: ResponseSurface.from_dict(r, m) for r, m in d["responses"].items()}
-            surrogate = cls(models=models, table_hash=d["table_hash"], training=d["training"])
-        except (KeyError, TypeError, ValueError) as exc:
-            raise DesignerError(
-                f"surrogate {p} is incomplete ({exc})", "refit it with designer fit"
-            ) from None
+            surrogate = cls.from_payload(d)
+        except DesignerError as exc:
+            raise DesignerError(f"surrogate {p}: {exc.problem}", stored.FIX) from None
         if "calibration" not in d:
             return surrogate
         return _recalibrate(surrogate, d["calibration"], p)
+
+    @classmethod
+    def from_payload(cls, d: dict[str, Any]) -> Surrogate:
+        """The study surrogate of a parsed surrogate file, every value and shape checked.
+
+        Raises:
+            DesignerError: naming the key and what it holds.
+        """
+        responses = stored.mapping(d.get("responses"), "responses")
+        if not responses:
+            raise stored.bad("responses", "is empty")
+        for r in responses:
+            stored.check_response_name(r)
+        training = stored.training_values(d.get("training"), list(responses))
+        n_runs = len(training["run"])
+        models = {r: ResponseSurface.from_dict(r, m, n_runs) for r, m in responses.items()}
+        for model in models.values():
+            stored.check_predictions(model, training)
+        if not isinstance(d.get("table_hash"), str):
+            raise stored.bad("table_hash", "is not a string")
+        return cls(models=models, table_hash=d["table_hash"], training=training)
 
 
 def _calibration_payload(surrogate: Surrogate) -> dict[str, Any]:
@@ -265,7 +286,7 @@ def _recalibrate(prior: Surrogate, d: Any, path: Path) -> Surrogate:
     try:
         table = runs_table(pd.DataFrame(d["runs"], dtype=float), prior)
         return calibrated(prior, table, check_printer_sd(float(d["printer_sd"])))
-    except (KeyError, TypeError, ValueError) as exc:
+    except (KeyError, TypeError, ValueError, OverflowError) as exc:
         raise DesignerError(
             f"the calibration block of {path} is incomplete ({exc})",
             "recalibrate it with designer calibrate",
