@@ -32,11 +32,12 @@ def cosim(
     Example: designer cosim examples/two_link_arm.toml -o results/ --validate
     """
     from designer.cosim import load, run, write_outputs
+    from designer.cosim.run import OUTPUT_FILES
     from designer.files import check_output_folder
 
     quiet_mujoco()
     sc = load(scenario)
-    check_output_folder(out)
+    check_output_folder(out, OUTPUT_FILES)
     with progress(f"co-simulating {scenario.name}", enabled=not json_out) as bar:
         result = run(sc, validate=validate, progress=bar, engine=engine)
     finishing()

@@ -47,13 +47,16 @@ def sweep(
     from dataclasses import replace
 
     from designer import sweep as sw
+    from designer.files import check_output_folder
     from designer.sweep.executors import executor
+    from designer.sweep.summary import OUTPUT_FILES
 
     s = sw.load(spec)
     if path is not None:
         if path not in ("fmu", "engine"):
             raise DesignerError(f"--path {path} is not allowed", "use --path fmu or --path engine")
         s = replace(s, path=path)
+    check_output_folder(out, OUTPUT_FILES)
     made = _missing_folders(out)
     out.mkdir(parents=True, exist_ok=True)
     workers = workers if workers else s.workers

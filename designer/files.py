@@ -69,6 +69,7 @@ def check_output(
     kind: str = "file",
     suffixes: Iterable[str] | None = None,
     estimate_bytes: float = 0,
+    inputs: Iterable[str | Path] = (),
 ) -> Path:
     """Check before any work that `path` can be written; returns it resolved.
 
@@ -77,10 +78,12 @@ def check_output(
         kind: "file" (its folder must exist) or "folder" (made with its parents when missing).
         suffixes: accepted file suffixes, lower case with the dot (None: any).
         estimate_bytes: expected size; the target's disk must have this much free plus 1 MiB.
+        inputs: the files the command reads; the output must not be one of them (writing it would
+            replace the input, a raw log the user cannot make again).
 
     Raises:
         DesignerError: a folder where a file is expected or the reverse, a wrong suffix, a folder that
-            is missing or cannot be written, or too little free space (with the estimate).
+            is missing or cannot be written, an output that is an input, or too little free space.
     """
     if kind not in ("file", "folder"):
         raise ValueError(f"kind={kind!r}: use 'file' or 'folder'")
@@ -97,6 +100,12 @@ def check_output(
             raise DesignerError(
                 f"cannot write {path}: the suffix '{p.suffix}' is not {' or '.join(allowed)}",
                 f"name the file with {' or '.join(allowed)}",
+            )
+    for source in inputs:
+        if p.exists() and Path(source).exists() and os.path.samefile(p, source):
+            raise DesignerError(
+                f"cannot write {path}: it is the input {source}, which the output would replace",
+                "give the output another name",
             )
     folder = p if (kind == "folder" and p.is_dir()) else p.parent
     if not folder.is_dir():
@@ -186,8 +195,28 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         raise
 
 
+def check_not_folders(folder: Path, names: Iterable[str]) -> None:
+    """Refuse when a file to be written into `folder` exists there as a folder (the user's own):
+    moving the results in would replace it and everything in it.
+
+    Raises:
+        DesignerError: naming the folder in the way.
+    """
+    for name in names:
+        p = folder / name
+        if p.is_dir():
+            n = sum(1 for _ in p.iterdir())
+            raise DesignerError(
+                f"cannot write {p}: a folder of that name is there ({n} entries), which the output "
+                "would replace",
+                "move that folder away or write the results to another folder",
+            )
+
+
 def _move_in(stage: Path, target: Path) -> None:
-    """Move every entry of `stage` into the existing folder `target`, replacing same-named entries."""
+    """Move every entry of `stage` into the existing folder `target`, replacing same-named files;
+    a folder in the way of a file is refused before anything moves."""
+    check_not_folders(target, [e.name for e in stage.iterdir() if not e.is_dir()])
     trash = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".old", dir=target.parent))
     try:
         for entry in stage.iterdir():
@@ -200,17 +229,19 @@ def _move_in(stage: Path, target: Path) -> None:
 
 
 @contextlib.contextmanager
-def atomic_folder(path: str | Path) -> Iterator[Path]:
+def atomic_folder(path: str | Path, files: Iterable[str] = ()) -> Iterator[Path]:
     """A staging folder beside `path`, moved into place when the block succeeds (removed when not).
 
     A missing or empty target is replaced by the staged folder in one rename; into an existing folder
     the staged entries replace their namesakes (other files there stay), with SIGINT/SIGTERM/SIGHUP
-    held back during the moves so an interrupt never leaves old and new outputs mixed.
+    held back during the moves so an interrupt never leaves old and new outputs mixed. A staged file
+    never replaces a folder; `files`, the names the block may write, are checked for that up front.
 
     Raises:
-        DesignerError: `path` is a file, or its folder cannot be created or written.
+        DesignerError: `path` is a file, its folder cannot be created or written, or one of `files`
+            is a folder there.
     """
-    target = _followed(check_output(path, kind="folder"))
+    target = _followed(check_output_folder(path, files))
     target.parent.mkdir(parents=True, exist_ok=True)
     stage = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent))
     try:
@@ -386,13 +417,17 @@ def check_table_file(path: str | Path, *, parquet: bool) -> None:
             )
 
 
-def check_output_folder(path: str | Path) -> Path:
-    """Check, before any work, that `path` is or can become a writable folder; returns it.
+def check_output_folder(path: str | Path, files: Iterable[str] = ()) -> Path:
+    """Check, before any work, that `path` is or can become a writable folder where none of `files`
+    (the names the command writes into it) is a folder; returns it.
 
     Raises:
-        DesignerError: `path` is a file, or it (or its nearest existing parent) is not writable.
+        DesignerError: `path` is a file, it (or its nearest existing parent) is not writable, or one
+            of `files` is a folder there.
     """
-    return check_output(path, kind="folder")
+    p = check_output(path, kind="folder")
+    check_not_folders(p, files)
+    return p
 
 
 def check_suffix(path: str | Path, suffixes: tuple[str, ...], *, what: str) -> Path:

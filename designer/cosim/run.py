@@ -254,6 +254,17 @@ def rig_log(result: Result) -> pd.DataFrame:
     )
 
 
+#: every file `write_outputs` may write into its folder (which ones: the scenario's switches and kind)
+OUTPUT_FILES = (
+    "timeseries.csv",
+    "timeseries.parquet",
+    "metrics.json",
+    "plot.png",
+    "rig_log.csv",
+    "rig_log.json",
+)
+
+
 def write_outputs(
     result: Result,
     folder: str | Path,
@@ -283,7 +294,7 @@ def write_outputs(
         "plot": switches["plot"] if plot is None else plot,
     }
     written = []
-    with atomic_folder(out) as stage:
+    with atomic_folder(out, OUTPUT_FILES) as stage:
         if want["csv"] or want["parquet"]:
             written += _write_series(result, stage, want["csv"], want["parquet"])
         with atomic_write(stage / "metrics.json") as fh:

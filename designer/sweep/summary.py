@@ -146,6 +146,10 @@ def summarize(spec: Spec, *, frame: pd.DataFrame, cases: Sequence[Case]) -> dict
     return summary
 
 
+#: every file `write_results` may write into its folder, and the journal the run keeps there
+OUTPUT_FILES = ("results.parquet", "summary.json", "metrics.png", "cases.jsonl")
+
+
 def write_results(result, folder: str | Path, *, plot: bool = True) -> list[Path]:
     """Write results.parquet (units in its metadata), summary.json and, optionally, metrics.png."""
     import pyarrow as pa
@@ -155,7 +159,7 @@ def write_results(result, folder: str | Path, *, plot: bool = True) -> list[Path
     arrow = pa.Table.from_pandas(result.table, preserve_index=False)
     meta = dict(arrow.schema.metadata or {})
     meta[b"designer.units"] = json.dumps(result.summary["units"]).encode()
-    with atomic_folder(folder) as stage:  # moved in together: an interrupt leaves none of them
+    with atomic_folder(folder, OUTPUT_FILES) as stage:  # moved in together: an interrupt leaves none of them
         with atomic_path(stage / "results.parquet") as tmp:
             pq.write_table(arrow.replace_schema_metadata(meta), tmp)
         with atomic_write(stage / "summary.json") as fh:
