@@ -18,6 +18,7 @@ from .common import (
     ToleranceOpt,
     answer,
     console,
+    finishing,
     load_surrogate,
     output_option,
     parse_fix,
@@ -50,6 +51,7 @@ def fit(
     table = load_table(data)
     with progress("fitting (nested leave-one-out)", enabled=not as_json) as bar:
         sur = Surrogate().fit(table, progress=bar)
+    finishing()
     if out is not None:
         sur.save(out)
     report = sur.report() | {"out": str(out) if out else None}

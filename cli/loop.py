@@ -15,6 +15,7 @@ from .common import (
     ToleranceOpt,
     answer,
     console,
+    finishing,
     load_surrogate,
     output_option,
     parse_fix,
@@ -56,6 +57,7 @@ def calibrate(
     if out is not None:
         check_output(out, suffixes=[".json"])
     calibrated = run_calibrate(load_surrogate(surrogate), runs)
+    finishing()
     if out is not None:
         calibrated.save(out)
     data = report(calibrated) | {"out": str(out) if out else None}

@@ -175,6 +175,7 @@ def run(argv: list[str] | None = None) -> int:
     head = args[: args.index("--")] if "--" in args else args
     common.QUIET = "--quiet" in head  # like --debug, accepted in any position
     common.FINISHING, common.LATE_STOP = False, None
+    RECEIVED.clear()  # a command run in this process before (the tests) is not this one
     if common.QUIET:
         args.remove("--quiet")
     with warnings.catch_warnings():
@@ -187,13 +188,17 @@ def _run(args: list[str], debug: bool) -> int:
     try:
         chosen = design_app if args[:1] and args[0] in DESIGN_COMMANDS else app
         code = chosen(args=args, prog_name="designer", standalone_mode=False)
+        if RECEIVED or code == 130:
+            return _swallowed()
         _late_stop()
         return code if isinstance(code, int) else 0
     except Stopped as exc:
         return _stopped(exc.signum)
     except (KeyboardInterrupt, typer.Abort):
-        return _stopped(signal.SIGINT)
+        return _stopped(RECEIVED[0] if RECEIVED else signal.SIGINT)
     except typer.Exit as exc:
+        if RECEIVED:
+            return _swallowed()
         _late_stop()
         return exc.exit_code
     except _click_errors.ClickException as exc:
@@ -216,6 +221,13 @@ def _run(args: list[str], debug: bool) -> int:
         if RECEIVED:  # the stop, converted on its way out: not a bug
             return _stopped(RECEIVED[0])
         return _internal(exc, debug)
+
+
+def _swallowed() -> int:
+    """A command that returned although a stop signal came before its last step: a C extension
+    caught the stop (CasADi inside IPOPT turns it into a failed solve; the library raises it again as a
+    KeyboardInterrupt, which typer turns into a silent exit 130). It was stopped all the same."""
+    return _stopped(RECEIVED[0] if RECEIVED else signal.SIGINT)
 
 
 def _late_stop() -> None:

@@ -366,6 +366,7 @@ def profile_cmd(
     page = profile.build_profiler(
         sur, axis=axis, targets=targets, tolerance=tolerance / 100, suggestion=suggestion, design=start
     )
+    finishing()
     path = profile.write_profiler(page, output)
     opened = page.data["design"]
     if as_json:

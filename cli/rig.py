@@ -10,7 +10,7 @@ import typer
 
 from designer.errors import DesignerError
 
-from .common import JsonOpt, console, err_console, print_json, progress
+from .common import JsonOpt, console, err_console, finishing, print_json, progress
 
 rig_app = typer.Typer(help="The virtual rig: simulate the study's experiment.", no_args_is_help=True)
 
@@ -53,11 +53,12 @@ def identify(
     from designer.rig.identify import results_table
 
     if output is not None:
-        check_output(output, suffixes=TABLE_SUFFIXES)
+        check_output(output, suffixes=TABLE_SUFFIXES, inputs=logs)
     if load_delay is not None and load_delay != load_delay:
         raise DesignerError("--load-delay is NaN", "give the delay in seconds, e.g. --load-delay 0.002")
     with progress("identifying") as bar:
         results = run(logs, load_delay_s=load_delay, load_filter=load_filter, progress=bar)
+    finishing()
     passed = [r for r in results if r.ok]
     wrote = output is not None and bool(passed)
     if wrote:
@@ -199,6 +200,7 @@ def simulate(
             f1=f1,
         )
         bar(0.5)
+        finishing()
         write_log(df, output, factors or None)
         bar(1.0)
     if json_out:
@@ -245,11 +247,12 @@ def clean(
     from designer.study.data import read_frame, write_frame
 
     if output is not None:
-        check_output(output, suffixes=TABLE_SUFFIXES)
+        check_output(output, suffixes=TABLE_SUFFIXES, inputs=[table])
     if not 0 <= max_drop <= 1:
         raise DesignerError(f"--max-drop {max_drop:g}", "give a share between 0 and 1, e.g. 0.2")
     res = run(read_frame(table), eps=eps, min_samples=min_samples, source=table.name)
     refused = res.drop_share > max_drop or len(res.table) == 0
+    finishing()
     if output is not None and not refused:
         write_frame(res.table, output)
     if json_out:
@@ -309,7 +312,7 @@ def doe(
     from designer.study import doe as plans
 
     if output is not None:
-        check_output(output, suffixes=TABLE_SUFFIXES)
+        check_output(output, suffixes=TABLE_SUFFIXES, inputs=[data] if data else [])
     if augment is None:
         if k is not None or c is not None or data is not None:
             raise DesignerError("--k, --c and --data go with --augment", "add --augment N")
@@ -359,6 +362,7 @@ def _finish_plan(plan, output: Path | None, json_out: bool, narrowing: dict) -> 
 
     from designer import units
 
+    finishing()
     if output is not None:
         from designer.study.data import write_frame
 

@@ -39,6 +39,19 @@ IPOPT = {
     "ipopt.max_iter": 300,
     "error_on_fail": False,
 }
+#: IPOPT's status when an exception left its callbacks. With these problems (CasADi expressions, no
+#: Python callbacks) only a stop signal does: CasADi turns the KeyboardInterrupt (or the CLI's stop) raised
+#: in its interrupt check into this status and returns normally, with the search cut short
+INTERRUPTED = "NonIpopt_Exception_Thrown"
+
+
+def solved(solver: ca.Function, **args: Any) -> dict[str, Any]:
+    """`solver(**args)`, raising KeyboardInterrupt when a stop signal ended IPOPT (see INTERRUPTED): an
+    interrupted search must stop the command, never be answered from."""
+    sol = solver(**args)
+    if solver.stats()["return_status"] == INTERRUPTED:
+        raise KeyboardInterrupt("stopped inside IPOPT")
+    return sol
 
 
 class Problem:
@@ -73,7 +86,7 @@ class Problem:
         return ca.nlpsol(f"extreme_{q}", "ipopt", nlp, IPOPT)
 
     def solve(self, u0: np.ndarray, ubounds: tuple[np.ndarray, np.ndarray], p: np.ndarray) -> np.ndarray:
-        sol = self.solver(x0=u0, lbx=ubounds[0], ubx=ubounds[1], p=p)
+        sol = solved(self.solver, x0=u0, lbx=ubounds[0], ubx=ubounds[1], p=p)
         return np.asarray(sol["x"]).ravel()
 
 
@@ -190,7 +203,7 @@ def reachable_range(problem: Problem, q: str, box: Box) -> tuple[float, float]:
     for combo in box.combos:
         for sign in (1.0, -1.0):
             p = np.concatenate([combo, box.lows, box.spans, [sign]])
-            sol = solver(x0=np.clip(0.5, box.lbu, box.ubu), lbx=box.lbu, ubx=box.ubu, p=p)
+            sol = solved(solver, x0=np.clip(0.5, box.lbu, box.ubu), lbx=box.lbu, ubx=box.ubu, p=p)
             design = as_solid(box.design(np.asarray(sol["x"]).ravel(), combo))  # as printed
             values.append(float(f([design[n] for n in space.FACTOR_NAMES])[0]))
     return min(values), max(values)
