@@ -8,9 +8,9 @@ import json
 import math
 import re
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Collection, Iterator
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, NamedTuple
 
 import typer
 from rich.console import Console
@@ -163,39 +163,73 @@ def progress(description: str, enabled: bool = True) -> Iterator[Callable[[float
         yield lambda fraction: bar.update(task, completed=min(max(fraction, 0.0), 1.0))
 
 
+class Flag(NamedTuple):
+    """A Python argument named in library messages and the flag the CLI spells it with."""
+
+    pattern: str
+    flag: str
+    #: a library message the pattern matches (tests/test_cli_flag_messages.py walks these)
+    example: str
+    #: the replacement in a command without that flag (None: the words stay as they are)
+    fallback: str | None = None
+
+
 #: Python arguments named in library messages, and the flags the CLI spells them with: the library
-#: speaks to Python callers, the command line to its users, so the one error path translates
-FLAGS: tuple[tuple[str, str], ...] = (
-    (r"\bsource_only=True\b", "--source-only"),
-    (r"\bplatforms=\"(\w+)\"", r"--platforms \1"),
-    (r"\brebuild=True\b", "--build"),
-    (r"\bfmi_version=", "--fmi "),
-    (r"\binterface=", "--interface "),
-    (r"\ballow_extrapolation=True\b", "--allow-extrapolation"),
-    (r"\btop=", "--top "),
-    (r"\bk= and/or c=", "--k and/or --c"),
-    (r"\bgive k= a target value", "give --k a target value"),
-    (r"\bn=(?=\S+ is not a whole number)", "--n "),
-    (r"\bstop=(?=\S+ is not in)", "--stop "),
-    (r"\bload_filter=", "--load-filter "),
-    (r"\ballow_outside_range=True\b", "--allow-outside-range"),
-    (r"\btargets=\{'k': 0\.8\}", "--target k=0.8"),
+#: speaks to Python callers, the command line to its users, so the one error path translates. A
+#: command that lacks the flag gets the fallback, never a flag it does not have
+FLAGS: tuple[Flag, ...] = (
+    Flag(r"\bsource_only=True\b", "--source-only", "or export with source_only=True and build"),
+    Flag(r"\bplatforms=\"(\w+)\"", r"--platforms \1", 'or use platforms="host"'),
+    Flag(r"\brebuild=True\b", "--build", "export with rebuild=True"),
+    Flag(r"\bfmi_version=", "--fmi ", "use fmi_version=2 or 3"),
+    Flag(r"\binterface=", "--interface ", "use interface='force' or 'body'"),
+    Flag(
+        r"(, or pass )?\ballow_extrapolation=True\b( to accept an unsupported prediction)?",
+        r"\1--allow-extrapolation\2",
+        "choose a value inside it, or pass allow_extrapolation=True to accept an unsupported prediction",
+        "",
+    ),
+    Flag(r"\btop=", "--top ", "top=0 must be at least 1"),
+    Flag(r"\bk= and/or c=", "--k and/or --c", "give k= and/or c= (a value, 'min' or 'max')"),
+    Flag(
+        r"\bgive k= a target value", "give --k a target value", "give k= a target value (k_x is predictable)"
+    ),
+    Flag(r"\bn=(?=\S+ is not a whole number)", "--n ", "n=0 is not a whole number from 1 to 10"),
+    Flag(r"\bstop=(?=\S+ is not in)", "--stop ", "stop=2 is not in (0, 1]"),
+    Flag(
+        r"\bload_filter=",
+        "--load-filter ",
+        "give the sensor's filter (load_filter='butter2:200Hz' if that is it)",
+    ),
+    Flag(
+        r"\ballow_outside_range=True\b", "--allow-outside-range", "or allow_outside_range=True if the spring"
+    ),
+    Flag(r"\btargets=\{'k': 0\.8\}", "--target k=0.8", "give targets={'k': 0.8}, for k or c"),
+    Flag(r"\bfrom fixed=", "from --fix", "drop width from fixed="),
     # export mjcf/urdf/sdf/modelica/ssp
-    (r"\binto=", "--into "),
-    (r"\bjoint_name=", "--joint "),
-    (r"\baxis=(?='\w+'(, or| is | does ))", "--use-axis "),
-    (r"\bform=(?='\w*' is not a form)", "--form "),
-    (r"\bmsl=", "--msl "),
-    (r"\brest=(?=\S+ is for exports into)", "--rest "),
-    (r"\bmotor_inertia=", "--motor-inertia "),
-    (r"\bmotor_bandwidth=", "--motor-bandwidth "),
+    Flag(r"\binto=", "--into ", "give the file that defines the joint as into="),
+    Flag(
+        r"\bjoint_name=", "--joint ", "joint_name='knee': the robot has no hinge or slide joint of that name"
+    ),
+    Flag(r"\baxis=(?='\w+'(, or| is | does ))", "--use-axis ", "axis='x' is not an axis of the joint"),
+    Flag(r"\bform=(?='\w*' is not a form)", "--form ", "form='serial' is not a form"),
+    Flag(r"\bmsl=", "--msl ", "msl='3.2' is not supported"),
+    Flag(r"\brest=(?=\S+ is for exports into)", "--rest ", "rest=0.1 is for exports into a robot"),
+    Flag(r"\bmotor_inertia=", "--motor-inertia ", "motor_inertia=0 and motor_bandwidth=0 must be positive"),
+    Flag(
+        r"\bmotor_bandwidth=", "--motor-bandwidth ", "motor_inertia=0 and motor_bandwidth=0 must be positive"
+    ),
 )
 
 
-def flag_message(text: str) -> str:
-    """A library message with its Python argument names replaced by the CLI's flags."""
-    for pattern, flag in FLAGS:
-        text = re.sub(pattern, flag, text)
+def flag_message(text: str, options: Collection[str] | None = None) -> str:
+    """A library message with its Python argument names replaced by the CLI's flags; with `options`
+    (the running command's), a flag the command lacks is never named (the flag's fallback instead)."""
+    for f in FLAGS:
+        if options is None or set(re.findall(r"--[\w-]+", f.flag)) <= set(options):
+            text = re.sub(f.pattern, f.flag, text)
+        elif f.fallback is not None:
+            text = re.sub(f.pattern, f.fallback, text)
     return text
 
 

@@ -208,7 +208,8 @@ def _run(args: list[str], debug: bool) -> int:
         where = f"{ctx.command_path} --help" if ctx is not None else "designer --help"
         return _fail(exc.format_message(), f"see {where}", 2)
     except DesignerError as exc:
-        return _fail(flag_message(exc.problem), exc.fix and flag_message(exc.fix), 2)
+        options = command_options(args)
+        return _fail(flag_message(exc.problem, options), exc.fix and flag_message(exc.fix, options), 2)
     except BrokenPipeError:
         return _closed_stdout()
     except MemoryError:
@@ -221,6 +222,21 @@ def _run(args: list[str], debug: bool) -> int:
         if RECEIVED:  # the stop, converted on its way out: not a bug
             return _stopped(RECEIVED[0])
         return _internal(exc, debug)
+
+
+def command_options(args: list[str]) -> set[str]:
+    """The option names (e.g. --fix) of the command the command line `args` invokes, with those of
+    `designer` itself: a message must not offer a flag the command lacks."""
+    cmd = typer.main.get_command(design_app if args[:1] and args[0] in DESIGN_COMMANDS else app)
+    names = {o for p in cmd.params for o in (*p.opts, *p.secondary_opts)}
+    for token in args:
+        commands = getattr(cmd, "commands", None)
+        if not commands:
+            break
+        if token in commands:
+            cmd = commands[token]
+            names |= {o for p in cmd.params for o in (*p.opts, *p.secondary_opts)}
+    return names
 
 
 def _swallowed() -> int:

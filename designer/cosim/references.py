@@ -10,6 +10,7 @@ import numpy as np
 
 from ..chirp import Chirp
 from ..errors import DesignerError
+from ..files import check_table_file
 
 
 @dataclass(frozen=True)
@@ -56,7 +57,14 @@ class Trajectory:
         path = Path(path)
         if not path.is_file():
             raise DesignerError(f"trajectory file {path} does not exist", "give the path of a CSV file")
-        df = pd.read_csv(path)
+        check_table_file(path, parquet=False)  # binary, UTF-16, ';' or tab separated: named
+        try:
+            df = pd.read_csv(path)
+        except (ValueError, UnicodeDecodeError) as exc:  # pandas' ParserError is a ValueError
+            raise DesignerError(
+                f"trajectory file {path} is not a comma-separated table ({str(exc).splitlines()[0]})",
+                "give a CSV file with a header row t,q and one sample per row",
+            ) from None
         for col in ("t", column):
             if col not in df.columns:
                 raise DesignerError(
