@@ -1,6 +1,5 @@
 """The compiled co-simulation kernel against the Python master: the same bits, the same errors."""
 
-import importlib
 import math
 import shutil
 import subprocess
@@ -16,10 +15,10 @@ from designer.cosim import binding, kernel, prepare
 from designer.cosim.master import Master
 from designer.cosim.references import Chirp, Sine, Step, Trajectory
 from designer.cosim.robot import Robot, SpringDamper, load_spec
-from designer.cosim.scenario import load
+from designer.cosim.robot_scenario import robot_reference
+from designer.cosim.scenario_file import load
 from designer.errors import DesignerError
 
-cosim_run = importlib.import_module("designer.cosim.run")
 EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "two_link_arm.toml"
 REFERENCES = [
     '{ type = "sine", amplitude = 0.5, frequency = 0.7, offset = 0.1, phase = 0.3 }',
@@ -231,7 +230,7 @@ def test_auto_falls_back_to_python_without_a_compiler(tmp_path, monkeypatch):
 def test_in_engine_reference_bit_identical():
     sc = load(EXAMPLE)
     laws = {j: {"k": 0.333, "c": 8.3e-4, "offset": 0.01} for j in sc.joints}
-    ker = cosim_run.robot_reference(sc, laws, 1e-3, 2.0, "rk4")
+    ker = robot_reference(sc, laws, 1e-3, 2.0, "rk4")
     py = _reference_master(sc, laws).run(2.0, 1e-3)
     assert_same(py, ker)
 

@@ -23,7 +23,8 @@ def check_cosim(ctx: Context) -> CheckResult:
     from ..plots.common import save_figure
     from ..plots.timeseries import plot_timeseries
     from .references import Sine, Step
-    from .run import robot_reference, run
+    from .robot_scenario import robot_reference
+    from .run import run
     from .scenario import JointSource, Scenario
 
     joint = JointSource(axis="theta", joint=Joint.from_coefficients({"theta": {"k": 330.0, "c": 0.83}}))

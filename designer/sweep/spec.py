@@ -8,14 +8,16 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ..cosim.rig_scenario import RigScenario
+from ..cosim.robot_scenario import RobotScenario
 from ..cosim.scenario import Scenario
-from ..cosim.session import sources  # noqa: F401  (the joints a sweep can vary, by name)
 from ..errors import DesignerError, check_type
 from ..keys import check_keys, read_toml
 from .limits import Limit, parse_limit
@@ -126,7 +128,7 @@ def _cases(doc: dict, path: Path, scenario: Scenario) -> Cases:
             f"{_where(path, 'cases.designs')} must map joints to print settings", "see the README"
         )
     designs = {j: dict(d) for j, d in designs.items()}
-    joints = table.get("joints", list(sources(scenario)) if kind != "grid" else None)
+    joints = table.get("joints", list(scenario.sources()) if kind != "grid" else None)
     if kind == "grid":
         if not isinstance(joints, dict) or not joints:
             raise DesignerError(
@@ -237,6 +239,26 @@ def with_duration(scenario: Scenario, duration: Any) -> Scenario:
     return dataclasses.replace(scenario, duration=float(duration))
 
 
+def _rig_sweep(spec: Spec) -> None:
+    """A rig sweep identifies each case's virtual rig log through the FMU: no engine path, no limits.
+
+    Raises:
+        DesignerError: the engine path or limits.
+    """
+    if spec.path != "fmu" or spec.limits:
+        raise DesignerError(
+            "a rig sweep identifies each case's virtual rig log through the FMU",
+            "use path='fmu' and no limits with a rig scenario",
+        )
+
+
+#: the checks a sweep of each scenario type adds (a robot sweep takes either path and any limits)
+TYPE_RULES: dict[type[Scenario], tuple[Callable[[Spec], None], ...]] = {
+    RobotScenario: (),
+    RigScenario: (_rig_sweep,),
+}
+
+
 def check(spec: Spec) -> Spec:
     """Check a spec built in code as `load` checks a file; returns it (a Monte Carlo or suggestion sweep
     without joints varies them all).
@@ -249,18 +271,15 @@ def check(spec: Spec) -> Spec:
     check_type(spec, Spec, "spec", expected="a sweep Spec", fix="read one with designer.sweep.load(path)")
     sc = spec.scenario if spec.scenario.checked else spec.scenario.check()
     spec = dataclasses.replace(spec, scenario=sc)
-    if sc.kind == "rig" and (spec.path != "fmu" or spec.limits):
-        raise DesignerError(
-            "a rig sweep identifies each case's virtual rig log through the FMU",
-            "use path='fmu' and no limits with a rig scenario",
-        )
+    for rule in TYPE_RULES[type(sc)]:
+        rule(spec)
     if spec.path not in PATHS:
         raise DesignerError(f"path={spec.path!r} is not allowed", "use path='fmu' or path='engine'")
     if spec.cases.type not in CASE_TYPES:
         raise DesignerError(
             f"cases type {spec.cases.type!r} is unknown", f"use one of {', '.join(CASE_TYPES)}"
         )
-    names = sources(sc)
+    names = sc.sources()
     if not spec.cases.joints:
         if spec.cases.type == "grid":
             raise DesignerError("a grid sweep needs its axes", "give joints={'j1': {'k': [100, 200]}}")
