@@ -297,7 +297,7 @@ def asking_fmus(monkeypatch, every=250, fail_at=None):
         fake = asking(self.fmu)
         keep.append(fake)
         fakes[id(self.fmu)] = ctypes.cast(fake, ctypes.c_void_p).value
-        self.needs_completed_step = True
+        self.mode.completed = True  # a ModelExchange mode: CompletedIntegratorStep after each step
 
         def python_completed():
             enter, stop = ctypes.c_int(0), ctypes.c_int(0)
@@ -307,8 +307,8 @@ def asking_fmus(monkeypatch, every=250, fail_at=None):
             return bool(enter.value), bool(stop.value)
 
         self.fmu.completedIntegratorStep = python_completed
-        iteration = self._event_iteration
-        self._event_iteration = lambda: (events.append((self.fmu.instanceName, self._steps)), iteration())
+        iteration = self.event_iteration
+        self.event_iteration = lambda: (events.append((self.fmu.instanceName, self.steps)), iteration())
 
     def function(fmu, name):
         return fakes[id(fmu)] if name.endswith("CompletedIntegratorStep") else real_function(fmu, name)
