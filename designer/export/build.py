@@ -166,7 +166,7 @@ def zig_flags(platform: str) -> list[str]:
     return extra
 
 
-def _compiler(platform: str, *, zig: bool = False) -> tuple[list[str], list[str]]:
+def platform_compiler(platform: str, *, zig: bool = False) -> tuple[list[str], list[str]]:
     """The compiler command and its extra flags for `platform`: the system one for the host (Zig if
     there is none and $CC names none, or if `zig`), Zig for the others.
 
@@ -254,7 +254,7 @@ def build_binary(
     shipped = None if rebuild else shipped_binary(fmi_version, platform)
     if shipped is not None:
         return shipped
-    compiler, extra = _compiler(platform, zig=zig)
+    compiler, extra = platform_compiler(platform, zig=zig)
     key = _build_key(fmi_version, compiler, extra, platform)
     target = cache_dir() / f"fmi{fmi_version}-{platform}-{key}" / library_name(platform)
     if target.is_file():

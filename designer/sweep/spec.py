@@ -114,7 +114,7 @@ def _cases(doc: dict, path: Path, scenario: Scenario) -> Cases:
         raise DesignerError(
             f"{path.name} needs a [cases] table with a type", f"type = one of {', '.join(CASE_TYPES)}"
         )
-    kind = table["type"]
+    kind = table["type"]  # CASE_TYPES are READERS' keys
     for key in table:
         if key != "type" and key not in CASE_KEYS[kind]:
             owners = " or ".join(f'"{t}"' for t in CASE_TYPES if key in CASE_KEYS[t])
@@ -127,40 +127,58 @@ def _cases(doc: dict, path: Path, scenario: Scenario) -> Cases:
         raise DesignerError(
             f"{_where(path, 'cases.designs')} must map joints to print settings", "see the README"
         )
-    designs = {j: dict(d) for j, d in designs.items()}
-    joints = table.get("joints", list(scenario.sources()) if kind != "grid" else None)
-    if kind == "grid":
-        if not isinstance(joints, dict) or not joints:
+    return READERS[kind](table, path, scenario, {j: dict(d) for j, d in designs.items()})
+
+
+def _grid(table: dict, path: Path, scenario: Scenario, designs: dict) -> Cases:
+    joints = table.get("joints")
+    if not isinstance(joints, dict) or not joints:
+        raise DesignerError(f"{_where(path, 'cases.joints')} must map joints to grid axes", "see the README")
+    grid = {}
+    for j, axes in joints.items():
+        if not isinstance(axes, dict) or not axes:
             raise DesignerError(
-                f"{_where(path, 'cases.joints')} must map joints to grid axes", "see the README"
+                f"{_where(path, 'cases.joints.' + j)} must be a table of axes", "e.g. {k = [..]}"
             )
-        grid = {}
-        for j, axes in joints.items():
-            if not isinstance(axes, dict) or not axes:
-                raise DesignerError(
-                    f"{_where(path, 'cases.joints.' + j)} must be a table of axes", "e.g. {k = [..]}"
-                )
-            grid[j] = {q: _values(v, f"cases.joints.{j}.{q}", path) for q, v in axes.items()}
-        return Cases(type=kind, joints=grid, designs=designs)
+        grid[j] = {q: _values(v, f"cases.joints.{j}.{q}", path) for q, v in axes.items()}
+    return Cases(type="grid", joints=grid, designs=designs)
+
+
+def _joint_names(table: dict, path: Path, scenario: Scenario) -> dict[str, None]:
+    """The joints a suggestion or Monte Carlo sweep varies (default: every joint of the scenario)."""
+    joints = table.get("joints", list(scenario.sources()))
     if not isinstance(joints, list) or not all(isinstance(j, str) for j in joints):
         raise DesignerError(f"{_where(path, 'cases.joints')} must list joint names", 'e.g. ["j1", "j2"]')
-    if kind == "suggestion":
-        if not isinstance(table.get("file"), str):
-            raise DesignerError(f"{_where(path, 'cases.file')} is missing", 'give file = "suggestion.json"')
-        file = (path.parent / table["file"]).resolve()
-        cands = table.get("candidates", [])
-        if not isinstance(cands, list) or not all(isinstance(c, int) and c >= 1 for c in cands):
-            raise DesignerError(
-                f"{_where(path, 'cases.candidates')} must list numbers >= 1", "e.g. [1, 2, 3]"
-            )
-        return Cases(type=kind, joints={j: None for j in joints}, file=file, candidates=tuple(cands))
+    return dict.fromkeys(joints)
+
+
+def _suggestion(table: dict, path: Path, scenario: Scenario, designs: dict) -> Cases:
+    joints = _joint_names(table, path, scenario)
+    if not isinstance(table.get("file"), str):
+        raise DesignerError(f"{_where(path, 'cases.file')} is missing", 'give file = "suggestion.json"')
+    file = (path.parent / table["file"]).resolve()
+    cands = table.get("candidates", [])
+    if not isinstance(cands, list) or not all(isinstance(c, int) and c >= 1 for c in cands):
+        raise DesignerError(f"{_where(path, 'cases.candidates')} must list numbers >= 1", "e.g. [1, 2, 3]")
+    return Cases(type="suggestion", joints=joints, file=file, candidates=tuple(cands))
+
+
+def _montecarlo(table: dict, path: Path, scenario: Scenario, designs: dict) -> Cases:
     return Cases(
-        type=kind,
-        joints={j: None for j in joints},
+        type="montecarlo",
+        joints=_joint_names(table, path, scenario),
         n=_count(table, "n", path, None),
         seed=_count(table, "seed", path, 0, minimum=0),
         designs=designs,
     )
+
+
+#: the reader of each type of [cases] table (what it holds besides `type` and `designs`: CASE_KEYS)
+READERS: dict[str, Callable[[dict, Path, Scenario, dict], Cases]] = {
+    "grid": _grid,
+    "suggestion": _suggestion,
+    "montecarlo": _montecarlo,
+}
 
 
 def _cluster(doc: dict, path: Path) -> dict[str, Any]:
@@ -280,15 +298,32 @@ def check(spec: Spec) -> Spec:
             f"cases type {spec.cases.type!r} is unknown", f"use one of {', '.join(CASE_TYPES)}"
         )
     names = sc.sources()
+    for rule in CASE_RULES[spec.cases.type]:
+        rule(spec.cases)
     if not spec.cases.joints:
-        if spec.cases.type == "grid":
-            raise DesignerError("a grid sweep needs its axes", "give joints={'j1': {'k': [100, 200]}}")
         spec = dataclasses.replace(spec, cases=dataclasses.replace(spec.cases, joints=dict.fromkeys(names)))
     for j in spec.cases.joints:
         if j not in names:
             raise DesignerError(
                 f"the sweep varies joint '{j}' the scenario lacks", f"it has {', '.join(names)}"
             )
-    if spec.cases.type == "montecarlo" and not spec.cases.n:
-        raise DesignerError("a Monte Carlo sweep needs a number of draws", "give n (e.g. n = 200)")
     return spec
+
+
+def _grid_axes(cases: Cases) -> None:
+    if not cases.joints:
+        raise DesignerError("a grid sweep needs its axes", "give joints={'j1': {'k': [100, 200]}}")
+
+
+def _draw_count(cases: Cases) -> None:
+    if not cases.n:
+        raise DesignerError("a Monte Carlo sweep needs a number of draws", "give n (e.g. n = 200)")
+
+
+#: what `Cases` built in code must hold, by type, beyond the common checks (a suggestion sweep
+#: without joints varies them all)
+CASE_RULES: dict[str, tuple[Callable[[Cases], None], ...]] = {
+    "grid": (_grid_axes,),
+    "suggestion": (),
+    "montecarlo": (_draw_count,),
+}
