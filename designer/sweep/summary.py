@@ -9,10 +9,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import space, units
+from .. import units
 from ..cosim.rig_scenario import RigScenario
 from ..cosim.robot_scenario import RobotScenario
 from ..files import atomic_folder, atomic_path, atomic_write
+from ..study import space
 from .cases import Case
 from .engine import rollout_traces
 from .evaluate import RIG_METRICS, fmu_result, metrics
