@@ -21,6 +21,7 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import functools
+import importlib
 import itertools
 import shutil
 from collections import deque
@@ -161,29 +162,44 @@ def _same_instant_capable(md) -> bool:
     )
 
 
-class CoSimulation:
-    """Driving an FMU through its Co-Simulation interface: a step is DoStep(n h, h); its outputs are
-    those of its last step (not feedthrough)."""
+class FmiMode:
+    """How an FMU is driven (the master's view of one FMI interface): `name`, `feedthrough`, its
+    model description element (`element`) and fmpy's class (FMU2<fmpy>, FMU3<fmpy>)."""
 
-    name = "co-simulation"
-    feedthrough = False
+    name: str
+    feedthrough: bool
+    element: str
+    fmpy: str
 
     def interface(self, md):
-        """The model description's Co-Simulation element."""
-        return md.coSimulation
+        """The model description's element of this interface."""
+        return getattr(md, self.element)
 
     def fmpy_class(self, version: int) -> type:
         """fmpy's class for an instance of this interface in FMI `version`."""
-        if version == 3:
-            from fmpy.fmi3 import FMU3Slave
-
-            return FMU3Slave
-        from fmpy.fmi2 import FMU2Slave
-
-        return FMU2Slave
+        return getattr(importlib.import_module(f"fmpy.fmi{version}"), f"FMU{version}{self.fmpy}")
 
     def initialized(self, system: FmuSystem) -> None:
-        """Nothing to do after Initialization Mode: the instance is in Step Mode."""
+        """What follows Initialization Mode."""
+        raise NotImplementedError
+
+    def step(self, system: FmuSystem, h: float) -> None:
+        """One macro step of `h` s."""
+        raise NotImplementedError
+
+    def kernel_calls(self) -> list[str]:
+        """The FMI calls the compiled kernel makes per step besides set and get (binding.CALLS)."""
+        raise NotImplementedError
+
+
+class CoSimulation(FmiMode):
+    """Driving an FMU through its Co-Simulation interface: a step is DoStep(n h, h); its outputs are
+    those of its last step (not feedthrough)."""
+
+    name, feedthrough, element, fmpy = "co-simulation", False, "coSimulation", "Slave"
+
+    def initialized(self, system: FmuSystem) -> None:
+        """Nothing to do: the instance is in Step Mode."""
 
     def step(self, system: FmuSystem, h: float) -> None:
         """DoStep(n h, h)."""
@@ -191,34 +207,18 @@ class CoSimulation:
         system.steps += 1
 
     def kernel_calls(self) -> list[str]:
-        """The FMI calls the compiled kernel makes per step besides set and get (binding.CALLS)."""
         return ["step"]
 
 
-class ModelExchange:
+class ModelExchange(FmiMode):
     """Driving an FMU without states through its Model Exchange interface, so that its outputs follow
     inputs set at the same instant (feedthrough): a step is SetTime((n + 1) h), then
     CompletedIntegratorStep when the FMU needs it (`completed`), and an event iteration if it asks."""
 
-    name = "model-exchange"
-    feedthrough = True
+    name, feedthrough, element, fmpy = "model-exchange", True, "modelExchange", "Model"
 
     def __init__(self, completed: bool) -> None:
         self.completed = completed
-
-    def interface(self, md):
-        """The model description's Model Exchange element."""
-        return md.modelExchange
-
-    def fmpy_class(self, version: int) -> type:
-        """fmpy's class for an instance of this interface in FMI `version`."""
-        if version == 3:
-            from fmpy.fmi3 import FMU3Model
-
-            return FMU3Model
-        from fmpy.fmi2 import FMU2Model
-
-        return FMU2Model
 
     def initialized(self, system: FmuSystem) -> None:
         """The event iteration after Initialization Mode, into Continuous-Time Mode."""
@@ -232,7 +232,6 @@ class ModelExchange:
             system.completed(*system.fmu.completedIntegratorStep())
 
     def kernel_calls(self) -> list[str]:
-        """The FMI calls the compiled kernel makes per step besides set and get (binding.CALLS)."""
         return ["time", "completed"] if self.completed else ["time"]
 
 
@@ -268,9 +267,7 @@ class FmuSystem:
         self.description, self.name = md, name
         self.interface, self.version = md.interface, md.version
         if self.interface == "force" and _same_instant_capable(md.md):
-            self.mode: CoSimulation | ModelExchange = ModelExchange(
-                bool(md.md.modelExchange.needsCompletedIntegratorStep)
-            )
+            self.mode: FmiMode = ModelExchange(bool(md.md.modelExchange.needsCompletedIntegratorStep))
         else:
             self.mode = CoSimulation()
         self.kind, self.feedthrough = self.mode.name, self.mode.feedthrough
