@@ -66,35 +66,29 @@ def _probe(folder: Path, path: Path) -> None:
 def check_output(
     path: str | Path,
     *,
-    kind: str = "file",
     suffixes: Iterable[str] | None = None,
     estimate_bytes: float = 0,
     inputs: Iterable[str | Path] = (),
 ) -> Path:
-    """Check before any work that `path` can be written; returns it resolved.
+    """Check before any work that the file `path` can be written; returns it resolved.
 
     Args:
-        path: the file (or folder, when kind="folder") to be written.
-        kind: "file" (its folder must exist) or "folder" (made with its parents when missing).
+        path: the file to be written (its folder must exist).
         suffixes: accepted file suffixes, lower case with the dot (None: any).
         estimate_bytes: expected size; the target's disk must have this much free plus 1 MiB.
         inputs: the files the command reads; the output must not be one of them (writing it would
             replace the input, a raw log the user cannot make again).
 
     Raises:
-        DesignerError: a folder where a file is expected or the reverse, a wrong suffix, a folder that
-            is missing or cannot be written, an output that is an input, or too little free space.
+        DesignerError: a folder where a file is expected, a wrong suffix, a folder that is missing or
+            cannot be written, an output that is an input, or too little free space (with the estimate).
     """
-    if kind not in ("file", "folder"):
-        raise ValueError(f"kind={kind!r}: use 'file' or 'folder'")
     p = Path(path).expanduser().absolute()
-    if kind == "file" and p.is_dir():
+    if p.is_dir():
         raise DesignerError(
             f"cannot write {path}: it is a folder", f"give a file name, e.g. {Path(path) / 'out'}"
         )
-    if kind == "folder" and p.exists() and not p.is_dir():
-        raise DesignerError(f"cannot write into {path}: it is a file", "give a folder (new or existing)")
-    if suffixes is not None and kind == "file":
+    if suffixes is not None:
         allowed = sorted(suffixes)
         if p.suffix.lower() not in allowed:
             raise DesignerError(
@@ -107,13 +101,33 @@ def check_output(
                 f"cannot write {path}: it is the input {source}, which the output would replace",
                 "give the output another name",
             )
-    folder = p if (kind == "folder" and p.is_dir()) else p.parent
+    if not p.parent.is_dir():
+        raise DesignerError(f"cannot write {path}: folder {p.parent} does not exist", "create it first")
+    return _room(p, p.parent, path, estimate_bytes)
+
+
+def check_output_folder(path: str | Path, files: Iterable[str] = (), *, estimate_bytes: float = 0) -> Path:
+    """Check, before any work, that `path` is or can become a writable folder (made with its parents
+    when missing, by its writer) where none of `files` (the names the command writes into it) is a
+    folder; returns it resolved.
+
+    Raises:
+        DesignerError: `path` is a file, it (or its nearest existing parent) is not a writable folder,
+            one of `files` is a folder there, or its disk has too little free space for
+            `estimate_bytes` (with the estimate).
+    """
+    p = Path(path).expanduser().absolute()
+    if p.exists() and not p.is_dir():
+        raise DesignerError(f"cannot write into {path}: it is a file", "give a folder (new or existing)")
+    folder = p if p.is_dir() else _existing_ancestor(p)
     if not folder.is_dir():
-        if kind == "file":
-            raise DesignerError(f"cannot write {path}: folder {folder} does not exist", "create it first")
-        folder = _existing_ancestor(p)
-        if not folder.is_dir():
-            raise DesignerError(f"cannot create {path}: {folder} is not a folder", "choose another path")
+        raise DesignerError(f"cannot create {path}: {folder} is not a folder", "choose another path")
+    check_not_folders(p, files)
+    return _room(p, folder, path, estimate_bytes)
+
+
+def _room(p: Path, folder: Path, path: str | Path, estimate_bytes: float) -> Path:
+    """`p` once `folder` (where it goes) is writable and its disk has `estimate_bytes` free plus 1 MiB."""
     _probe(folder, Path(path))
     free = shutil.disk_usage(folder).free
     if estimate_bytes + _SPARE_BYTES > free:
@@ -415,19 +429,6 @@ def check_table_file(path: str | Path, *, parquet: bool) -> None:
                 f"cannot read {p}: it is separated by {used[0]}, not commas",
                 "save it as comma-separated CSV (decimal point '.'), or as Parquet",
             )
-
-
-def check_output_folder(path: str | Path, files: Iterable[str] = ()) -> Path:
-    """Check, before any work, that `path` is or can become a writable folder where none of `files`
-    (the names the command writes into it) is a folder; returns it.
-
-    Raises:
-        DesignerError: `path` is a file, it (or its nearest existing parent) is not writable, or one
-            of `files` is a folder there.
-    """
-    p = check_output(path, kind="folder")
-    check_not_folders(p, files)
-    return p
 
 
 def check_suffix(path: str | Path, suffixes: tuple[str, ...], *, what: str) -> Path:
