@@ -187,6 +187,10 @@ def simulate(
     if factors and len(factors) < 6:
         missing = ", ".join(f"--{n}" for n, v in given.items() if v is None)
         raise DesignerError(f"missing factor(s) {missing}", "give all six factors, or none")
+    if factors:
+        from designer.rig.logs import sidecar_path
+
+        check_output(sidecar_path(output))  # its name is longer than the log's with a shorter suffix
     with progress("simulating") as bar:
         df = run(
             {a: {"m": m, "c": c, "k": k} for a in axis},

@@ -84,6 +84,12 @@ def check_output(
             cannot be written, an output that is an input, or too little free space (with the estimate).
     """
     p = Path(path).expanduser().absolute()
+    size = len(os.fsencode(p.name))
+    if size > NAME_MAX:
+        raise DesignerError(
+            f"cannot write {path}: its name is {size} bytes, more than the {NAME_MAX} a file name can have",
+            "give a shorter name",
+        )
     if p.is_dir():
         raise DesignerError(
             f"cannot write {path}: it is a folder", f"give a file name, e.g. {Path(path) / 'out'}"
@@ -139,6 +145,24 @@ def _room(p: Path, folder: Path, path: str | Path, estimate_bytes: float) -> Pat
     return p
 
 
+#: the longest file name most file systems take, in bytes (ext4, XFS, Btrfs, tmpfs, APFS, NTFS)
+NAME_MAX = 255
+#: the bytes a temporary name adds to its affixes: mkstemp's 8 random characters
+_RANDOM = 8
+#: the longest suffix kept on a temporary file name (writers such as savefig read the format from it)
+_SUFFIX_MAX = 16
+
+
+def temporary_affixes(name: str, tail: str, suffix: str = "") -> tuple[str, str]:
+    """(prefix, suffix) for mkstemp/mkdtemp of a temporary entry beside `name`:
+    `.name.XXXXXXXX<tail><suffix>`, or `.XXXXXXXX<tail><suffix>` where that would pass NAME_MAX bytes (a
+    legal name of up to 255 bytes must be writable, not refused as "File name too long")."""
+    suffix = suffix if len(suffix.encode(errors="surrogateescape")) <= _SUFFIX_MAX else ""
+    prefix = f".{name}."
+    size = len((prefix + tail + suffix).encode(errors="surrogateescape")) + _RANDOM
+    return (prefix if size <= NAME_MAX else "."), tail + suffix
+
+
 def _followed(path: str | Path) -> Path:
     """`path` with symbolic links followed (the file to replace), unchanged when it is no link."""
     path = Path(path)
@@ -191,7 +215,8 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     path = _followed(path)
     parent = _check_dir(path)
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part" + path.suffix, dir=parent)
+        prefix, suffix = temporary_affixes(path.name, ".part", path.suffix)
+        fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=parent)
     except OSError as exc:
         raise _space_error(path, exc) from None
     os.close(fd)
@@ -231,7 +256,8 @@ def _move_in(stage: Path, target: Path) -> None:
     """Move every entry of `stage` into the existing folder `target`, replacing same-named files;
     a folder in the way of a file is refused before anything moves."""
     check_not_folders(target, [e.name for e in stage.iterdir() if not e.is_dir()])
-    trash = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".old", dir=target.parent))
+    prefix, suffix = temporary_affixes(target.name, ".old")
+    trash = Path(tempfile.mkdtemp(prefix=prefix, suffix=suffix, dir=target.parent))
     try:
         for entry in stage.iterdir():
             dest = target / entry.name
@@ -257,7 +283,8 @@ def atomic_folder(path: str | Path, files: Iterable[str] = ()) -> Iterator[Path]
     """
     target = _followed(check_output_folder(path, files))
     target.parent.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent))
+    prefix, suffix = temporary_affixes(target.name, ".part")
+    stage = Path(tempfile.mkdtemp(prefix=prefix, suffix=suffix, dir=target.parent))
     try:
         yield stage
         os.chmod(stage, 0o755)
@@ -357,7 +384,8 @@ def cache_entry(target: str | Path) -> Iterator[Path]:
     entry = target.parent
     try:
         entry.parent.mkdir(parents=True, exist_ok=True)
-        stage = Path(tempfile.mkdtemp(prefix=f".{entry.name}.", suffix=".part", dir=entry.parent))
+        prefix, suffix = temporary_affixes(entry.name, ".part")
+        stage = Path(tempfile.mkdtemp(prefix=prefix, suffix=suffix, dir=entry.parent))
     except OSError as exc:
         raise _space_error(entry, exc) from None
     try:
