@@ -160,7 +160,25 @@ def temporary_affixes(name: str, tail: str, suffix: str = "") -> tuple[str, str]
     suffix = suffix if len(suffix.encode(errors="surrogateescape")) <= _SUFFIX_MAX else ""
     prefix = f".{name}."
     size = len((prefix + tail + suffix).encode(errors="surrogateescape")) + _RANDOM
+    if not utf8(name + suffix):  # bytes that are not UTF-8: writers such as pyarrow refuse the path
+        return ".", tail + (suffix if utf8(suffix) else "")
     return (prefix if size <= NAME_MAX else "."), tail + suffix
+
+
+def utf8(text: str) -> bool:
+    """Whether `text` encodes as UTF-8: a path from bytes that are not UTF-8 (`l\\xff.csv` on the
+    command line) holds surrogate escapes, which many writers refuse."""
+    try:
+        text.encode()
+    except UnicodeEncodeError:
+        return False
+    return True
+
+
+def display_path(path: str | Path) -> str:
+    """`path` as text that can be written anywhere (JSON, XML, a Modelica comment, a hash): its bytes
+    that are not UTF-8 as \\xNN escapes."""
+    return os.fsencode(str(path)).decode("utf-8", "backslashreplace")
 
 
 def _followed(path: str | Path) -> Path:

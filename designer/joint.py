@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 from . import units
 from .errors import DesignerError, check_type, describe, number_argument, path_argument
+from .files import display_path
 from .mass import specimen_mass
 from .study import space
 
@@ -205,7 +206,7 @@ class Joint:
         where = "the suggestion"
         if not isinstance(suggestion, Suggestion):
             path = path_argument(suggestion, "suggestion", what="a suggestion (designer suggest --json)")
-            where = f"suggestion {path.name}"
+            where = f"suggestion {display_path(path.name)}"
             suggestion = Suggestion.load(path)
         n = len(suggestion.candidates)
         if not 1 <= number_argument(candidate, "candidate", example="1 (the best)") <= n:

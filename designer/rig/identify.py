@@ -19,6 +19,7 @@ import pandas as pd
 
 from .. import units
 from ..errors import DesignerError, describe, names_argument, number_argument
+from ..files import display_path
 from ..study import space
 from . import channel
 from .axis_fit import AxisFailed, AxisFit, StillAxis, check_time, fit_axis
@@ -214,7 +215,7 @@ def results_table(results: list[Identification]) -> pd.DataFrame:
             if all(r.axes[a].m_identified for r in results):
                 row[f"m_{a}"] = f.m
             row[f"r2_{a}"], row[f"nrmse_{a}"] = f.r2, f.nrmse
-        row["log"] = str(res.path)
+        row["log"] = display_path(res.path)  # a table cell: bytes that are not UTF-8 escaped
     table = pd.DataFrame(rows)
     front = list(space.FACTOR_NAMES) + [
         f"{q}_{a}" for a in axes for q in units.QUANTITIES if f"{q}_{a}" in table

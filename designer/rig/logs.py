@@ -441,7 +441,9 @@ def _read_frame(p: Path) -> pd.DataFrame:
     from ..files import check_table_file
 
     check_table_file(p, parquet=is_parquet(p))
-    table = pq.read_table(p) if is_parquet(p) else pacsv.read_csv(p)
+    # opened here: pyarrow refuses a path with bytes that are not UTF-8 (log\xff.csv), a file it reads
+    with open(p, "rb") as fh:
+        table = pq.read_table(fh) if is_parquet(p) else pacsv.read_csv(fh)
     return table.to_pandas(split_blocks=True, self_destruct=True)
 
 
