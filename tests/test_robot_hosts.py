@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import importlib.util
 import math
+import os
 import shutil
 from pathlib import Path
 
@@ -21,7 +22,7 @@ import numpy as np
 import pytest
 
 from designer.errors import DesignerError
-from designer.export.checks import joint_numbers, other_joint_changes, pose_changes
+from designer.export.checks import gain_changes, joint_numbers, other_joint_changes, pose_changes
 from designer.export.mjcf import export_mjcf
 from designer.export.urdf import export_urdf
 from designer.joint import Joint
@@ -350,3 +351,81 @@ def test_a_new_rest_on_a_joint_a_fixed_tendon_couples(copies, package, sub, file
     assert joint_numbers(after, name)["springref"][0] == pytest.approx(rest, rel=1e-12)
     assert other_joint_changes(before, after, name) == [] and pose_changes(before, after) == []
     assert any(n.startswith("springref: ") for n in out.notes), out.notes
+
+
+#: mesh-bearing robots of the installed packages: (package, folder linked whole, model in it, joint)
+MESH_HOSTS = [
+    # 11 meshes, 9 textures, 44 tendons; the arm joint that carries the hand
+    ("gymnasium_robotics", "envs/assets", "adroit_hand/adroit_hammer.xml", "ARRx"),
+    # 5 meshes (Kinova Jaco), a motor armature of 2 on the joint
+    ("dm_control", "third_party/kinova", "jaco_arm.xml", "joint_4"),
+]
+
+
+def _linked_folder(source: Path, target: Path) -> Path:
+    """`source`'s files linked into `target` (nothing copied, nothing written into site-packages:
+    the exports are new files beside the links, so the model's relative paths resolve as shipped)."""
+    shutil.copytree(source, target, copy_function=os.symlink, ignore=shutil.ignore_patterns("__pycache__"))
+    return target
+
+
+def _asset_files(model) -> list[str]:
+    """Each mesh and texture file a compiled model read, as the absolute path it resolved to."""
+    paths = bytes(model.paths)
+    out = []
+    for adr in (*model.mesh_pathadr, *model.tex_pathadr):
+        if adr >= 0:
+            out.append(os.path.abspath(paths[adr : paths.index(b"\0", adr)].decode()))
+    return out
+
+
+@pytest.mark.parametrize("package, sub, model, name", MESH_HOSTS)
+@pytest.mark.parametrize("form", ["parallel", "series"])
+def test_mesh_robots_from_their_own_folder_with_relative_paths(
+    tmp_path, monkeypatch, package, sub, model, name, form
+):
+    """As a user types it: in the robot's folder, relative --into and -o. MuJoCo stores asset file names
+    as the file was opened, so a check of the compiled model's name offsets saw 'a change' on every host
+    with two or more meshes (exit 3); what the assets mean is compared instead."""
+    source = _package_dir(package, sub)
+    if source is None or not source.is_dir():
+        pytest.skip(f"{package} is not installed")
+    folder = _linked_folder(source, tmp_path / "robot") / Path(model).parent
+    monkeypatch.chdir(folder)
+    host = Path(Path(model).name)
+    before = mujoco.MjModel.from_xml_path(str(host))
+    assert before.nmesh >= 2
+    out = export_mjcf(JOINT, Path(f"flex_{form}.xml"), into=host, joint_name=name, axis="theta", form=form)
+    assert out.path == Path(f"flex_{form}.xml") and out.path.is_file()
+    after = mujoco.MjModel.from_xml_path(str(out.path))
+    (_check_parallel if form == "parallel" else _check_series)(before, after, name, SI["theta"], out.notes)
+    for field in ("mesh_vert", "mesh_face", "mesh_normal", "tex_data", "geom_dataid"):
+        assert np.array_equal(getattr(before, field), getattr(after, field)), field
+    assert _asset_files(before) == _asset_files(after)
+    assert other_joint_changes(before, after, name) == [] and pose_changes(before, after) == []
+    assert gain_changes(before, after) == []
+
+
+def test_cli_into_a_mesh_robot_from_its_folder(tmp_path, monkeypatch, capsys):
+    """The command line the issue typed, in the robot's folder: exit 0 (it was 3)."""
+    from clitools import run_inprocess
+
+    source = _package_dir("dm_control", "third_party/kinova")
+    if source is None:
+        pytest.skip("dm_control is not installed")
+    monkeypatch.chdir(_linked_folder(source, tmp_path / "kinova"))
+    args = [
+        "export",
+        "mjcf",
+        "--into",
+        "jaco_arm.xml",
+        "--joint",
+        "joint_4",
+        "--k",
+        "224934",
+        "--c",
+        "4773.24",
+    ]
+    code, out, err = run_inprocess([*args, "--m", "1e-05", "--axis", "theta", "-o", "jaco_flex.xml"], capsys)
+    assert code == 0, err
+    assert Path("jaco_flex.xml").is_file() and "stiffness: 0 -> 224.9 (SI)" in out

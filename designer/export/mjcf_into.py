@@ -38,6 +38,10 @@ _DERIVED = {
     "tendon_invweight0",
     "tendon_lengthspring",
 }
+#: where a compiled model keeps its asset files' names (offsets into its `paths` string): MuJoCo stores
+#: them as the file was opened (a relative host, an absolute temporary file), so they differ with the
+#: same files; what the assets mean (mesh_vert, mesh_face, tex_data, hfield_data, skin_vert...) is compared
+_ASSET_NAMES = {"hfield_pathadr", "mesh_pathadr", "skin_pathadr", "tex_pathadr"}
 #: compiled-model arrays the parallel edit sets, per joint, degree of freedom or qpos entry
 _EDITED = {"jnt_stiffness": "jnt", "dof_damping": "dof", "dof_armature": "dof", "qpos_spring": "qpos"}
 #: what the advice's inertia is when it comes from the compiled robot
@@ -158,7 +162,7 @@ def _compare_parallel(before, after, joint_name: str, k: float, c: float) -> Non
     changed = []
     for name in dir(before):
         a = getattr(before, name)
-        if name.startswith("_") or not isinstance(a, np.ndarray) or name in _DERIVED:
+        if name.startswith("_") or not isinstance(a, np.ndarray) or name in _DERIVED | _ASSET_NAMES:
             continue
         b = getattr(after, name)
         if a.shape == b.shape and name in _EDITED:
