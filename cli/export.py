@@ -345,6 +345,11 @@ def _ssp(joint: Joint, output: Path, suggestion: Source, *, interface: str, syst
     )
 
 
+OUTSIDE_RANGE = _option(
+    "allow_outside_range",
+    Annotated[bool, typer.Option(help="accept a --rest outside the robot joint's range")],
+    False,
+)
 #: the options of `export mjcf` beyond the joint's: where it goes in a robot and how
 MJCF_OPTIONS = (
     INTO,
@@ -354,11 +359,7 @@ MJCF_OPTIONS = (
     _option("form", Annotated[str, typer.Option(help="parallel or series (motor -> flexure)")], "parallel"),
     _option("motor_inertia", Annotated[float | None, typer.Option(help="series: SI")], None),  # noqa: UP007
     _option("motor_bandwidth", Annotated[float | None, typer.Option(help="series: servo Hz")], None),  # noqa: UP007
-    _option(
-        "allow_outside_range",
-        Annotated[bool, typer.Option(help="accept a --rest outside the robot joint's range")],
-        False,
-    ),
+    OUTSIDE_RANGE,
 )
 #: the options of `export ssp` beyond the joint's
 SSP_OPTIONS = (
@@ -413,7 +414,7 @@ def _formats(snippet: Callable[..., None]) -> None:
         "a URDF chain (damping; spring in a <gazebo reference> extension)",
         _urdf,
         "designer export urdf --k 50 --c 0.5 --m 1e-5 --axis theta -o joint.urdf",
-        (INTO, ROBOT_JOINT, REST, AXIS_PICK),
+        (INTO, ROBOT_JOINT, REST, AXIS_PICK, OUTSIDE_RANGE),
     )
     snippet(
         "sdf",

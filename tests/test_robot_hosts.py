@@ -111,7 +111,11 @@ def _same_poses(before, after) -> None:
 def _check_parallel(before, after, name: str, si: dict, notes: tuple[str, ...]) -> None:
     old, new = joint_numbers(before, name), joint_numbers(after, name)
     assert new["stiffness"][0] == si["k"] and new["damping"][0] == si["c"]
-    assert new["springref"][0] == pytest.approx(old["springref"][0], rel=1e-12, abs=1e-15)
+    lo, hi = old["range"] if old["limited"][0] else (-np.inf, np.inf)
+    if lo <= old["springref"][0] <= hi:
+        assert new["springref"][0] == pytest.approx(old["springref"][0], rel=1e-12, abs=1e-15)
+    else:  # a host rest outside the range moves inside it, stated
+        assert lo - 1e-12 <= new["springref"][0] <= hi + 1e-12
     expected_armature = old["armature"][0] if old["armature"][0] > 0 else si["m"]
     assert new["armature"][0] == expected_armature
     for field in ("frictionloss", "ref", "range", "limited", "axis", "pos"):
@@ -120,7 +124,7 @@ def _check_parallel(before, after, name: str, si: dict, notes: tuple[str, ...]) 
     for field in ("stiffness", "damping", "armature"):
         if new[field][0] != old[field][0]:
             assert f"{field}: {old[field][0]:.4g} -> {new[field][0]:.4g}" in text, (field, text)
-    assert "springref kept" in text
+    assert "springref kept" in text or "lies outside the joint's range" in text
     if old["armature"][0] > 0:
         assert "armature kept" in text
 
@@ -240,8 +244,12 @@ def test_urdf_into_pybullet_data_robots(tmp_path, file, name):
     edited = etree.parse(str(out.path)).getroot()
     gz = edited.xpath("/robot/gazebo[@reference=$n]", n=name)
     assert len(gz) == 1
+    limit = root.xpath("/robot/joint[@name=$n]/limit", n=name)
+    span = (float(limit[0].get("lower", 0)), float(limit[0].get("upper", 0))) if limit else (-np.inf, np.inf)
+    rest = min(max(0.0, span[0]), span[1])  # no host springReference: 0, or the limits' nearest value
     assert (
-        float(gz[0].findtext("springStiffness")) == si["k"] and float(gz[0].findtext("springReference")) == 0
+        float(gz[0].findtext("springStiffness")) == si["k"]
+        and float(gz[0].findtext("springReference")) == rest
     )
     if name in out.advice:  # the links the joint moves state their inertia
         assert "flags=p.URDF_USE_INERTIA_FROM_FILE" in out.advice[name].text()
@@ -314,6 +322,11 @@ def test_urdf_into_pybullet_data_robots_gives_drake_the_spring(tmp_path, file, n
     )
     prismatic = "finger" in name
     axis, rest, span = ("x", 0.01, 0.02) if prismatic else ("theta", 0.3, 1.0)
+    from lxml import etree
+
+    limit = etree.parse(str(host)).getroot().xpath("/robot/joint[@name=$n]/limit", n=name)
+    if limit and not float(limit[0].get("lower", 0)) <= rest <= float(limit[0].get("upper", 0)):
+        rest = (float(limit[0].get("lower", 0)) + float(limit[0].get("upper", 0))) / 2  # inside, as required
     try:
         drake_joint_torque(folder / host.name, name, [0.0], prismatic=prismatic)
     except (

@@ -269,17 +269,20 @@ def _parallel_values(
     }
     new = {"stiffness": si["k"], "damping": si["c"]}
     notes = []
+    span = tuple(float(v) for v in h.model.jnt_range[j.id]) if h.model.jnt_limited[j.id] else None
     if rest is None:
-        notes.append(f"springref kept at the host's {old['springref']:.4g} {unit} (give rest to set it)")
+        keys = {
+            f"keyframe '{h.model.key(k).name or k}'": float(h.model.key_qpos[k][adr])
+            for k in range(h.model.nkey)
+        }
+        rest, moved = robot.rest_inside(old["springref"], span, unit, "springref", keys)
+        if moved is None:
+            notes.append(f"springref kept at the host's {old['springref']:.4g} {unit} (give rest to set it)")
+        else:
+            notes.append(moved)
+            new["springref"] = rest
     else:
-        lo, hi = (float(v) for v in h.model.jnt_range[j.id])
-        if h.model.jnt_limited[j.id] and not lo <= rest <= hi and not allow_outside_range:
-            raise DesignerError(
-                f"rest={rest:g} {unit} is outside the range [{lo:.4g}, {hi:.4g}] {unit} of robot joint "
-                f"'{joint_name}'",
-                "give a rest inside the range, or allow_outside_range=True if the spring should preload "
-                "the joint against its limit",
-            )
+        robot.check_rest(rest, span, joint_name, unit, allow_outside_range)
         new["springref"] = rest
     if old["armature"] > 0:
         notes.append(

@@ -172,12 +172,30 @@ def _host_values(root, element, joint_name: str) -> dict[str, float]:
     return old
 
 
+def _span(element) -> tuple[float, float] | None:
+    """A revolute or prismatic URDF joint's `<limit lower upper>` (URDF's defaults 0); None for a
+    continuous joint, which has no range."""
+    if element.get("type") == "continuous":
+        return None
+    limit = element.find("limit")
+    get = (lambda n: 0.0) if limit is None else (lambda n: float(limit.get(n, 0)))
+    return get("lower"), get("upper")
+
+
 def _into_urdf(
-    joint: Joint, host: Path, *, joint_name: str, axis: str | None, rest: float | None
+    joint: Joint,
+    host: Path,
+    *,
+    joint_name: str,
+    axis: str | None,
+    rest: float | None,
+    allow_outside_range: bool = False,
 ) -> tuple[bytes, dict[str, robot.StepAdvice], tuple[str, ...]]:
     """The host URDF's bytes with `joint_name`'s damping and Gazebo spring set, the rest as written;
     the joint's step advice (none when the links it moves declare no inertia); one note per host
-    value changed or kept (old -> new, SI). `rest` None keeps the host's springReference (else 0)."""
+    value changed or kept (old -> new, SI). `rest` None keeps the host's springReference (else 0)
+    when it lies inside the joint's limits, else takes the limits' nearest value (stated); a given
+    `rest` outside them is refused unless `allow_outside_range`, as in MJCF."""
     from lxml import etree
 
     if not host.is_file():
@@ -205,10 +223,14 @@ def _into_urdf(
     si = joint.axes[a].si()
     old = _host_values(root, found[0], joint_name)
     notes = []
+    span, unit = _span(found[0]), "rad" if rot else "m"
     if rest is None:
-        rest = old.get("springReference", 0.0)
+        host_rest = old.get("springReference", 0.0)
+        rest, moved = robot.rest_inside(host_rest, span, unit, "springReference")
         how = "kept at the host's" if "springReference" in old else "set to"
-        notes.append(f"springReference {how} {rest:.4g} (give rest to set it)")
+        notes.append(moved or f"springReference {how} {rest:.4g} (give rest to set it)")
+    else:
+        robot.check_rest(rest, span, joint_name, unit, allow_outside_range)
     new = {"damping": si["c"], "springStiffness": si["k"], "springReference": rest}
     notes += [
         f"{tag}: {'none' if tag not in old else format(old[tag], '.4g')} -> {v:.4g} (SI)"
@@ -299,14 +321,16 @@ def export_urdf(
     joint_name: str | None = None,
     axis: str | None = None,
     rest: float | None = None,
+    allow_outside_range: bool = False,
 ) -> robot.RobotExport:
     """Write `joint` as URDF at `path` (.urdf) and return the path and the stated step advice.
 
     Standalone: a chain of links with real masses (see `urdf_text`), every spring at `rest`. With
     `into` (a URDF file) and
     `joint_name`: a copy of that robot with the joint's damping set and a Gazebo spring extension
-    (stiffness, and `rest` in rad or m as springReference); its links are left as they are (URDF has
-    no armature, so the flexure's own moving inertia is not added). The advice uses the inertia the
+    (stiffness, and `rest` in rad or m as springReference: None keeps the host's when it lies inside
+    the joint's limits; outside them a given rest is refused unless `allow_outside_range`); its links
+    are left as they are (URDF has no armature, so the flexure's own moving inertia is not added). The advice uses the inertia the
     joint moves according to the links' `<inertial>` (see `urdf_inertia`).
 
     Raises:
@@ -318,7 +342,14 @@ def export_urdf(
         if joint_name is None:
             raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
         check_type(joint_name, str, "joint_name", expected="a name", fix="give e.g. joint_name='knee'")
-        data, advice, notes = _into_urdf(joint, Path(into), joint_name=joint_name, axis=axis, rest=rest)
+        data, advice, notes = _into_urdf(
+            joint,
+            Path(into),
+            joint_name=joint_name,
+            axis=axis,
+            rest=rest,
+            allow_outside_range=allow_outside_range,
+        )
         with atomic_path(path) as tmp:
             tmp.write_bytes(data)
         return robot.RobotExport(path, advice, notes + READERS)

@@ -1,0 +1,134 @@
+"""What an export into a robot does with the host's own values, checked by stepping MuJoCo:
+a spring rest outside the joint's range (MJCF and URDF alike), `dampratio` actuators whose damping
+MuJoCo derives from the mass matrix, and, in series, which joint carries the host's friction, spring
+and damping."""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from designer.errors import DesignerError
+from designer.export.checks import gain_changes, other_joint_changes, pose_changes
+from designer.export.mjcf import export_mjcf
+from designer.export.urdf import export_urdf
+from designer.joint import Joint
+
+mujoco = pytest.importorskip("mujoco")
+
+#: SI: k 0.5 N.m/rad, c 0.01 N.m.s/rad, J 1e-5 kg.m^2
+JOINT = Joint.from_coefficients({"theta": {"k": 500.0, "c": 10.0, "m": 1e-5}})
+SI = JOINT.axes["theta"].si()
+
+#: a Panda-like arm: joint4's range excludes 0 (MuJoCo's default springref), the home keyframe
+#: bends it, and position servos hold the home pose
+PANDA_LIKE = """<mujoco model="arm">
+  <compiler angle="radian"/>
+  <option timestep="0.001"/>
+  <worldbody>
+    <body name="upper">
+      <joint name="joint1" type="hinge" axis="0 0 1" range="-2.9 2.9" damping="1"/>
+      <geom type="capsule" fromto="0 0 0 0 0 0.3" size="0.04" mass="2"/>
+      <body name="fore" pos="0 0 0.3">
+        <joint name="joint4" type="hinge" axis="0 1 0" range="-3.0718 -0.0698" damping="1"/>
+        <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03" mass="1.5"/>
+      </body>
+    </body>
+  </worldbody>
+  <actuator>
+    <position name="a1" joint="joint1" kp="300" kv="20"/>
+    <position name="a4" joint="joint4" kp="300" kv="20"/>
+  </actuator>
+  <keyframe>
+    <key name="home" qpos="0 -1.571" ctrl="0 -1.571"/>
+  </keyframe>
+</mujoco>
+"""
+
+
+def _held_from_home(path: Path, seconds: float = 3.0) -> float:
+    """joint4's angle after `seconds` from the home keyframe under the robot's own servos."""
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
+    mujoco.mj_step(model, data, nstep=round(seconds / model.opt.timestep))
+    return float(data.qpos[model.joint("joint4").qposadr[0]])
+
+
+def test_parallel_rest_outside_the_range_takes_the_keyframe_and_says_so(tmp_path):
+    """Before: the host's springref 0 (outside [-3.07, -0.07]) was kept silently and the edited arm,
+    reset to home under its own servos, drifted off its pose."""
+    host = tmp_path / "arm.xml"
+    host.write_text(PANDA_LIKE)
+    assert _held_from_home(host) == pytest.approx(-1.571, abs=1e-3)
+    # 50 N.m/rad, a sixth of the servo's stiffness: a spring resting at 0 pulls joint4 0.23 rad off (measured)
+    stiff = Joint.from_coefficients({"theta": {"k": 5e4, "c": 100.0, "m": 1e-5}})
+    out = export_mjcf(stiff, tmp_path / "flex.xml", into=host, joint_name="joint4")
+    model = mujoco.MjModel.from_xml_path(str(out.path))
+    assert model.qpos_spring[model.joint("joint4").qposadr[0]] == -1.571
+    text = " | ".join(out.notes)
+    assert "outside the joint's range [-3.072, -0.0698] rad" in text
+    assert "the keyframe 'home' pose's -1.571 rad" in text and "springref: 0 -> -1.571 (SI)" in text
+    # the stiff flexure no longer pulls the joint off the pose its servo holds
+    assert _held_from_home(out.path) == pytest.approx(-1.571, abs=1e-3)
+    # without a keyframe inside the range: the range's value nearest the host's springref
+    bare = tmp_path / "bare.xml"
+    bare.write_text(PANDA_LIKE.replace('"0 -1.571"', '"0 -3.2"'))
+    out = export_mjcf(JOINT, tmp_path / "flex2.xml", into=bare, joint_name="joint4")
+    assert "the range's nearest value -0.0698 rad" in " | ".join(out.notes)
+    model = mujoco.MjModel.from_xml_path(str(out.path))
+    assert model.qpos_spring[model.joint("joint4").qposadr[0]] == -0.0698
+
+
+def test_ant_ankle_rest_moves_inside_its_range(tmp_path):
+    """gymnasium's ant (angles in degrees, no keyframe): ankle_1's range [30, 70] deg excludes its
+    springref 0; the rest becomes 30 deg, written in degrees, and nothing else of the ant changes."""
+    spec = importlib.util.find_spec("gymnasium")
+    if spec is None:
+        pytest.skip("gymnasium is not installed")
+    source = Path(next(iter(spec.submodule_search_locations))) / "envs/mujoco/assets/ant.xml"
+    host = tmp_path / "ant.xml"
+    host.write_bytes(source.read_bytes())
+    before = mujoco.MjModel.from_xml_path(str(host))
+    out = export_mjcf(JOINT, tmp_path / "flex.xml", into=host, joint_name="ankle_1")
+    after = mujoco.MjModel.from_xml_path(str(out.path))
+    assert after.qpos_spring[after.joint("ankle_1").qposadr[0]] == pytest.approx(math.radians(30), rel=1e-12)
+    assert "the range's nearest value 0.5236 rad" in " | ".join(out.notes)
+    assert other_joint_changes(before, after, "ankle_1") == [] and pose_changes(before, after) == []
+
+
+def example_robot_data() -> Path:
+    """example-robot-data's installed share folder (the `package://example-robot-data/` of its URDFs)."""
+    import importlib.metadata
+
+    try:
+        dist = importlib.metadata.distribution("example-robot-data")
+    except importlib.metadata.PackageNotFoundError:
+        pytest.skip("example-robot-data is not installed")
+    return Path(dist.locate_file("cmeel.prefix/share/example-robot-data"))
+
+
+def _panda_urdf() -> Path:
+    return example_robot_data() / "robots/panda_description/urdf/panda.urdf"
+
+
+def test_urdf_rest_checked_against_the_joint_limits_as_mjcf(tmp_path):
+    """Before: URDF --into never looked at <limit>: rest 3 on panda_joint4 (-3.07..-0.07) was written."""
+    host = _panda_urdf()
+    with pytest.raises(DesignerError, match=r"rest=3 rad is outside the range \[-3.072, -0.0698\] rad") as no:
+        export_urdf(JOINT, tmp_path / "p.urdf", into=host, joint_name="panda_joint4", rest=3.0)
+    assert "\n" not in str(no.value) and not (tmp_path / "p.urdf").exists()
+    out = export_urdf(JOINT, tmp_path / "p.urdf", into=host, joint_name="panda_joint4")
+    text = " | ".join(out.notes)
+    assert "springReference: the host's 0 rad lies outside the joint's range [-3.072, -0.0698] rad" in text
+    assert "<springReference>-0.0698</springReference>" in out.path.read_text()
+    out = export_urdf(
+        JOINT, tmp_path / "q.urdf", into=host, joint_name="panda_joint4", rest=3.0, allow_outside_range=True
+    )
+    assert "<springReference>3.0</springReference>" in out.path.read_text()
+    out = export_urdf(JOINT, tmp_path / "r.urdf", into=host, joint_name="panda_joint4", rest=-1.0)
+    assert "<springReference>-1.0</springReference>" in out.path.read_text()
