@@ -330,8 +330,8 @@ def export_urdf(
     `joint_name`: a copy of that robot with the joint's damping set and a Gazebo spring extension
     (stiffness, and `rest` in rad or m as springReference: None keeps the host's when it lies inside
     the joint's limits; outside them a given rest is refused unless `allow_outside_range`); its links
-    are left as they are (URDF has no armature, so the flexure's own moving inertia is not added). The advice uses the inertia the
-    joint moves according to the links' `<inertial>` (see `urdf_inertia`).
+    are left as they are (URDF has no armature, so the flexure's own moving inertia is not added).
+    The advice uses the inertia the joint moves according to the links' `<inertial>` (see `urdf_inertia`).
 
     Raises:
         DesignerError: a wrong suffix, a missing mass, or an `into` problem.
