@@ -2,7 +2,8 @@
 
 The snippet declares no `<compiler>`, `<option>` or `<default>`: `<include>`-ing it changes nothing
 global in the host. Every value it writes is angle-unit free (stiffness, damping and inertia are per
-radian whatever the compiler's angle; springref is 0). Into a robot: see `mjcf_into` (parallel) and `mjcf_series`.
+radian whatever the compiler's angle; springref is 0). Into a robot: see `mjcf_into` (parallel) and
+`mjcf_series`.
 """
 
 from __future__ import annotations
