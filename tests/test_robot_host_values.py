@@ -132,3 +132,55 @@ def test_urdf_rest_checked_against_the_joint_limits_as_mjcf(tmp_path):
     assert "<springReference>3.0</springReference>" in out.path.read_text()
     out = export_urdf(JOINT, tmp_path / "r.urdf", into=host, joint_name="panda_joint4", rest=-1.0)
     assert "<springReference>-1.0</springReference>" in out.path.read_text()
+
+
+#: a G1-like leg: position servos whose damping MuJoCo derives from dampratio (a class default and
+#: one on the element), a general actuator with dampratio in its bias, joints without armature
+DAMPRATIO_HOST = """<mujoco model="leg">
+  <compiler angle="radian"/>
+  <default>
+    <position kp="80" dampratio="1"/>
+  </default>
+  <worldbody>
+    <body name="thigh">
+      <joint name="hip" type="hinge" axis="0 1 0" range="-1.5 1.5"/>
+      <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.04" mass="3"/>
+      <body name="shin" pos="0 0 -0.3">
+        <joint name="knee" type="hinge" axis="0 1 0" range="0 2.5"/>
+        <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03" mass="2"/>
+        <body name="foot" pos="0 0 -0.3">
+          <joint name="ankle" type="hinge" axis="0 1 0" range="-0.8 0.8"/>
+          <geom type="box" size="0.08 0.03 0.02" mass="0.5"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+  <actuator>
+    <position name="hip_servo" joint="hip"/>
+    <position name="knee_servo" joint="knee" kp="120" dampratio="0.7"/>
+    <general name="ankle_servo" joint="ankle" biastype="affine" gainprm="40" biasprm="0 -40 1"/>
+  </actuator>
+</mujoco>
+"""
+
+
+@pytest.mark.parametrize("form", ["parallel", "series"])
+def test_dampratio_actuators_keep_the_gains_the_host_compiled(tmp_path, form):
+    """Before: series moved the knee servo's damping gain (the motor body changes the mass matrix MuJoCo
+    derives it from) and printed nothing; parallel into a joint without armature was an internal
+    error (actuator_biasprm)."""
+    host = tmp_path / "leg.xml"
+    host.write_text(DAMPRATIO_HOST)
+    before = mujoco.MjModel.from_xml_path(str(host))
+    out = export_mjcf(JOINT, tmp_path / f"{form}.xml", into=host, joint_name="knee", form=form)
+    after = mujoco.MjModel.from_xml_path(str(out.path))
+    assert gain_changes(before, after) == []
+    for name in ("hip_servo", "knee_servo", "ankle_servo"):
+        assert np.array_equal(before.actuator(name).biasprm, after.actuator(name).biasprm), name
+    text = " | ".join(out.notes)
+    kv = -before.actuator("knee_servo").biasprm[2]
+    assert "3 actuator(s) with dampratio keep the damping gain the host compiled" in text
+    assert f"knee_servo dampratio 0.7 -> kv {kv:.4g}" in text
+    if form == "series":  # the knee servo now drives the motor joint
+        assert after.actuator("knee_servo").trnid[0] == after.joint("knee_motor").id
+    assert other_joint_changes(before, after, "knee") == [] and pose_changes(before, after) == []

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..joint import Joint
 from . import robot, xmltext
+from .mjcf_derived import dampratio_gains, gains_into_text, gains_note
 from .mjcf_host import (
     MASS_MATRIX_BASIS,
     Host,
@@ -89,7 +90,8 @@ def into_parallel(
 
     Sets stiffness and damping; springref to `rest` (SI, the joint's qpos, written in the host's
     angle unit; None keeps the host's); armature to the axis' moving mass only where the host has
-    none (a host armature, the motor's reflected inertia, is kept). Returns the step advice for the
+    none (a host armature, the motor's reflected inertia, is kept), and then the host's `dampratio`
+    actuators' damping gains as it compiled them (see `mjcf_derived`). Returns the step advice for the
     joint (inertia from the compiled model's mass matrix, other joints held, at the reference pose)
     and one note per host value changed or kept (old -> new, SI).
 
@@ -105,6 +107,10 @@ def into_parallel(
     raw = h.path.read_bytes()
     encoding = h.tree.docinfo.encoding or "utf-8"
     text = _retag(raw.decode(encoding), joint_name, values)
+    if "armature" in values:  # the mass matrix changes: dampratio gains are kept as compiled
+        gains = dampratio_gains(h)
+        text = gains_into_text(text, gains)
+        notes += tuple(gains_note(gains, "the flexure's armature"))
     si = joint.axes[a].si()
     check = partial(_compare_parallel, h.model, joint_name=joint_name, k=si["k"], c=si["c"])
     after = write_checked(h, path, check, text.encode(encoding))

@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import DesignerError
 from ..joint import Joint
 from . import robot
-from .mjcf_derived import freeze_springdampers
+from .mjcf_derived import dampratio_gains, freeze_springdampers, gains_into_tree, gains_note
 from .mjcf_host import (
     MASS_MATRIX_BASIS,
     Host,
@@ -288,6 +288,9 @@ def into_series(
         f"joint's was {host_armature:.4g})"
     )
     notes += freeze_springdampers(h, joint_name)
+    gains = dampratio_gains(h)
+    gains_into_tree(h, gains)
+    notes += gains_note(gains, "the motor body")
     _extend_keys(h, joint_name, keys, rest, servo_added=not moved)
     _flexure(h, joint, a, rest, notes)
     for attr, value in (("ref", "0"), ("limited", "false")):
