@@ -184,3 +184,51 @@ def test_dampratio_actuators_keep_the_gains_the_host_compiled(tmp_path, form):
     if form == "series":  # the knee servo now drives the motor joint
         assert after.actuator("knee_servo").trnid[0] == after.joint("knee_motor").id
     assert other_joint_changes(before, after, "knee") == [] and pose_changes(before, after) == []
+
+
+#: an Apollo/Cassie-like knee: drive friction 7.7 N.m, a 1500 N.m/rad spring, damping 1, a stiff servo
+KNEE_HOST = """<mujoco model="knee">
+  <compiler angle="radian"/>
+  <option timestep="0.0005" gravity="0 0 0"/>
+  <worldbody>
+    <body name="shin">
+      <joint name="knee" type="hinge" axis="0 1 0" range="-2 0.2" frictionloss="7.7" stiffness="1500"
+             springref="-0.5" damping="1"/>
+      <geom type="capsule" fromto="0 0 0 0 0 -0.4" size="0.03" mass="2"/>
+    </body>
+  </worldbody>
+  <actuator>
+    <position name="knee_servo" joint="knee" kp="3000" kv="60"/>
+  </actuator>
+</mujoco>
+"""
+
+
+def test_series_puts_the_drive_friction_and_spring_on_the_motor_and_says_so(tmp_path):
+    """Before: the flexure kept the host's 7.7 N.m frictionloss (a 5 N.m load deflected it 0.0284 rad in
+    2 s, not 5 / k = 0.0293) and the motor the 1500 N.m/rad spring, while the notes said 'stiffness 1500
+    -> 170.6' of the flexure. Now the flexure is only the flexure: a static load deflects it by load / k."""
+    host = tmp_path / "knee.xml"
+    host.write_text(KNEE_HOST)
+    flex = Joint.from_coefficients({"theta": {"k": 170600.0, "c": 2000.0, "m": 1e-4}})
+    k = flex.axes["theta"].si()["k"]
+    out = export_mjcf(flex, tmp_path / "sea.xml", into=host, joint_name="knee", form="series", rest=0.0)
+    model = mujoco.MjModel.from_xml_path(str(out.path))
+    knee, motor = model.joint("knee"), model.joint("knee_motor")
+    assert (knee.frictionloss[0], knee.stiffness[0]) == (0.0, k)
+    assert (motor.frictionloss[0], motor.stiffness[0], motor.damping[0]) == (7.7, 1500.0, 1.0)
+    assert motor.qpos_spring[0] == -0.5
+    text = " | ".join(out.notes)
+    assert "knee is now the flexure (SI): stiffness 170.6, damping 2, armature 0.0001" in text
+    assert "frictionloss 0; nothing of the host joint's own" in text
+    assert (
+        "knee_motor, the drive, carries the host joint's (SI): stiffness 1500 about springref -0.5 rad, "
+        "damping 1, frictionloss 7.7" in text
+    )
+    # 5 N.m on the link, the servo holding the motor at the spring's rest: the flexure deflects 5 / k
+    data = mujoco.MjData(model)
+    data.qpos[motor.qposadr[0]] = -0.5
+    data.ctrl[model.actuator("knee_servo").id] = -0.5
+    data.xfrc_applied[model.body("shin").id, 3:] = [0.0, 5.0, 0.0]  # torque about the joint axis y
+    mujoco.mj_step(model, data, nstep=4000)
+    assert data.qpos[knee.qposadr[0]] == pytest.approx(5.0 / k, rel=1e-3)

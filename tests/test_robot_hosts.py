@@ -136,14 +136,21 @@ def _check_series(before, after, name: str, si: dict, notes: tuple[str, ...]) ->
         joint_numbers(after, f"{name}_motor"),
     )
     assert new["stiffness"][0] == si["k"] and new["damping"][0] == si["c"] and new["armature"][0] == si["m"]
-    assert new["springref"][0] == 0.0 and new["limited"][0] == 0
-    for field in ("range", "limited", "axis", "ref"):
+    assert new["springref"][0] == 0.0 and new["limited"][0] == 0 and new["frictionloss"][0] == 0
+    # the motor joint is the drive: the host joint's range, spring, friction (and damping, plus an
+    # added servo's derivative gain)
+    for field in ("range", "limited", "axis", "ref", "stiffness", "springref", "frictionloss"):
         assert np.array_equal(old[field], motor[field]), field
     text = " | ".join(notes)
-    assert (
-        f"{name} is now the flexure" in text
-        and f"stiffness {old['stiffness'][0]:.4g} -> {si['k']:.4g}" in text
+    assert f"{name} is now the flexure (SI): stiffness {si['k']:.4g}, damping {si['c']:.4g}" in text
+    drive = (
+        f"{name}_motor, the drive, carries the host joint's (SI): stiffness {old['stiffness'][0]:.4g} about "
+        f"springref {old['springref'][0]:.4g}"
     )
+    assert drive in text and f"frictionloss {old['frictionloss'][0]:.4g}" in text
+    assert motor["damping"][0] >= old["damping"][0]
+    if "servo's derivative gain" not in text:
+        assert motor["damping"][0] == old["damping"][0]
     if before.nkey:
         assert f"{before.nkey} keyframe(s) extended" in text
     if old["limited"][0]:

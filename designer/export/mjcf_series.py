@@ -8,6 +8,7 @@ reference configuration and every other joint its numbers.
 from __future__ import annotations
 
 import copy
+from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
 
@@ -34,10 +35,10 @@ _FRAME = ("pos", "quat", "euler", "axisangle", "xyaxes", "zaxis")
 
 
 def _flexure(host: Host, joint: Joint, a: str, rest: float, notes: list[str]) -> dict[str, str]:
-    """Set the joint element's stiffness, damping, armature (moving inertia, if known) and springref;
-    return them as written."""
+    """Set the joint element's stiffness, damping, armature (moving inertia, if known), springref and
+    frictionloss 0 (the drive's friction is the motor joint's); return them as written."""
     si = joint.axes[a].si()
-    values = {"stiffness": si["k"], "damping": si["c"], "springref": host.angle(rest)}
+    values = {"stiffness": si["k"], "damping": si["c"], "springref": host.angle(rest), "frictionloss": 0.0}
     if si["m"] is not None:
         values["armature"] = si["m"]
     values = {attr: robot.num(v) for attr, v in values.items()}
@@ -47,15 +48,30 @@ def _flexure(host: Host, joint: Joint, a: str, rest: float, notes: list[str]) ->
     return values
 
 
-def _insert_motor(host: Host, joint_name: str, motor: robot.Sphere, servo: robot.Servo) -> int:
-    """Put a motor body between the joint's body and its parent; return how many actuators moved to it.
+@dataclass(frozen=True)
+class Drive:
+    """What the motor joint carries of the host joint (SI, as the host compiled them): its spring
+    (stiffness about springref), damping, friction; `servo_kv` the added servo's derivative gain, which
+    adds to the damping (0 when the host's actuators moved to the motor); `moved` those actuators."""
+
+    stiffness: float
+    springref: float
+    damping: float
+    frictionloss: float
+    servo_kv: float
+    moved: int
+
+
+def _insert_motor(host: Host, joint_name: str, motor: robot.Sphere, servo: robot.Servo) -> Drive:
+    """Put a motor body between the joint's body and its parent; return what its joint carries.
 
     The motor body (inertial `motor`) takes the link body's place and frame attributes; the link sits
     in it at the identity. The motor joint is a copy of the host joint (type, axis, range...) with the
     servo's armature; joints written before the host joint in its body move with it, so the joints
-    still act in the host's order. Actuators
-    on the host joint now drive the motor joint; without any, `servo` is added as a position actuator
-    (its derivative gain as the motor joint's damping).
+    still act in the host's order. The motor joint is the drive: it carries the host joint's spring,
+    damping and friction as the host compiled them (written out: a class default or a springdamper
+    cannot change them). Actuators on the host joint now drive the motor joint; without any, `servo`
+    is added as a position actuator (its derivative gain added to the motor joint's damping).
     """
     from lxml import etree
 
@@ -70,6 +86,16 @@ def _insert_motor(host: Host, joint_name: str, motor: robot.Sphere, servo: robot
     motor_joint = copy.deepcopy(host.element)
     motor_joint.set("name", f"{joint_name}_motor")
     motor_joint.set("armature", robot.num(servo.motor_inertia))
+    j = host.model.joint(joint_name)
+    own = {
+        "stiffness": float(j.stiffness[0]),
+        "damping": float(j.damping[0]),
+        "frictionloss": float(j.frictionloss[0]),
+    }
+    for attr, value in own.items():
+        motor_joint.set(attr, robot.num(value))
+    if float(host.spec.joint(joint_name).springdamper[0]) > 0:
+        motor_joint.set("springdamper", "0 0")
     comment = etree.Comment(f" flexjoint designer: the motor of series-elastic joint {joint_name} ")
     # joints before this one in its body act before it: they move to the motor body, in order
     before = []
@@ -87,7 +113,7 @@ def _insert_motor(host: Host, joint_name: str, motor: robot.Sphere, servo: robot
     for act in moved:
         act.set("joint", f"{joint_name}_motor")
     if not moved:
-        motor_joint.set("damping", robot.num(servo.kv))
+        motor_joint.set("damping", robot.num(own["damping"] + servo.kv))
         section = root.find("actuator")
         if section is None:
             section = etree.SubElement(root, "actuator")
@@ -97,7 +123,15 @@ def _insert_motor(host: Host, joint_name: str, motor: robot.Sphere, servo: robot
             'ctrllimited="false"/>'
         )
         section.append(etree.fromstring(servo_xml))
-    return len(moved)
+    springref = float(host.model.qpos_spring[j.qposadr[0]])
+    return Drive(
+        own["stiffness"],
+        springref,
+        own["damping"],
+        own["frictionloss"],
+        0.0 if moved else servo.kv,
+        len(moved),
+    )
 
 
 def _key_layout(host: Host, joint_name: str) -> dict[str, int]:
@@ -142,12 +176,13 @@ def _extend_keys(host: Host, joint_name: str, at: dict[str, int], rest: float, *
             key.set(name, " ".join(values))
 
 
-def _compare_series(before, after, joint_name: str, k: float, c: float) -> None:
+def _compare_series(before, after, joint_name: str, k: float, c: float, servo_kv: float) -> None:
     """Raise unless every host body keeps its world pose and every host joint its numbers.
 
     MuJoCo numbers bodies and joints in the file's depth-first order, so the inserted motor body and
     joint shift the ids after them by one; the host joint is compared with the motor joint, which
-    took over its type, axis and range.
+    took over its type, axis, range, spring, friction and damping (plus an added servo's `servo_kv`);
+    the flexure has no friction.
     """
     import mujoco
 
@@ -168,13 +203,14 @@ def _compare_series(before, after, joint_name: str, k: float, c: float) -> None:
     ]
     for i in range(before.njnt):
         mine, theirs = before.joint(i), after.joint(shifted(i, motor_joint + 1))
-        fields = (
-            ("type", "range", "axis", "limited")
-            if i == motor_joint
-            else ("type", "range", "axis", "limited", "stiffness", "armature", "damping")
-        )
-        if not all(np.array_equal(getattr(mine, f), getattr(theirs, f)) for f in fields):
+        fields = ("type", "range", "axis", "limited", "stiffness", "frictionloss", "qpos_spring")
+        fields += ("damping",) if i == motor_joint else ("armature", "damping")
+        same = all(np.array_equal(getattr(mine, f), getattr(theirs, f)) for f in fields[:-1])
+        damping = mine.damping + servo_kv if i == motor_joint else mine.damping
+        if not (same and np.array_equal(damping, theirs.damping)):
             changed.append(mine.name or f"joint {i}")
+    if after.joint(joint_name).frictionloss[0] != 0:
+        changed.append(f"{joint_name} (the flexure keeps a frictionloss)")
     if changed:
         raise RuntimeError(f"the series edit changed host bodies or joints: {', '.join(changed)}")
     check_joint(after, joint_name, k, c)
@@ -199,20 +235,21 @@ def _refuse_limit_sensors(host: Host, joint_name: str) -> None:
         )
 
 
-def _series_notes(host: Host, joint_name: str, si: dict, moved: int, rest: float) -> list[str]:
-    """What the series edit did to the host's own values, one sentence each (SI)."""
+def _series_notes(host: Host, joint_name: str, si: dict, drive: Drive, rest: float) -> list[str]:
+    """What the series edit did to the host's own values, one sentence each (SI): which joint carries
+    each of them now."""
     j = host.model.joint(joint_name)
-    dof, adr = j.dofadr[0], j.qposadr[0]
+    adr = j.qposadr[0]
     unit = "rad" if host.hinge else "m"
-    old = (float(j.stiffness[0]), float(host.model.dof_damping[dof]), float(host.model.dof_armature[dof]))
-    new = (si["k"], si["c"], si["m"])
+    damping = f"damping {drive.damping:.4g}"
+    if drive.servo_kv:
+        total = drive.damping + drive.servo_kv
+        damping += f" + the added servo's derivative gain {drive.servo_kv:.4g} = {total:.4g}"
     notes = [
-        f"{joint_name} is now the flexure (SI): "
-        + ", ".join(
-            f"{n} {a:.4g} -> {b:.4g}"
-            for n, a, b in zip(("stiffness", "damping", "armature"), old, new, strict=True)
-        )
-        + f", springref {float(host.model.qpos_spring[adr]):.4g} -> {rest:.4g} {unit}"
+        f"{joint_name} is now the flexure (SI): stiffness {si['k']:.4g}, damping {si['c']:.4g}, armature "
+        f"{si['m']:.4g}, springref {rest:.4g} {unit}, frictionloss 0; nothing of the host joint's own",
+        f"{joint_name}_motor, the drive, carries the host joint's (SI): stiffness {drive.stiffness:.4g} "
+        f"about springref {drive.springref:.4g} {unit}, {damping}, frictionloss {drive.frictionloss:.4g}",
     ]
     if j.limited[0]:
         lo, hi = (float(v) for v in j.range)
@@ -222,8 +259,8 @@ def _series_notes(host: Host, joint_name: str, si: dict, moved: int, rest: float
             f"{joint_name}'s ref {float(host.model.qpos0[adr]):.4g} {unit} -> 0 (the motor keeps it)"
         )
     notes.append(
-        f"{moved} actuator(s) moved from {joint_name} to {joint_name}_motor"
-        if moved
+        f"{drive.moved} actuator(s) moved from {joint_name} to {joint_name}_motor"
+        if drive.moved
         else f"position servo {joint_name}_motor added (no actuator drove {joint_name})"
     )
     keys = host.model.nkey
@@ -281,8 +318,8 @@ def into_series(
         bandwidth=motor_bandwidth,
     )
     keys = _key_layout(h, joint_name)
-    moved = _insert_motor(h, joint_name, clamp, servo)
-    notes = _series_notes(h, joint_name, si, moved, rest)
+    drive = _insert_motor(h, joint_name, clamp, servo)
+    notes = _series_notes(h, joint_name, si, drive, rest)
     notes.append(
         f"{joint_name}_motor armature {servo.motor_inertia:.4g} (the motor's reflected inertia; the host "
         f"joint's was {host_armature:.4g})"
@@ -291,17 +328,19 @@ def into_series(
     gains = dampratio_gains(h)
     gains_into_tree(h, gains)
     notes += gains_note(gains, "the motor body")
-    _extend_keys(h, joint_name, keys, rest, servo_added=not moved)
+    _extend_keys(h, joint_name, keys, rest, servo_added=not drive.moved)
     _flexure(h, joint, a, rest, notes)
     for attr, value in (("ref", "0"), ("limited", "false")):
         h.element.set(attr, value)
-    check = partial(_compare_series, h.model, joint_name=joint_name, k=si["k"], c=si["c"])
+    check = partial(
+        _compare_series, h.model, joint_name=joint_name, k=si["k"], c=si["c"], servo_kv=drive.servo_kv
+    )
     after = write_checked(h, path, check)
     diag = mass_diagonal(after)
     flex_dof, motor_dof = after.joint(joint_name).dofadr[0], after.joint(f"{joint_name}_motor").dofadr[0]
     held = {"basis": MASS_MATRIX_BASIS.replace("the other joints held", "the motor and other joints held")}
     advice = {joint_name: step_advice(si["k"], si["c"], diag[flex_dof], **held)}
-    if not moved:
+    if not drive.moved:
         held = {
             "basis": MASS_MATRIX_BASIS.replace("the other joints held", "the flexure and other joints held")
         }
