@@ -42,9 +42,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import printers as truth  # noqa: E402
 
 import designer  # noqa: E402
-from designer.calibration import new_printer  # noqa: E402
-from designer.doe import plan_next  # noqa: E402
-from designer.suggestions import DISTINCT, _distance  # noqa: E402
+from designer.design.search import DISTINCT, distance
+from designer.model.calibration import new_printer
+from designer.study.doe import plan_next
 
 TOLERANCE = 0.10
 CANONICAL = {"k_x_N_per_mm": "k_x", "c_x_Ns_per_mm": "c_x"}
@@ -81,7 +81,7 @@ def loop(study, printer, goals, fixed, rng, max_prints, stated, policy="next"):
             # no print proposed (stop, or the calibrated model finds the target out of reach): the
             # recommendation itself, the nearest design
             design = nxt.prints[0].params if nxt.prints else rec.params
-            is_rec = not nxt.prints or _distance(design, rec.params, SPANS) <= DISTINCT
+            is_rec = not nxt.prints or distance(design, rec.params, SPANS) <= DISTINCT
         targets = {q: v for q, v in goals.items() if q == "k"}
         hit, run = _lands(printer, design, rng, targets)
         if is_rec:

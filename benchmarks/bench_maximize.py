@@ -26,7 +26,7 @@ import cdp  # noqa: E402
 from test_profile_browser import _design  # noqa: E402
 from test_profile_console import _set_goal  # noqa: E402
 
-from designer import space  # noqa: E402
+from designer.study import space
 
 
 def _case(page, rnd: random.Random) -> tuple[list[str], dict]:

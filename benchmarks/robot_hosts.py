@@ -52,7 +52,7 @@ def main() -> int:
     import mujoco
 
     from designer.errors import DesignerError
-    from designer.export.checks import gain_changes, joint_numbers, other_joint_changes, pose_changes
+    from designer.validate.export import gain_changes, joint_numbers, other_joint_changes, pose_changes
     from designer.export.mjcf import export_mjcf
     from designer.joint import Joint
 

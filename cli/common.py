@@ -16,7 +16,7 @@ import typer
 from rich.console import Console
 
 from designer.errors import DesignerError
-from designer.space import FACTOR_NAMES
+from designer.study.space import FACTOR_NAMES
 
 #: set by `finishing()`, cleared by each `run()`: the command is writing its outputs and a stop signal
 #: no longer interrupts it; LATE_STOP is the signal that came meanwhile (None: none did)
@@ -78,7 +78,7 @@ def parse_fix(
     """
     import difflib
 
-    from designer import space
+    from designer.study import space
 
     pairs: dict[str, float] = {}
     for item in items or []:
@@ -197,3 +197,53 @@ def flag_message(text: str) -> str:
     for pattern, flag in FLAGS:
         text = re.sub(pattern, flag, text)
     return text
+
+
+AxisOpt = Annotated[str, typer.Option("--axis", help="Axis: x y z theta phi psi.")]
+ToleranceOpt = Annotated[
+    float, typer.Option("--tolerance", help="Band around a target that counts as met, % (+-).")
+]
+
+
+def load_surrogate(path: Path | None):
+    """The surrogate of a --surrogate flag: that file, or the shipped one for None."""
+    from designer.model.surrogate import Surrogate
+
+    return Surrogate.load() if path is None else Surrogate.load(path)
+
+
+def parse_goal(text: str | None, flag: str) -> float | str | None:
+    """A goal flag's value: a number in rig units, or min or max."""
+    if text is None:
+        return None
+    if text.strip().lower() in ("min", "max"):
+        return text.strip().lower()
+    try:
+        return float(text)
+    except ValueError:
+        raise DesignerError(
+            f"{flag} '{text}' is not a number, min or max", f"write e.g. {flag} 0.8 or {flag} max"
+        ) from None
+
+
+def pi_text(p: dict) -> str:
+    """A prediction's to_dict() as 'value [low, high]': three significant digits, bounds two."""
+    return f"{p['value']:.3g} [{p['low']:.2g}, {p['high']:.2g}]"
+
+
+def answer(data: dict, as_json: bool, show: Callable[[dict], None]) -> None:
+    """Print a design answer (JSON, or `show`'s table and sentences); exit 1 when it is negative
+    (`data["reachable"]` False: the output still says why and what comes nearest)."""
+    if as_json:
+        print_json(data)
+    else:
+        show(data)
+    if not data["reachable"]:
+        raise typer.Exit(1)
+
+
+def tolerance_fraction(percent: float) -> float:
+    """--tolerance in % as a fraction, refused outside (0, 100)."""
+    if not 0 < percent < 100:
+        raise DesignerError(f"--tolerance {percent:g} is not between 0 and 100 %", "give e.g. --tolerance 10")
+    return percent / 100

@@ -57,7 +57,7 @@ def _verdict(val: dict) -> tuple[list[str], bool]:
     its error against the fine reference falls at least first-order (Gauss-Seidel) as the step halves."""
     import math
 
-    from designer.cosim.checks import COSIM_ORDER, COSIM_SAME_STEP
+    from designer.validate.cosim import COSIM_ORDER, COSIM_SAME_STEP
 
     steps = sorted(val["steps"], key=lambda r: -r["step"])
     ok = True

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated
 
@@ -11,46 +10,23 @@ import typer
 from designer.errors import DesignerError
 
 from .common import (
+    AxisOpt,
     DataOpt,
     FixOpt,
     JsonOpt,
     SurrogateOpt,
+    ToleranceOpt,
+    answer,
     console,
+    load_surrogate,
     output_option,
     parse_fix,
+    parse_goal,
+    pi_text,
     print_json,
     progress,
+    tolerance_fraction,
 )
-
-AxisOpt = Annotated[str, typer.Option("--axis", help="Axis: x y z theta phi psi.")]
-ToleranceOpt = Annotated[
-    float, typer.Option("--tolerance", help="Band around a target that counts as met, % (+-).")
-]
-
-
-def _load(path: Path | None):
-    from designer.surrogate import Surrogate
-
-    return Surrogate.load() if path is None else Surrogate.load(path)
-
-
-def _parse_goal(text: str | None, flag: str) -> float | str | None:
-    """A goal flag's value: a number in rig units, or min or max."""
-    if text is None:
-        return None
-    if text.strip().lower() in ("min", "max"):
-        return text.strip().lower()
-    try:
-        return float(text)
-    except ValueError:
-        raise DesignerError(
-            f"{flag} '{text}' is not a number, min or max", f"write e.g. {flag} 0.8 or {flag} max"
-        ) from None
-
-
-def _pi(p: dict) -> str:
-    """A prediction's to_dict() as 'value [low, high]': three significant digits, bounds two."""
-    return f"{p['value']:.3g} [{p['low']:.2g}, {p['high']:.2g}]"
 
 
 def fit(
@@ -65,9 +41,9 @@ def fit(
 
     Example: designer fit --data my_runs.csv -o my_surrogate.json
     """
-    from designer.data import load_table
     from designer.files import check_output
-    from designer.surrogate import Surrogate
+    from designer.model.surrogate import Surrogate
+    from designer.study.data import load_table
 
     if out is not None:
         check_output(out, suffixes=[".json"])
@@ -136,14 +112,15 @@ def predict(
 
     Example: designer predict --density 60 --length 24 --width 4.5 --height 9 --layer 0.16 --raster 0
     """
-    from designer import space, units
-    from designer.suggestions import predictability
+    from designer import units
+    from designer.design.suggestions import predictability
+    from designer.study import space
 
     params = space.check_design(
         dict(density=density, length=length, width=width, height=height, layer=layer, raster=raster),
         allow_extrapolation,
     )
-    sur = _load(surrogate)
+    sur = load_surrogate(surrogate)
     units.check_axis(axis)
     preds = sur.predict(params, responses=[f"k_{axis}", f"c_{axis}"], allow_extrapolation=allow_extrapolation)
     info = predictability(sur, axis)
@@ -179,7 +156,7 @@ def predict(
     for q in ("k", "c"):
         p = predicted[q]
         console.print(
-            f"{q}_{axis} = {_pi(p)} {p['unit']}  (value [95 % PI]; nested LOO Q2 = {p['loo_q2']:.2f})"
+            f"{q}_{axis} = {pi_text(p)} {p['unit']}  (value [95 % PI]; nested LOO Q2 = {p['loo_q2']:.2f})"
         )
         if not p["predictable"]:
             console.print(f"  [yellow]{info[q]['statement']}[/yellow]")
@@ -236,34 +213,23 @@ def suggest(
 
     Example: designer suggest --k 0.8 --c 2e-3 --fix raster=0 --top 3
     """
-    from designer.suggestions import suggest as run_suggest
+    from designer.design.suggestions import suggest as run_suggest
 
     _positive(importance_k=importance_k, importance_c=importance_c, weight_k=weight_k, weight_c=weight_c)
     result = run_suggest(
-        _load(surrogate),
-        k=_parse_goal(k, "--k"),
-        c=_parse_goal(c, "--c"),
+        load_surrogate(surrogate),
+        k=parse_goal(k, "--k"),
+        c=parse_goal(c, "--c"),
         axis=axis,
         fixed=parse_fix(fix),
         top=top,
         importance={"k": importance_k, "c": importance_c},
         bounds={"k": (k_low, k_high), "c": (c_low, c_high)},
         weight={"k": weight_k, "c": weight_c},
-        tolerance=_tolerance(tolerance),
+        tolerance=tolerance_fraction(tolerance),
         allow_extrapolation=allow_extrapolation,
     )
     answer(result.to_dict(), as_json, _print_suggestion)
-
-
-def answer(data: dict, as_json: bool, show: Callable[[dict], None]) -> None:
-    """Print a design answer (JSON, or `show`'s table and sentences); exit 1 when it is negative
-    (`data["reachable"]` False: the output still says why and what comes nearest)."""
-    if as_json:
-        print_json(data)
-    else:
-        show(data)
-    if not data["reachable"]:
-        raise typer.Exit(1)
 
 
 def _positive(**values: float) -> None:
@@ -272,12 +238,6 @@ def _positive(**values: float) -> None:
         if not v > 0:
             flag = "--" + name.replace("_", "-")
             raise DesignerError(f"{flag} {v:g} must be positive", f"give e.g. {flag} 1")
-
-
-def _tolerance(percent: float) -> float:
-    if not 0 < percent < 100:
-        raise DesignerError(f"--tolerance {percent:g} is not between 0 and 100 %", "give e.g. --tolerance 10")
-    return percent / 100
 
 
 def _cell(cand: dict, name: str) -> str:
@@ -315,7 +275,7 @@ def _print_suggestion(data: dict) -> None:
         tab.add_row(
             str(i),
             *[_cell(cand, n) for n in names],
-            *[_pi(cand["predicted"][q]) for q in ("k", "c")],
+            *[pi_text(cand["predicted"][q]) for q in ("k", "c")],
             "-" if cand["p_within"] is None else f"{cand['p_within']:.2f}",
             "-" if cand["desirability"] is None else f"{cand['desirability']:.2f}",
         )

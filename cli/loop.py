@@ -7,8 +7,23 @@ from typing import Annotated
 
 import typer
 
-from .common import FixOpt, JsonOpt, SurrogateOpt, console, output_option, parse_fix, print_json, progress
-from .design import AxisOpt, ToleranceOpt, _load, _parse_goal, _pi, _tolerance, answer
+from .common import (
+    AxisOpt,
+    FixOpt,
+    JsonOpt,
+    SurrogateOpt,
+    ToleranceOpt,
+    answer,
+    console,
+    load_surrogate,
+    output_option,
+    parse_fix,
+    parse_goal,
+    pi_text,
+    print_json,
+    progress,
+    tolerance_fraction,
+)
 
 #: the calibrate report's significant digits for a factor and its interval
 _FACTOR = "{:.2f}"
@@ -32,13 +47,13 @@ def calibrate(
 
     Example: designer calibrate my_runs.csv -o mine.json
     """
-    from designer.calibration import calibrate as run_calibrate
-    from designer.calibration import report
     from designer.files import check_output
+    from designer.model.calibration import calibrate as run_calibrate
+    from designer.model.calibration import report
 
     if out is not None:
         check_output(out, suffixes=[".json"])
-    calibrated = run_calibrate(_load(surrogate), runs)
+    calibrated = run_calibrate(load_surrogate(surrogate), runs)
     if out is not None:
         calibrated.save(out)
     data = report(calibrated) | {"out": str(out) if out else None}
@@ -100,17 +115,17 @@ def next_(
 
     Example: designer next --k 0.8 --n 3 --surrogate mine.json
     """
-    from designer.next_prints import next_prints
+    from designer.design.next_prints import next_prints
 
     with progress("choosing the next prints", enabled=not as_json) as bar:
         result = next_prints(
-            _load(surrogate),
-            k=_parse_goal(k, "--k"),
-            c=_parse_goal(c, "--c"),
+            load_surrogate(surrogate),
+            k=parse_goal(k, "--k"),
+            c=parse_goal(c, "--c"),
             axis=axis,
             fixed=parse_fix(fix),
             n=n,
-            tolerance=_tolerance(tolerance),
+            tolerance=tolerance_fraction(tolerance),
             stop=stop,
             progress=bar,
         )
@@ -128,14 +143,14 @@ def _print_next(data: dict) -> None:
     rec = data["recommendation"]
     console.print(f"Design #1 now: {_design(rec['params'])}")
     console.print(
-        f"  k {_pi(rec['predicted']['k'])}, c {_pi(rec['predicted']['c'])}; "
+        f"  k {pi_text(rec['predicted']['k'])}, c {pi_text(rec['predicted']['c'])}; "
         f"lands within +-{100 * data['tolerance']:g} % with probability {data['p_now']:.2f}"
     )
     for i, p in enumerate(data["prints"], 1):
         mark = " (design #1 itself)" if p["recommended"] else ""
         console.print(f"Print {i}{mark}: {_design(p['params'])}")
         console.print(
-            f"  predicted k {_pi(p['predicted']['k'])}, c {_pi(p['predicted']['c'])}; {p['reason']}"
+            f"  predicted k {pi_text(p['predicted']['k'])}, c {pi_text(p['predicted']['c'])}; {p['reason']}"
         )
     for s in data["statements"]:
         console.print(f"- {s}")

@@ -52,8 +52,8 @@ def effects_cmd(
 
     Example: designer plot effects --response k --axis x -o effects.png
     """
-    from designer.data import load_table
     from designer.plots import common, effects
+    from designer.study.data import load_table
 
     _image_out(output)
     t = load_table(table)
@@ -79,9 +79,9 @@ def heatmap_cmd(
 
     Example: designer plot heatmap -o heatmap.png
     """
-    from designer.data import load_table
     from designer.plots import common, heatmap
-    from designer.stats import correlation
+    from designer.study.data import load_table
+    from designer.study.stats import correlation
 
     _image_out(output)
     t = load_table(table)
@@ -100,7 +100,7 @@ Surrogate = Annotated[
 
 
 def _surrogate(path: Path | None):
-    from designer.surrogate import Surrogate as _S
+    from designer.model.surrogate import Surrogate as _S
 
     return _S.load() if path is None else _S.load(path)
 
@@ -162,7 +162,7 @@ def space_cmd(
         f"{resp} from {view.value_range[0]:.4g} to {view.value_range[1]:.4g} {view.unit} (held: {held})"
     )
     if not sur.model(resp).predictable:
-        from designer.suggestions import predictability
+        from designer.design.suggestions import predictability
 
         console.print(predictability(sur, axis)[response]["statement"])
     if target is not None:
@@ -268,7 +268,7 @@ def _read_series(path: Path):
     if not path.is_file():
         raise DesignerError(f"no such file: {path}", "give a CSV or Parquet time series")
     try:
-        from designer.data import read_frame
+        from designer.study.data import read_frame
 
         return read_frame(path)
     except (ValueError, OSError, pd.errors.ParserError, UnicodeDecodeError) as exc:
@@ -289,7 +289,7 @@ def validate_cmd(
     Example: designer validate -o report/
     """
     from designer.files import check_output
-    from designer.report import validate
+    from designer.validate.report import validate
 
     check_output(output, kind="folder", estimate_bytes=20e6)
     quiet_mujoco()
@@ -352,9 +352,9 @@ def profile_cmd(
 
     Example: designer profile --target k=0.8 -o profiler.html
     """
-    from designer import space
     from designer.errors import DesignerError
     from designer.plots import profile
+    from designer.study import space
 
     if not 0 < tolerance < 100:
         raise DesignerError(

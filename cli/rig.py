@@ -60,7 +60,7 @@ def identify(
     passed = [r for r in results if r.ok]
     wrote = output is not None and bool(passed)
     if wrote:
-        from designer.data import write_frame
+        from designer.study.data import write_frame
 
         write_frame(results_table(passed), output)
     if json_out:
@@ -237,9 +237,9 @@ def clean(
 
     Example: designer clean table.csv -o clean.csv
     """
-    from designer.data import read_frame, write_frame
     from designer.files import check_output
     from designer.rig.clean import clean as run
+    from designer.study.data import read_frame, write_frame
 
     if output is not None:
         check_output(output, suffixes=TABLE_SUFFIXES)
@@ -302,8 +302,8 @@ def doe(
     Example: designer doe --seed 1 -o plan.csv
     Example: designer doe --augment 8 --k 0.8 --c 2e-3 -o next.csv
     """
-    from designer import doe as plans
     from designer.files import check_output
+    from designer.study import doe as plans
 
     if output is not None:
         check_output(output, suffixes=TABLE_SUFFIXES)
@@ -342,7 +342,7 @@ def _check_augment(plans, n: int) -> None:
 
 
 def _augment(plans, n: int, k: float | None, c: float | None, axis: str, data: Path | None):
-    from designer.surrogate import Surrogate
+    from designer.model.surrogate import Surrogate
 
     if n < 1:
         raise DesignerError(f"--augment {n}", "give the number of specimens to add, 1 or more")
@@ -357,7 +357,7 @@ def _finish_plan(plan, output: Path | None, json_out: bool, narrowing: dict) -> 
     from designer import units
 
     if output is not None:
-        from designer.data import write_frame
+        from designer.study.data import write_frame
 
         write_frame(plan, output)
     if json_out:
@@ -394,8 +394,8 @@ def analyze(
 
     Example: designer analyze --json
     """
-    from designer.data import load_table
-    from designer.stats import analyze as run
+    from designer.study.data import load_table
+    from designer.study.stats import analyze as run
 
     res = run(load_table(data))
     if json_out:

@@ -30,13 +30,13 @@ __version__ = "0.1.0"
 
 #: public name -> module that defines it (imported on first access)
 _PUBLIC = {
-    "load_table": "data",
-    "Surrogate": "surrogate",
-    "Prediction": "surrogate",
-    "suggest": "suggestions",
-    "Suggestion": "suggestions",
-    "calibrate": "calibration",
-    "next_prints": "next_prints",
+    "load_table": "study.data",
+    "Surrogate": "model.surrogate",
+    "Prediction": "model.prediction",
+    "suggest": "design.suggestions",
+    "Suggestion": "design.candidates",
+    "calibrate": "model.calibration",
+    "next_prints": "design.next_prints",
     "Joint": "joint",
     "export_fmu": "export",
     "export_modelica": "export",

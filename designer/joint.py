@@ -12,13 +12,15 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from . import space, units
+from . import units
 from .errors import DesignerError, check_type, describe, number_argument, path_argument
 from .mass import specimen_mass
+from .study import space
 
 if TYPE_CHECKING:
-    from .suggestions import Suggestion
-    from .surrogate import Prediction, Surrogate
+    from .design.candidates import Suggestion
+    from .model.prediction import Prediction
+    from .model.surrogate import Surrogate
 
 #: Howell's pseudo-rigid-body characteristic radius factor for a fixed-guided/cantilever beam
 PRB_GAMMA = 0.85
@@ -156,7 +158,7 @@ class Joint:
             fix = "give params={'density': 60, 'length': 24, 'width': 4.5, ...} with all six factors"
             raise DesignerError(f"params is {describe(params)}, not a mapping of factors", fix)
         params = space.check_design(params, allow_extrapolation)
-        from .surrogate import Surrogate
+        from .model.surrogate import Surrogate
 
         if surrogate is None:
             surrogate = Surrogate.load()
@@ -198,7 +200,7 @@ class Joint:
         Raises:
             DesignerError: the file is not a suggestion, or the candidate does not exist.
         """
-        from .suggestions import Suggestion
+        from .design.candidates import Suggestion
 
         where = "the suggestion"
         if not isinstance(suggestion, Suggestion):
@@ -227,7 +229,7 @@ class Joint:
             "source": f"{where.removeprefix('the ')}, candidate {candidate}",
             "params": params,
             "surrogate": suggestion.surrogate_id,
-            "targets": {q: t.value if t.kind == "target" else t.kind for q, t in suggestion.targets.items()},
+            "targets": {q: t.goal for q, t in suggestion.targets.items()},
             "desirability": cand.desirability,
             "reachable": suggestion.reachable,
         }

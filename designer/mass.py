@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from .space import NOZZLE_MM, WALL_MM
+from .study.space import NOZZLE_MM, WALL_MM
 from .units import MM, TPU_DENSITY
 
 

@@ -80,7 +80,7 @@ def assert_clean_failure(code: int, err: str, allowed=(1, 2)) -> None:
 
 
 def bundled_table() -> pd.DataFrame:
-    from designer.data import load_table
+    from designer.study.data import load_table
 
     return load_table()
 
@@ -170,8 +170,8 @@ def _make_logs(folder: Path) -> None:
 
 
 def _make_suggestions(folder: Path) -> None:
-    from designer.suggestions import suggest
-    from designer.surrogate import Surrogate
+    from designer.design.suggestions import suggest
+    from designer.model.surrogate import Surrogate
 
     good = suggest(Surrogate.load(), k=0.8, top=2).to_dict()
     (folder / "suggestion.json").write_text(json.dumps(good))

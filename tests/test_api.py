@@ -21,7 +21,7 @@ def test_public_names_are_there_and_documented():
     for name in designer.__all__:
         obj = getattr(designer, name)
         assert obj.__doc__, name
-    assert list(designer.load_table().columns[:6]) == list(designer.space.FACTOR_NAMES)
+    assert list(designer.load_table().columns[:6]) == list(designer.study.space.FACTOR_NAMES)
     assert callable(designer.cosim.run) and callable(designer.cosim.write_outputs)
 
 
@@ -47,7 +47,7 @@ def test_a_nan_response_is_refused_with_column_and_row():
 def test_an_unfitted_surrogate_does_not_predict():
     with pytest.raises(DesignerError, match="not fitted"):
         designer.Surrogate().predict(DESIGN)
-    from designer.surrogate import ResponseSurface
+    from designer.model.prediction import ResponseSurface
 
     with pytest.raises(DesignerError, match="not fitted"):
         ResponseSurface("k_x", "linear").predict({k: [v] for k, v in DESIGN.items()})
@@ -159,7 +159,12 @@ def test_the_api_tour_runs_with_public_names_only(tmp_path):
 def test_public_functions_are_not_hidden_by_submodules():
     import importlib
 
-    for module in ("designer.suggestions", "designer.surrogate", "designer.joint", "designer.rig.identify"):
+    for module in (
+        "designer.design.suggestions",
+        "designer.model.surrogate",
+        "designer.joint",
+        "designer.rig.identify",
+    ):
         importlib.import_module(module)
     assert callable(designer.suggest) and not isinstance(designer.suggest, type(designer))
     assert callable(designer.identify) and not isinstance(designer.identify, type(designer))

@@ -13,9 +13,9 @@ from clitools import assert_clean_failure, run_inprocess
 from test_cli_campaign import SIX
 
 import designer
-from designer.calibration import CalibratedSurface, noise_of
-from designer.space import check_design
-from designer.surrogate import Surrogate
+from designer.model.correction import CalibratedSurface, noise_of
+from designer.model.surrogate import Surrogate
+from designer.study.space import check_design
 
 sys.path.insert(0, str(Path(__file__).parent))
 import printers  # noqa: E402
@@ -66,7 +66,7 @@ def test_one_run_at_a_study_design_moves_the_prediction_by_the_models_amount(stu
     X.loc[X[["width", "height"]].min(axis=1) <= 2.0, "density"] = 100.0  # as printed: walls fill 2 mm
     from sklearn.gaussian_process.kernels import Matern
 
-    from designer.calibration import coded
+    from designer.model.correction import coded
 
     p = base.predict(X)
     s0 = _log_sd(p, base.t95)
@@ -99,12 +99,12 @@ def test_the_correction_predicts_each_study_run_from_the_others_with_calibrated_
     (measured: k sd 0.94, 91 % inside; c sd 1.07, 95 % inside)."""
     from scipy import stats
 
-    from designer.calibration import _correlation, _local_sd, _log_moments, _settings_of, coded
-    from designer.surrogate import _as_printed
+    from designer.model.correction import _correlation, _local_sd, _log_moments, coded, settings_of
+    from designer.model.forms import as_printed
 
     base = study.model(response)
-    length, amplitude, noise = _settings_of(study, response)
-    X = _as_printed({n: np.asarray(study.training[n], dtype=float) for n in FACTORS})
+    length, amplitude, noise = settings_of(study, response)
+    X = as_printed({n: np.asarray(study.training[n], dtype=float) for n in FACTORS})
     y = np.asarray(study.training[response], dtype=float)
     mu0, s0 = _log_moments(base, X)
     sg = amplitude * _local_sd(s0, noise)
@@ -129,7 +129,7 @@ def test_printer_factor_of_one_half_is_recovered_within_its_interval(study, tabl
 
 
 def test_interval_narrows_near_measured_designs_and_stays_wide_elsewhere(study, table):
-    from designer.calibration import coded
+    from designer.model.correction import coded
 
     runs = _rows(table, [3, 10, 20, 30])
     cal = designer.calibrate(study, runs)
@@ -277,7 +277,8 @@ def test_cli_calibrate_bad_input(tmp_path, capsys, content, words):
 
 
 def test_a_new_printer_carries_the_printer_factor_and_the_studys_own_runs(study, table):
-    from designer.calibration import PRINTER_SD, new_printer
+    from designer.model.calibration import new_printer
+    from designer.model.correction import PRINTER_SD
 
     fresh = new_printer(study)
     X = table[FACTORS]

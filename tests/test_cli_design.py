@@ -128,7 +128,7 @@ def test_bad_input_one_line_exit_2(args, message):
 
 
 def test_constant_factor_table_is_one_line(tmp_path):
-    from designer import data
+    from designer.study import data
 
     t = data.load_table()
     t["raster"] = 0.0

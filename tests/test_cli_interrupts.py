@@ -231,7 +231,7 @@ def test_a_stop_turned_into_another_exception_is_still_a_stop(tmp_path, monkeypa
     from designer_cli import main as m
 
     import designer.rig.clean as cleaning
-    from designer.data import load_table
+    from designer.study.data import load_table
 
     monkeypatch.chdir(tmp_path)
     load_table().to_csv("t.csv", index=False)

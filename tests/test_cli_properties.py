@@ -191,8 +191,8 @@ _GOOD = {}
 
 def _good_suggestion() -> dict:
     if not _GOOD:
-        from designer.suggestions import suggest
-        from designer.surrogate import Surrogate
+        from designer.design.suggestions import suggest
+        from designer.model.surrogate import Surrogate
 
         _GOOD.update(suggest(Surrogate.load(), k=0.8, top=2).to_dict())
     return _GOOD

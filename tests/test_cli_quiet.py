@@ -32,7 +32,7 @@ def test_quiet_is_accepted_in_any_position(monkeypatch, capsys):
 
 
 def test_fit_reports_progress_per_response():
-    from designer.surrogate import Surrogate
+    from designer.model.surrogate import Surrogate
 
     seen: list[float] = []
     Surrogate().fit(None, responses=["k_x", "c_x"], nested=False, progress=seen.append)

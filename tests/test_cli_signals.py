@@ -86,7 +86,7 @@ def test_exit_codes_and_version(tmp_path, monkeypatch, capsys):
     assert code == 0 and out.startswith("designer ")
     assert run_inprocess(["predict", "--density", "60"], capsys)[0] == 2
     # 1: a negative answer, nothing written (clean refuses to drop 12 of the 44 study runs)
-    from designer.data import load_table
+    from designer.study.data import load_table
 
     load_table().to_csv("t.csv", index=False)
     code, out, err = run_inprocess(["clean", "t.csv", "-o", "kept.csv"], capsys)
@@ -149,8 +149,8 @@ def test_full_disk_before_and_during_a_write(small_disk, capsys, monkeypatch):
 
 
 def test_validate_exit_1_when_a_check_fails_3_when_it_crashes(tmp_path, monkeypatch, capsys):
-    import designer.report as report
-    from designer.checks import CheckResult
+    import designer.validate.report as report
+    from designer.validate.checks import CheckResult
 
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(

@@ -171,8 +171,8 @@ DESIGN_TOML = "design = { density = 60, length = 24, width = 4.5, height = 9, la
 
 
 def _suggestion(tmp_path):
-    from designer.suggestions import suggest
-    from designer.surrogate import Surrogate
+    from designer.design.suggestions import suggest
+    from designer.model.surrogate import Surrogate
 
     doc = suggest(Surrogate.load(), k=0.8, fixed={"length": 24}, top=2).to_dict()
     (tmp_path / "s.json").write_text(json.dumps(doc))

@@ -8,9 +8,16 @@ import sys
 import numpy as np
 import pandas as pd
 
-from designer import space
-from designer.doe import all_continuous_plan, augment, box_behnken_6, near_target, printable_grid, study_plan
-from designer.surrogate import Surrogate
+from designer.model.surrogate import Surrogate
+from designer.study import space
+from designer.study.doe import (
+    all_continuous_plan,
+    augment,
+    box_behnken_6,
+    near_target,
+    printable_grid,
+    study_plan,
+)
 
 CLI = [sys.executable, "-I", "-c", "from designer_cli.main import main; main()"]
 

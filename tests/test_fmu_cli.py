@@ -197,7 +197,7 @@ def _starts(fmu) -> dict[str, float]:
 def test_cli_exports_a_design_through_the_shipped_surrogate(tmp_path, cache_env):
     import pandas as pd
 
-    from designer.surrogate import Surrogate
+    from designer.model.surrogate import Surrogate
 
     flags = [x for f, v in DESIGN.items() for x in (f"--{f}", str(v))]
     out = tmp_path / "design.fmu"

@@ -19,8 +19,8 @@ import pytest
 
 from designer import Joint
 from designer.errors import DesignerError
-from designer.export.checks import step_response
 from designer.export.modelica import export_modelica
+from designer.validate.export import step_response
 
 rumoca = pytest.importorskip("rumoca")
 

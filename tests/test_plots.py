@@ -14,10 +14,10 @@ import pandas as pd
 import pytest
 from imagecheck import assert_picture
 
-from designer import space
-from designer.data import load_table
 from designer.errors import DesignerError
 from designer.plots import common, effects, heatmap
+from designer.study import space
+from designer.study.data import load_table
 
 
 @pytest.fixture(scope="module")
@@ -73,7 +73,7 @@ def test_effects_png(table, tmp_path):
 
 
 def test_correlations_are_pearson(table):
-    from designer.stats import correlation
+    from designer.study.stats import correlation
 
     corr = correlation(table, ["c_x", "k_x"])
     assert corr.loc["width", "k_x"] == pytest.approx(np.corrcoef(table.width, table.k_x)[0, 1])
@@ -168,8 +168,8 @@ def _cosim_frame() -> pd.DataFrame:
 def test_plot_loo_prints_the_figures_it_draws(tmp_path):
     """The terminal and the figure give the nested leave-one-out Q2 (0.32 for k_x, not the selected
     form's optimistic 0.43), and the legend sits below the data."""
+    from designer.model.surrogate import Surrogate
     from designer.plots import loo
-    from designer.surrogate import Surrogate
 
     sur = Surrogate.load()
     nested = sur.model("k_x").accuracy["q2"]
@@ -257,12 +257,12 @@ def test_importing_and_plotting_leave_the_process_alone(tmp_path):
         "import designer.plots.space, designer.plots.timeseries, designer.plots.checks\n"
         "import designer.plots.profile\n"
         "assert dict.__getitem__(matplotlib.rcParams, 'backend') is backend, 'backend set on import'\n"
-        "from designer.data import load_table\n"
+        "from designer.study.data import load_table\n"
         "fig = designer.plots.heatmap.plot_heatmap(load_table(), responses=['k_x'])\n"
         "designer.plots.common.save_figure(fig, sys.argv[1])\n"
         "assert dict.__getitem__(matplotlib.rcParams, 'backend') is backend, 'backend switched'\n"
         "assert 'matplotlib.pyplot' not in sys.modules, 'pyplot imported'\n"
-        "from designer.surrogate import Surrogate\n"
+        "from designer.model.surrogate import Surrogate\n"
         "view = designer.plots.space.surface_view(Surrogate.load(), 'k_x', resolution=5)\n"
         "designer.plots.space.render(view, window=(200, 150)).close()\n"
         "assert dict(os.environ) == env, 'environment edited'\n"

@@ -11,10 +11,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from designer import space
 from designer.errors import DesignerError
+from designer.model.forms import FORMS, design_matrix
+from designer.model.surrogate import Surrogate
 from designer.plots import profile
-from designer.surrogate import FORMS, Surrogate, design_matrix
+from designer.study import space
 
 
 @pytest.fixture(scope="module")

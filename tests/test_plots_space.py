@@ -10,8 +10,8 @@ import pytest
 from imagecheck import assert_picture, chromium, dump_dom, load_rgb
 
 from designer.errors import DesignerError
+from designer.model.surrogate import Surrogate
 from designer.plots import common, html3d, loo, space
-from designer.surrogate import Surrogate
 
 
 @pytest.fixture(scope="module")

@@ -18,9 +18,9 @@ import pytest
 from imagecheck import assert_picture
 from scipy import stats
 
-from designer import space
-from designer.suggestions import make_target
-from designer.surrogate import Surrogate
+from designer.design.targets import make_target
+from designer.model.surrogate import Surrogate
+from designer.study import space
 
 pytest.importorskip("websocket", reason="the browser tests speak to Chromium with websocket-client")
 import cdp  # noqa: E402

@@ -11,8 +11,8 @@ import pytest
 from test_profile_browser import _check
 
 import designer
-from designer import space
-from designer.surrogate import Surrogate
+from designer.model.surrogate import Surrogate
+from designer.study import space
 
 pytest.importorskip("websocket", reason="the browser tests speak to Chromium with websocket-client")
 import cdp  # noqa: E402

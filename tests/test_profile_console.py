@@ -25,8 +25,8 @@ from imagecheck import assert_picture
 from scipy import stats
 from test_profile_browser import _design
 
-from designer import space
-from designer.surrogate import Surrogate
+from designer.model.surrogate import Surrogate
+from designer.study import space
 
 pytest.importorskip("websocket", reason="the browser tests speak to Chromium with websocket-client")
 import cdp  # noqa: E402
@@ -380,10 +380,10 @@ def test_suggestion_buttons_name_the_factors_and_say_why_one_is_out_of_reach(bro
 
 def test_every_html_output_fits_a_phone(browser, sur, tmp_path):
     """plot space --html and the validation report: a viewport meta, no horizontal overflow at 390 px."""
-    from designer import checks, report
-    from designer.data import load_table
-    from designer.data_checks import check_dataset
     from designer.plots import html3d, space
+    from designer.study.data import load_table
+    from designer.validate import checks, report
+    from designer.validate.study import check_dataset
 
     html3d.write_scene(space.surface_view(sur, "k_x", resolution=9).scene, tmp_path / "scene.html")
     figures = tmp_path / "figures"

@@ -62,7 +62,7 @@ def _figure(pattern: str) -> tuple[str, ...]:
 
 def test_readme_accuracy_figures_are_the_shipped_surrogates():
     """The figures README states for k_x are what `designer fit --json` reports of the shipped file."""
-    from designer.surrogate import Surrogate
+    from designer.model.surrogate import Surrogate
 
     q2, rmse, mape, inside = _figure(
         r"k_x is moderately predictable: nested Q2 = ([\d.]+), RMSE ([\d.]+) N/mm, "

@@ -12,11 +12,11 @@ import pytest
 from imagecheck import assert_picture, chromium, dump_dom
 
 import designer
-from designer import checks, report
-from designer.data import load_table, table_hash
-from designer.data_checks import check_dataset
-from designer.stats_checks import check_main_effects
-from designer.surrogate import Surrogate
+from designer.model.surrogate import Surrogate
+from designer.study.data import load_table, table_hash
+from designer.validate import checks, report
+from designer.validate.stats import check_main_effects
+from designer.validate.study import check_dataset
 
 
 def test_validate_writes_a_passing_report(tmp_path):

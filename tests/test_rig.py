@@ -9,13 +9,13 @@ import pandas as pd
 import pytest
 
 from designer.chirp import Chirp
-from designer.data import load_table
 from designer.errors import DesignerError
 from designer.mass import specimen_mass
 from designer.rig.clean import clean
 from designer.rig.identify import identify, results_table
 from designer.rig.logs import read_log, sidecar_path, validate_frame, write_log
 from designer.rig.simulate import simulate
+from designer.study.data import load_table
 
 FACTORS = {"density": 60, "length": 24, "width": 4.5, "height": 9, "layer": 0.16, "raster": 0}
 CLI = [sys.executable, "-I", "-c", "from designer_cli.main import main; main()"]

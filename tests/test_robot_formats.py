@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 
 from designer.errors import DesignerError
-from designer.export.checks import step_response
 from designer.export.mjcf import export_mjcf
 from designer.export.stability import step_advice
 from designer.export.urdf import export_sdf, export_urdf
 from designer.joint import Joint
+from designer.validate.export import step_response
 
 mujoco = pytest.importorskip("mujoco")
 

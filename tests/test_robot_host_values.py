@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from designer.errors import DesignerError
-from designer.export.checks import gain_changes, other_joint_changes, pose_changes
+from designer.validate.export import gain_changes, other_joint_changes, pose_changes
 from designer.export.mjcf import export_mjcf
 from designer.export.urdf import export_urdf
 from designer.joint import Joint

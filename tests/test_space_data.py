@@ -4,9 +4,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from designer import data, space, units
+from designer import units
 from designer.errors import DesignerError
 from designer.mass import specimen_mass
+from designer.study import data, space
 
 
 def test_bundled_table_is_the_study_table():

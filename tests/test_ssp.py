@@ -10,8 +10,8 @@ import pytest
 
 from designer import Joint
 from designer.errors import DesignerError
-from designer.export.checks import libcosim_ssp_run, ssp_with_value, step_response
 from designer.export.ssp import export_ssp, read_ssv
+from designer.validate.export import libcosim_ssp_run, ssp_with_value, step_response
 
 JOINT = Joint.from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}})
 STIFFER = Joint.from_coefficients({"x": {"k": 1.6, "c": 4e-3, "m": 0.01}})

@@ -7,8 +7,8 @@ import sys
 import numpy as np
 import pytest
 
-from designer.data import load_table
-from designer.stats import anova, compare_table4, correlation, manova, paper_table4
+from designer.study.data import load_table
+from designer.study.stats import anova, compare_table4, correlation, manova, paper_table4
 
 CLI = [sys.executable, "-I", "-c", "from designer_cli.main import main; main()"]
 

@@ -5,9 +5,12 @@ import json
 import numpy as np
 import pytest
 
-from designer import data, space
 from designer.errors import DesignerError
-from designer.surrogate import FORMAT, Surrogate, _grid, _ridge_fit, design_matrix, leave_one_out
+from designer.model.forms import design_matrix, level_grid
+from designer.model.ridge import ridge_fit
+from designer.model.selection import leave_one_out
+from designer.model.surrogate import FORMAT, Surrogate
+from designer.study import data, space
 
 
 @pytest.fixture(scope="module")
@@ -80,7 +83,7 @@ def test_lack_of_fit_matches_statsmodels():
     import statsmodels.formula.api as smf
     from statsmodels.stats.anova import anova_lm
 
-    from designer.validation import lack_of_fit
+    from designer.model.validation import lack_of_fit
 
     rng = np.random.default_rng(3)
     t = data.load_table().iloc[::3]
@@ -134,7 +137,7 @@ def test_leave_one_out_is_an_honest_refit():
     X = {n: t[n].to_numpy(float) for n in space.FACTOR_NAMES}
     y = t["k_x"].to_numpy(float)
     loo = leave_one_out("linear", X, y, "k_x")
-    from designer.surrogate import ResponseSurface
+    from designer.model.prediction import ResponseSurface
 
     keep = np.arange(len(y)) != 7
     m = ResponseSurface("k_x", "linear").fit({k: v[keep] for k, v in X.items()}, y[keep])
@@ -165,10 +168,10 @@ def test_positivity_is_enforced_on_the_tested_grid():
     t = data.load_table()
     Z = design_matrix("quadratic", t)
     y = 0.01 + np.abs(rng.normal(0, 1, len(t))) * (t["height"].to_numpy() < 6)
-    Zg = design_matrix("quadratic", _grid())
+    Zg = design_matrix("quadratic", level_grid())
     free = np.linalg.lstsq(Z, y, rcond=None)[0]
     assert (Zg @ free).min() < 0
-    beta = _ridge_fit(Z, y, 0.0, Zg, 1e-3)
+    beta = ridge_fit(Z, y, 0.0, Zg, 1e-3)
     assert (Zg @ beta).min() >= 1e-3 * (1 - 1e-6)
     # the same optimum as qpOASES (another QP solver) with every grid row as a constraint
     import casadi as ca
@@ -183,15 +186,15 @@ def test_degenerate_positivity_qp_falls_back_to_nnls():
     """qrqp cycles on some degenerate grid rows; the NNLS route gives qpOASES's optimum."""
     import casadi as ca
 
-    from designer.surrogate import _qp_by_nnls
+    from designer.model.ridge import qp_by_nnls
 
     rng = np.random.default_rng(2)
     t = data.load_table()
     Z = design_matrix("linear", t)
-    Zg = design_matrix("linear", _grid())
+    Zg = design_matrix("linear", level_grid())
     y = 0.01 + np.abs(rng.normal(0, 1, len(t))) * (t["width"].to_numpy() < 3)
     H, g = 2 * (Z.T @ Z + 0.1 * np.eye(Z.shape[1])), -2 * Z.T @ y
-    beta = _qp_by_nnls(H, g, Zg, 0.01)
+    beta = qp_by_nnls(H, g, Zg, 0.01)
     qp = ca.conic("ref", "qpoases", {"h": ca.Sparsity.dense(*H.shape), "a": ca.Sparsity.dense(*Zg.shape)})
     ref = np.asarray(qp(h=H, g=g, a=Zg, lba=0.01, uba=np.inf)["x"]).ravel()
     np.testing.assert_allclose(beta, ref, atol=1e-8)

@@ -285,7 +285,7 @@ def test_tune_on_the_fmu_path(monkeypatch):
 
 def test_reachable_range_holds_every_printable_design():
     """Default tune bounds: every design in the tested ranges predicts k and c inside them (theta via PRB)."""
-    from designer import space
+    from designer.study import space
     from designer.sweep.tune import reachable
 
     sur = Surrogate.load()

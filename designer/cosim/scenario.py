@@ -198,7 +198,7 @@ class Scenario:
         hub.check_sampling(1.0 / self.step, what="1 / step")
         out: dict[str, Any] = {"rig_joint": src, "hub": hub}
         if self.factors is not None:
-            from .. import space
+            from ..study import space
 
             out["factors"] = space.check_design(self.factors)
         return out

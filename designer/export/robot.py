@@ -16,10 +16,11 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from .. import space, units
+from .. import units
 from ..errors import DesignerError
 from ..joint import PRB_GAMMA, Joint
 from ..mass import specimen_mass
+from ..study import space
 from .stability import StepAdvice, step_advice
 
 #: the joint axis of each channel; the rotational ones follow roll (phi, x), pitch (theta, y), yaw (psi, z)

@@ -216,7 +216,7 @@ def candidate_sets(suggestion, *, axes: list[str] | None = None, name: str = "Fl
     Raises:
         DesignerError: the suggestion cannot be read or has no candidates.
     """
-    from ..suggestions import Suggestion
+    from ..design.candidates import Suggestion
 
     if not isinstance(suggestion, Suggestion):
         suggestion = Suggestion.load(suggestion)

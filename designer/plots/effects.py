@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from .. import space
+from ..study import space
 from .common import new_figure, response_label, value_formatter
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from ..stats import correlation
+from ..study.stats import correlation
 from .common import new_figure
 
 

@@ -12,7 +12,7 @@ print-process noise (`PRINT_NOISE`, `MC_DRAWS`) to a defect rate; remembered set
 
 The page evaluates the surrogate itself, from the exported coefficients: each response's feature
 columns are exported as expression trees recorded by running the surrogate's own feature code
-(`designer.surrogate._columns`) on symbols, so the page and `Surrogate.predict` compute the same
+(`designer.model.forms.columns`) on symbols, so the page and `Surrogate.predict` compute the same
 expressions with the same coefficients, covariance, t quantile and transform.
 """
 
@@ -30,10 +30,13 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .. import space, units
+from .. import units
 from ..errors import DesignerError
 from ..files import atomic_write
-from ..surrogate import ResponseSurface, Surrogate, _columns
+from ..model.forms import columns
+from ..model.prediction import ResponseSurface
+from ..model.surrogate import Surrogate
+from ..study import space
 
 #: the design the page opens at unless told otherwise (the study's centre, layer 0.16 mm, raster 0 deg)
 DEFAULT_DESIGN: dict[str, float] = {
@@ -117,7 +120,7 @@ def feature_program(form: str) -> list[list[Any]]:
     ``["log", a]`` and ``["level", a, level]`` (1 where a is the level as numpy.isclose says, else 0).
     """
     symbols = {n: _Expr(["x", n]) for n in space.FACTOR_NAMES}
-    return [_node(c) for c in _columns(form, symbols, _TraceOps)]
+    return [_node(c) for c in columns(form, symbols, _TraceOps)]
 
 
 def _accuracy(model: ResponseSurface) -> dict[str, Any]:
@@ -149,7 +152,7 @@ def _value_range(model: ResponseSurface, observed: np.ndarray, target: float | N
 def _target(surrogate: Surrogate, quantity: str, axis: str, goal: float | str) -> dict[str, Any]:
     """A goal (a target value, "min" or "max") with its desirability bounds, as `designer suggest`
     sets them."""
-    from ..suggestions import make_target
+    from ..design.targets import make_target
 
     return make_target(surrogate, quantity, axis, goal).to_dict()
 
@@ -243,10 +246,10 @@ def _within(f: space.Factor, v: float) -> bool:
 
 def _search_data() -> dict[str, Any]:
     """What the page's "maximize" needs to run `designer suggest`'s search: its starts and weights."""
-    from ..suggestions import DISTINCT, N_STARTS, PI_WEIGHT, _starts
+    from ..design.search import DISTINCT, N_STARTS, PI_WEIGHT, starts
 
     return {
-        "starts": _starts(N_STARTS, len(space.CONTINUOUS)).tolist(),
+        "starts": starts(N_STARTS, len(space.CONTINUOUS)).tolist(),
         "n_starts": N_STARTS,
         "pi_weight": PI_WEIGHT,
         "distinct": DISTINCT,
@@ -301,7 +304,7 @@ def build_profiler(
             f"tolerance={tolerance!r} is not a fraction between 0 and 1", "give e.g. tolerance=0.1"
         )
     start = space.check_design(DEFAULT_DESIGN | dict(design or {}))
-    from ..suggestions import predictability
+    from ..design.suggestions import predictability
 
     info = predictability(surrogate, axis)
     responses = [

@@ -20,9 +20,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .. import space
 from ..errors import DesignerError
 from ..files import atomic_path
+from ..study import space
 from .common import check_image_path, response_label
 from .html3d import Layer, Scene
 

@@ -16,9 +16,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from .. import space, units
-from ..data import canonical_columns, check_text_cells, coefficient_columns, normalise
+from .. import units
 from ..errors import DesignerError
+from ..study import space
+from ..study.data import canonical_columns, check_text_cells, coefficient_columns, normalise
 
 EPS = 0.5
 MIN_SAMPLES = 5

@@ -34,9 +34,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import space, units
+from .. import units
 from ..errors import DesignerError, describe, names_argument, number_argument
 from ..mass import specimen_mass
+from ..study import space
 from . import band as bandlib
 from . import channel, departures
 from .logs import LOAD, RigLog, missing, read_log, validate_frame

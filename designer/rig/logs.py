@@ -19,11 +19,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import space, units
-from ..data import is_parquet
+from .. import units
 from ..errors import DesignerError
 from ..files import atomic_path, atomic_write
 from ..keys import check_keys
+from ..study import space
+from ..study.data import is_parquet
 from . import channel
 
 #: the load column of each axis

@@ -15,10 +15,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import space, units
+from .. import units
 from ..cosim.scenario import JointSource
 from ..errors import DesignerError
-from ..surrogate import Surrogate
+from ..model.surrogate import Surrogate
+from ..study import space
 from .draws import joint_draws, on_axis, source_axis
 from .spec import Spec, sources
 
@@ -136,7 +137,7 @@ def suggestion(spec: Spec) -> list[Case]:
     from ..joint import Joint
 
     path: Path = spec.cases.file
-    from ..suggestions import Suggestion
+    from ..design.candidates import Suggestion
 
     n = len(Suggestion.load(path).candidates)
     numbers = spec.cases.candidates or tuple(range(1, n + 1))

@@ -19,7 +19,8 @@ import numpy as np
 from .. import units
 from ..errors import DesignerError
 from ..joint import AxisCoefficients, rotational_from_translational
-from ..surrogate import ResponseSurface, Surrogate
+from ..model.prediction import ResponseSurface
+from ..model.surrogate import Surrogate
 
 #: redraw rounds for non-positive raw-space draws before giving up
 _REDRAWS = 100

@@ -9,8 +9,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import space, units
+from .. import units
 from ..files import atomic_folder, atomic_path, atomic_write
+from ..study import space
 from .cases import Case
 from .evaluate import RIG_METRICS
 from .limits import METRICS, applies

@@ -22,10 +22,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import space
 from ..cosim.scenario import Scenario
 from ..errors import DesignerError
-from ..surrogate import Surrogate
+from ..model.surrogate import Surrogate
+from ..study import space
 from .cases import Case, finish
 from .draws import on_axis, source_axis
 from .evaluate import holding
@@ -296,7 +296,7 @@ def _designs(
     tuned: TuneResult, spec: Spec, surrogate: Surrogate, draws: int, seed: int, ex: Executor
 ) -> None:
     """Suggest designs for each tuned joint, then a Monte Carlo sweep over the best designs' PIs."""
-    from ..suggestions import suggest
+    from ..design.suggestions import suggest
     from .cases import make_cases
     from .run import table
     from .summary import summarize

@@ -11,21 +11,56 @@ and Analysis of Experiments, sec. 6.8 / 11.2).
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from . import space
-
-if TYPE_CHECKING:
-    from .surrogate import Prediction, Selection, _Fit, _Folds
+from ..study import space
+from .folds import Folds, point_metrics
+from .prediction import Prediction
+from .ridge import Fit
 
 #: a run is influential when leaving it out moves the chosen form's LOO Q2 by more than this
 INFLUENCE_Q2 = 0.05
 
 
+@dataclass(frozen=True)
+class Selection:
+    """The outcome of the selection procedure on some runs: the form and every form's LOO."""
+
+    form: str
+    fit: Fit
+    #: every form's LOO predicted values over the runs, shape (n,)
+    loo: dict[str, np.ndarray]
+    n_params: dict[str, int]
+
+
+def select_on(
+    folds: Folds, rows: np.ndarray, forms: tuple[str, ...], out: frozenset[int] = frozenset()
+) -> Selection:
+    """Run the selection procedure on `rows` (the runs without `out`): LOO per form, one-SE rule.
+
+    The one-standard-error rule (Breiman et al., Hastie et al.) on paired squared LOO errors: a
+    richer form must beat a simpler one by more than the noise of the comparison, so a response
+    the factors do not explain falls back to the mean instead of a form that fits noise.
+    """
+    y = folds.y[rows]
+    preds = {form: folds.loo(form, rows, out) for form in forms}
+    sq = {form: (y - p) ** 2 for form, p in preds.items()}
+    best = min(forms, key=lambda f: sq[f].mean())
+    n_params = {form: folds.Z[form].shape[1] for form in forms}
+
+    def within_one_se(form: str) -> bool:
+        d = sq[form] - sq[best]
+        return form == best or d.mean() <= d.std(ddof=1) / np.sqrt(len(y))
+
+    chosen = min((f for f in forms if within_one_se(f)), key=lambda f: (n_params[f], forms.index(f)))
+    return Selection(chosen, folds.fit(chosen, out), preds, n_params)
+
+
 def nested_loo(
-    folds: _Folds, full: Selection, forms: tuple[str, ...]
+    folds: Folds, full: Selection, forms: tuple[str, ...]
 ) -> tuple[Prediction, list[dict[str, Any]]]:
     """Predict each run from the whole selection procedure run on the others.
 
@@ -40,11 +75,9 @@ def nested_loo(
         Q2 of the form chosen without that run over the remaining runs, and `press_share` the
         run's share of the chosen form's LOO squared error on all runs).
     """
-    from .surrogate import Prediction, _point_metrics, select_on
-
     y = folds.y
     n = len(y)
-    full_q2 = _point_metrics(y, full.loo[full.form])["q2"]
+    full_q2 = point_metrics(y, full.loo[full.form])["q2"]
     sq = (y - full.loo[full.form]) ** 2
     value, low, high = np.empty(n), np.empty(n), np.empty(n)
     influence = []
@@ -53,7 +86,7 @@ def nested_loo(
         sel = select_on(folds, rows, forms, out=frozenset({i}))
         p = sel.fit.predict(folds.Z[sel.form][i : i + 1])
         value[i], low[i], high[i] = p[0][0], p[1][0], p[2][0]
-        q2 = _point_metrics(y[rows], sel.loo[sel.form])["q2"]
+        q2 = point_metrics(y[rows], sel.loo[sel.form])["q2"]
         if sel.form != full.form or abs(q2 - full_q2) > INFLUENCE_Q2:
             share = float(sq[i] / sq.sum())
             influence.append(
@@ -69,7 +102,7 @@ def replicate_groups(X: Mapping[str, np.ndarray]) -> np.ndarray:
 
 
 def lack_of_fit(
-    X: Mapping[str, np.ndarray], y: np.ndarray, Z: np.ndarray, fit: _Fit, log: bool
+    X: Mapping[str, np.ndarray], y: np.ndarray, Z: np.ndarray, fit: Fit, log: bool
 ) -> dict[str, float] | None:
     """Pure-error and lack-of-fit F test of a fit, in its fit space; None without replicates.
 

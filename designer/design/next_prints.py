@@ -22,11 +22,15 @@ from typing import Any
 
 import numpy as np
 
-from . import space
-from .calibration import new_printer, with_runs
-from .errors import DesignerError, number_argument
-from .suggestions import DISTINCT, TOLERANCE, Candidate, _distance, probability_within, suggest
-from .surrogate import Prediction, Surrogate, check_surrogate
+from ..errors import DesignerError, number_argument
+from ..model.calibration import new_printer, with_runs
+from ..model.prediction import Prediction
+from ..model.surrogate import Surrogate, check_surrogate
+from ..study import space
+from .candidates import Candidate
+from .search import DISTINCT, distance
+from .suggestions import suggest
+from .targets import TOLERANCE, probability_within
 
 #: quadrature nodes of the fantasised measurement
 NODES = 9
@@ -178,9 +182,7 @@ def _batch_p(surrogate: Surrogate, scorer: _Scorer, designs: list[dict[str, floa
 
 def _predictable_targets(sug: Any) -> dict[str, float]:
     return {
-        q: t.value
-        for q, t in sug.targets.items()
-        if t.kind == "target" and sug.predictability[q]["predictable"]
+        q: t.value for q, t in sug.targets.items() if t.has_value and sug.predictability[q]["predictable"]
     }
 
 
@@ -213,7 +215,7 @@ def _greedy_batch(
     for step in range(n):
         if progress is not None:
             progress(step / (n + 1))
-        free = [c for c in candidates if all(_distance(c.params, p.params, spans) > DISTINCT for p in chosen)]
+        free = [c for c in candidates if all(distance(c.params, p.params, spans) > DISTINCT for p in chosen)]
         if not free:
             break
         scores = [_expected_best(surrogate, scorer, c.params, known, pool) for c in free]
@@ -285,7 +287,7 @@ def next_prints(
     scorer = _Scorer(surrogate, axis, targets, tolerance)
     best = sug.candidates[0]
     p_now = float(best.p_within or 0.0)
-    goals = {q: (t.value if t.kind == "target" else t.kind) for q, t in sug.targets.items()}
+    goals = {q: t.goal for q, t in sug.targets.items()}
     if not sug.reachable:
         statements += [st for st in sug.statements if "distinct design" not in st] + [
             "no print is proposed: the target lies outside what the data supports (see above)"

@@ -4,15 +4,15 @@ from __future__ import annotations
 
 import pandas as pd
 
+from ..errors import DesignerError
 from .checks import CheckResult, Context
-from .errors import DesignerError
 
 
 def check_table4(ctx: Context) -> CheckResult:
     """Our type III ANOVA of k_x against the study's Table 4: F and p side by side."""
-    from .plots.checks import plot_table4
-    from .plots.common import save_figure
-    from .stats import TABLE4_NOTE, compare_table4
+    from ..plots.checks import plot_table4
+    from ..plots.common import save_figure
+    from ..study.stats import TABLE4_NOTE, compare_table4
 
     if "k_x" not in ctx.table.columns:
         raise DesignerError("the table has no k_x column", "Table 4 is the ANOVA of k_x: give c_x, k_x")
@@ -45,8 +45,8 @@ SIGNIFICANT_K_X = ("width", "height", "layer")
 
 def check_main_effects(ctx: Context) -> CheckResult:
     """Medians move as the study's effect plots say, for each factor its Table 4 finds significant."""
-    from .plots.common import save_figure
-    from .plots.effects import main_effects, plot_effects
+    from ..plots.common import save_figure
+    from ..plots.effects import main_effects, plot_effects
 
     responses = [r for r in ("c_x", "k_x") if r in ctx.table.columns]
     if "k_x" not in responses:

@@ -1,4 +1,4 @@
-"""`designer validate`: run every check (designer.checks) and render the report in HTML and Markdown.
+"""`designer validate`: run every check (designer.validate.checks) and render the report in HTML and Markdown.
 
 The report is written into a new folder beside the target and swapped in at the end, so an
 interrupted run leaves the previous report whole (or no report), never a mix of old and new.
@@ -17,9 +17,9 @@ from collections.abc import Callable, Mapping
 from datetime import datetime, timezone
 from pathlib import Path
 
+from ..files import atomic_folder, atomic_write
+from ..study.data import load_table
 from .checks import CheckResult, Context, run_checks
-from .data import load_table
-from .files import atomic_folder, atomic_write
 
 #: the checks' raw column names as a reader wants them, with units
 COLUMN_NAMES = {
@@ -104,7 +104,7 @@ def _code_version() -> str:
 def provenance(ctx: Context | None = None) -> dict[str, str]:
     """What a reader needs to know which run this was: date (UTC), tool version, commit or package
     hash, platform; with the checks' context also the surrogate id and the table's hash and source."""
-    from . import __version__
+    from .. import __version__
 
     out = {
         "date": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
@@ -113,7 +113,7 @@ def provenance(ctx: Context | None = None) -> dict[str, str]:
         "platform": f"{platform.system()} {platform.machine()}, Python {platform.python_version()}",
     }
     if ctx is not None:
-        from .data import table_hash
+        from ..study.data import table_hash
 
         out |= {
             "surrogate": ctx.surrogate.id,

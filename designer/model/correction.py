@@ -29,15 +29,19 @@ factor's uncertainty. With no run of the user's, `calibrate` returns the study s
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field, fields
-from typing import Any
+from dataclasses import dataclass, field, fields, replace
+from typing import TYPE_CHECKING, Any
 
 import casadi as ca
 import numpy as np
 
-from . import space
-from .errors import DesignerError, number_argument
-from .surrogate import Prediction, ResponseSurface, Surrogate, _as_printed
+from ..errors import DesignerError, number_argument
+from ..study import space
+from .forms import as_printed
+from .prediction import Prediction, ResponseSurface
+
+if TYPE_CHECKING:  # for annotations only: the surrogate module imports this one
+    from .surrogate import Surrogate
 
 #: prior standard deviation of log(printer factor): filaments of one grade and printers differ
 PRINTER_SD = 0.3
@@ -137,7 +141,7 @@ def fit_length(base: ResponseSurface, X: Mapping[str, Any], y: np.ndarray, noise
     if held is None:
         return LENGTHS[0]
     r = np.log(y) - np.log(np.asarray(held.value, dtype=float))
-    printed = _as_printed(dict(X))  # as the evidence and fit_amplitude see the runs
+    printed = as_printed(dict(X))  # as the evidence and fit_amplitude see the runs
     _, s0 = _log_moments(base, printed)
     sg = _local_sd(s0, noise)
     Z = coded(printed)
@@ -161,13 +165,13 @@ def fit_amplitude(base: ResponseSurface, X: Mapping[str, Any], y: np.ndarray, no
     for c, whose surface is a constant in raw space, the log-normal stand-in understates how far its
     runs spread (2.47).
     """
-    from scipy.optimize import brentq  # once per study surface; kept off the import of designer
+    from scipy.optimize import brentq
 
     held = base.nested_predictions or base.loo_predictions
     if held is None:
         return 1.0
     r = np.log(y) - np.log(np.asarray(held.value, dtype=float))
-    _, s0 = _log_moments(base, _as_printed(dict(X)))
+    _, s0 = _log_moments(base, as_printed(dict(X)))
     sg = _local_sd(s0, noise)
 
     def excess(a: float) -> float:  # rms standardized error above 1; falls as the amplitude grows
@@ -180,12 +184,12 @@ def fit_amplitude(base: ResponseSurface, X: Mapping[str, Any], y: np.ndarray, no
     return float(brentq(excess, 1.0, MAX_AMPLITUDE, xtol=1e-6))
 
 
-def _settings_of(prior: Surrogate, response: str) -> tuple[float, float, float]:
+def settings_of(prior: Surrogate, response: str) -> tuple[float, float, float]:
     """(length, amplitude, noise) of `response`'s correction, computed once per study surface (the
     design loop recalibrates many times)."""
     base = prior.models[response]
     if "_calibration_settings" not in base.__dict__:
-        X, y = _study_runs(prior, response)
+        X, y = study_runs(prior, response)
         noise = noise_of(base)
         length = fit_length(base, X, y, noise)
         amplitude = fit_amplitude(base, X, y, noise)
@@ -220,7 +224,7 @@ class CalibratedSurface(ResponseSurface):
         settings: tuple[float, float, float],
         printer_sd: float = PRINTER_SD,
     ) -> CalibratedSurface:
-        """`settings`: (length, amplitude, noise), as `_settings_of` gives them."""
+        """`settings`: (length, amplitude, noise), as `settings_of` gives them."""
         shared = {f.name: getattr(base, f.name) for f in fields(ResponseSurface)}
         length, amplitude, noise = settings
         surf = cls(
@@ -323,12 +327,12 @@ class CalibratedSurface(ResponseSurface):
         }
 
 
-def _runs_table(runs: Any, surrogate: Surrogate) -> Any:
+def runs_table(runs: Any, surrogate: Surrogate) -> Any:
     """The user's runs through `load_table` (factors checked, printable), restricted to responses
     the surrogate has; raise for a table that shares no response or no factor with it."""
     import pandas as pd
 
-    from .data import check_table_argument, load_table
+    from ..study.data import check_table_argument, load_table
 
     check_table_argument(runs, "runs")
     if runs is None:
@@ -349,109 +353,31 @@ def _runs_table(runs: Any, surrogate: Surrogate) -> Any:
     return table
 
 
-def _study_runs(prior: Surrogate, response: str) -> tuple[dict[str, np.ndarray], np.ndarray]:
+def study_runs(prior: Surrogate, response: str) -> tuple[dict[str, np.ndarray], np.ndarray]:
     X = {n: np.asarray(prior.training[n], dtype=float) for n in space.FACTOR_NAMES}
     return X, np.asarray(prior.training[response], dtype=float)
 
 
-def _evidence(
+def evidence(
     prior: Surrogate, response: str, user: Mapping[str, np.ndarray], observed: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(designs (n, 6) as printed, measured values (n,), own (n,)): the study's runs (own 0: the
     study's printer, no printer factor) and the user's (own 1), where the local correction is observed.
     The study's runs observe it directly: each one's residual from the study's own prediction is the
     model's error there (plus print scatter)."""
-    X, y = _study_runs(prior, response)
+    X, y = study_runs(prior, response)
     ok = np.isfinite(y)
     parts = [({n: v[ok] for n, v in X.items()}, y[ok], 0.0), (user, observed, 1.0)]
     designs, values, own = [], [], []
     for X, y, u in parts:
-        printed = _as_printed(dict(X))
+        printed = as_printed(dict(X))
         designs.append(np.column_stack([printed[n] for n in space.FACTOR_NAMES]).reshape(-1, 6))
         values.append(np.asarray(y, dtype=float))
         own.append(np.full(len(y), u))
     return np.vstack(designs), np.concatenate(values), np.concatenate(own)
 
 
-def new_printer(surrogate: Surrogate, *, printer_sd: float = PRINTER_SD) -> Surrogate:
-    """The study surrogate as a prior for a printer not measured yet: every response carries the
-    printer factor's uncertainty, and the local correction the study's own runs observe (no run of
-    the user's). What a user's first print should expect; `calibrate` with runs continues from it."""
-    if surrogate.calibration is not None:
-        return surrogate
-    import pandas as pd
-
-    models = {
-        r: CalibratedSurface.from_base(
-            base,
-            *_evidence(surrogate, r, {n: np.zeros(0) for n in space.FACTOR_NAMES}, np.zeros(0)),
-            _settings_of(surrogate, r),
-            printer_sd,
-        )
-        for r, base in surrogate.models.items()
-    }
-    empty = pd.DataFrame(columns=list(space.FACTOR_NAMES) + surrogate.responses, dtype=float)
-    return Surrogate(
-        models=models,
-        table_hash=surrogate.table_hash,
-        training=surrogate.training,
-        prior=surrogate,
-        calibration={"table": empty, "printer_sd": printer_sd},
-    )
-
-
-def calibrate(surrogate: Surrogate, runs: Any, *, printer_sd: float = PRINTER_SD) -> Surrogate:
-    """The study surrogate updated by a user's measured runs: a printer factor and a local correction.
-
-    Args:
-        surrogate: the prior, usually the shipped study surrogate (`Surrogate.load()`); a surrogate
-            that is already calibrated is recalibrated from its own prior with all runs.
-        runs: the user's runs, a coefficient table (path or DataFrame: the six factors and any of
-            the surrogate's responses, e.g. k_x and c_x; designer identify's output) with 0 or more
-            rows. Responses missing from the table stay as in the prior.
-        printer_sd: prior standard deviation of log(printer factor).
-
-    Returns:
-        A new `Surrogate` whose responses are `CalibratedSurface`s; with no run, `surrogate` itself.
-
-    Raises:
-        DesignerError: a malformed table, a factor outside what can be printed, no response of the
-            surrogate's axis in the table, a non-positive coefficient, or printer_sd <= 0.
-    """
-    if not isinstance(surrogate, Surrogate) or not surrogate.models:
-        raise DesignerError(
-            f"surrogate={type(surrogate).__name__} is not a fitted Surrogate",
-            "give Surrogate.load() or a fitted Surrogate",
-        )
-    if not 0 < number_argument(printer_sd, "printer_sd", example="0.3") <= MAX_PRINTER_SD:
-        raise DesignerError(
-            f"printer_sd={printer_sd} is not in (0, {MAX_PRINTER_SD:g}]",
-            "give e.g. printer_sd=0.3 (a printer factor within about x/÷ 1.8 at 95 %)",
-        )
-    prior = surrogate.prior if surrogate.calibration else surrogate
-    table = _runs_table(runs, prior)
-    if prior is not surrogate and len(surrogate.calibration["table"]):
-        import pandas as pd
-
-        table = pd.concat([surrogate.calibration["table"], table], ignore_index=True)
-    return _calibrated(prior, table, printer_sd)
-
-
-def with_runs(surrogate: Surrogate, rows: list[dict[str, float]]) -> Surrogate:
-    """`surrogate` calibrated on its own runs plus `rows`, runs the tool itself imagines (the six
-    factors and responses by their canonical names, printable), without a user table's checks: the
-    design loop recalibrates on each imagined measurement, where those checks cost half its time."""
-    import pandas as pd
-
-    if not rows:
-        return surrogate
-    if surrogate.calibration is None:
-        return _calibrated(surrogate, pd.DataFrame(rows), PRINTER_SD)
-    table = pd.concat([surrogate.calibration["table"], pd.DataFrame(rows)], ignore_index=True)
-    return _calibrated(surrogate.prior, table, surrogate.calibration["printer_sd"])
-
-
-def _calibrated(prior: Surrogate, table: Any, printer_sd: float) -> Surrogate:
+def calibrated(prior: Surrogate, table: Any, printer_sd: float) -> Surrogate:
     """`calibrate`'s work once its arguments are checked: `prior` uncalibrated, `table` the user's
     runs (load_table's columns)."""
     if table.empty:
@@ -463,83 +389,19 @@ def _calibrated(prior: Surrogate, table: Any, printer_sd: float) -> Surrogate:
             models[r] = base
             continue
         user = {n: table.loc[rows, n].to_numpy(dtype=float) for n in space.FACTOR_NAMES}
-        designs, observed, own = _evidence(prior, r, user, table.loc[rows, r].to_numpy(dtype=float))
-        settings = _settings_of(prior, r)
+        designs, observed, own = evidence(prior, r, user, table.loc[rows, r].to_numpy(dtype=float))
+        settings = settings_of(prior, r)
         models[r] = CalibratedSurface.from_base(base, designs, observed, own, settings, printer_sd)
     keep = list(space.FACTOR_NAMES) + [r for r in prior.responses if r in table.columns]
-    return Surrogate(
-        models=models,
-        table_hash=prior.table_hash,
-        training=prior.training,
-        prior=prior,
-        calibration={"table": table.loc[:, keep].reset_index(drop=True), "printer_sd": printer_sd},
-    )
+    table = table.loc[:, keep].reset_index(drop=True)
+    return replace(prior, models=models, prior=prior, calibration={"table": table, "printer_sd": printer_sd})
 
 
-def _user_loo(surrogate: Surrogate, response: str) -> dict[str, float] | None:
-    """Each of the user's runs predicted by the surrogate calibrated on the others (the prior and
-    its settings come from the study, so nothing is refitted on the user's runs)."""
-    table = surrogate.calibration["table"]
-    rows = np.flatnonzero(table[response].notna().to_numpy()) if response in table.columns else []
-    if len(rows) < 2:
-        return None
-    errors, inside = [], []
-    for i in rows:
-        others = calibrate(
-            surrogate.prior, table.drop(index=i), printer_sd=surrogate.calibration["printer_sd"]
+def check_printer_sd(printer_sd: Any) -> float:
+    """`printer_sd` as a float in (0, MAX_PRINTER_SD]; raise DesignerError naming it otherwise."""
+    if not 0 < number_argument(printer_sd, "printer_sd", example="0.3") <= MAX_PRINTER_SD:
+        raise DesignerError(
+            f"printer_sd={printer_sd} is not in (0, {MAX_PRINTER_SD:g}]",
+            "give e.g. printer_sd=0.3 (a printer factor within about x/÷ 1.8 at 95 %)",
         )
-        p = others.model(response).predict(table.loc[[i], list(space.FACTOR_NAMES)]).at(0)
-        y = float(table.loc[i, response])
-        errors.append(abs(p.value - y) / y)
-        inside.append(p.low <= y <= p.high)
-    return {"n": len(rows), "mape": 100 * float(np.median(errors)), "coverage95": float(np.mean(inside))}
-
-
-def _statement(m: ResponseSurface, calibrated: ResponseSurface) -> str:
-    if not isinstance(calibrated, CalibratedSurface):
-        return "no measured value: the study's prediction"
-    if m.predictable:
-        return (
-            f"{m.response}: the study's {m.form} form times your printer's factor, corrected near the "
-            "designs you and the study printed (correlation length "
-            f"{calibrated.length:g} of a factor's half-range); far from them the interval stays as "
-            "wide as the study's plus the factor's uncertainty"
-        )
-    return (
-        f"{m.response} is not predictable from the six factors (the study's nested Q2 "
-        f"{m.accuracy.get('q2', float('nan')):.2f}): your runs set its level for your printer and pin it "
-        "down at the designs you printed; elsewhere its interval stays wide"
-    )
-
-
-def report(surrogate: Surrogate) -> dict[str, Any]:
-    """What a calibration found, as plain data: per response the user's run count, the printer
-    factor with its 95 % interval, and the nested leave-one-out over the user's runs.
-
-    Raises:
-        DesignerError: `surrogate` is not calibrated.
-    """
-    if surrogate.calibration is None:
-        raise DesignerError("surrogate is not calibrated", "give the result of designer.calibrate(...)")
-    table = surrogate.calibration["table"]
-    out: dict[str, Any] = {
-        "surrogate_id": surrogate.id,
-        "prior_id": surrogate.prior.id,
-        "n_runs": len(table),
-        "n_study_runs": len(surrogate.prior.training["run"]),
-        "printer_sd": surrogate.calibration["printer_sd"],
-        "responses": {},
-    }
-    for r, m in surrogate.models.items():
-        base = surrogate.prior.model(r)
-        cal = isinstance(m, CalibratedSurface)
-        out["responses"][r] = {
-            "unit": m.unit,
-            "n_runs": int(m.own.sum()) if cal else 0,
-            "printer_factor": m.printer_factor().to_dict() if cal else None,
-            "settings": m.settings() if cal else None,
-            "loo_user": _user_loo(surrogate, r) if cal else None,
-            "predictable": base.predictable,
-            "statement": _statement(base, m),
-        }
-    return out
+    return float(printer_sd)

@@ -17,8 +17,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from . import space, units
-from .errors import DesignerError, describe
+from .. import units
+from ..errors import DesignerError, describe
+from . import space
 
 BUNDLED_NAME = "study_table3_x.csv"
 #: the widest a printed joint's coefficients can be, per (quantity, rotational), rig units: far
@@ -262,7 +263,7 @@ def is_parquet(path: str | Path) -> bool:
 def read_frame(path: str | Path) -> pd.DataFrame:
     """A CSV or Parquet file (by suffix) as a DataFrame, unvalidated (DesignerError naming a wrong
     delimiter, binary content or an empty file)."""
-    from .files import check_table_file
+    from ..files import check_table_file
 
     check_table_file(path, parquet=is_parquet(path))
     return pd.read_parquet(path) if is_parquet(path) else pd.read_csv(path)
@@ -270,7 +271,7 @@ def read_frame(path: str | Path) -> pd.DataFrame:
 
 def write_frame(frame: pd.DataFrame, path: str | Path) -> Path:
     """Write a table atomically as CSV or Parquet (by suffix)."""
-    from .files import atomic_path, atomic_write
+    from ..files import atomic_path, atomic_write
 
     if is_parquet(path):
         with atomic_path(path) as tmp:

@@ -16,8 +16,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from ..errors import DesignerError
 from . import space
-from .errors import DesignerError
 
 #: Box and Behnken (1960), six factors: the factors varied together in each block (0-based)
 BB6_BLOCKS: tuple[tuple[int, int, int], ...] = (

@@ -6,7 +6,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from .errors import DesignerError
+from ..errors import DesignerError
 
 #: Printed shell (perimeter) thickness of the study's specimens, mm (Table 1).
 WALL_MM = 0.8

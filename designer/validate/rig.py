@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pandas as pd
 
-from ..checks import CheckResult, Context
 from ..units import rig_unit
+from .checks import CheckResult, Context
 
 #: coefficient sets of the closed loop (rig units): the bundled table's lowest, middle and highest
 #: k_x, and the example joint's theta axis
@@ -25,7 +25,7 @@ def check_identification(ctx: Context) -> CheckResult:
     from ..plots.common import save_figure
     from ..rig.identify import identify
     from ..rig.logs import validate_frame
-    from .simulate import simulate
+    from ..rig.simulate import simulate
 
     rows = []
     for i, (axis, coef) in enumerate(IDENTIFY_SETS):

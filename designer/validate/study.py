@@ -4,16 +4,16 @@ from __future__ import annotations
 
 import pandas as pd
 
-from . import space
+from ..study import space
+from ..study.data import coefficient_columns, table_hash
+from ..units import rig_unit
 from .checks import CheckResult, Context
-from .data import coefficient_columns, table_hash
-from .units import rig_unit
 
 
 def check_dataset(ctx: Context) -> CheckResult:
     """The table holds the six factors at tested values and positive coefficients, with no gaps."""
-    from .plots.common import save_figure
-    from .plots.heatmap import plot_heatmap
+    from ..plots.common import save_figure
+    from ..plots.heatmap import plot_heatmap
 
     t = ctx.table
     rows, problems = [], []

@@ -14,8 +14,8 @@ def check_surrogate_loo(ctx: Context) -> CheckResult:
     """Leave-one-out metrics per response, and whether its 95 % PIs cover as often as they claim."""
     from scipy.stats import binom
 
-    from .plots.common import save_figure
-    from .plots.loo import loo_table, plot_loo
+    from ..plots.common import save_figure
+    from ..plots.loo import loo_table, plot_loo
 
     sur = ctx.surrogate
     rows = []

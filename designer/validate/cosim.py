@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..checks import CheckResult, Context
+from .checks import CheckResult, Context
 
 #: the co-simulated arm (as examples/two_link_arm.toml, over 2 s): macro steps of the convergence
 COSIM_STEPS = (4e-3, 2e-3, 1e-3, 5e-4)
@@ -18,13 +18,13 @@ COSIM_ORDER = 0.8
 
 def check_cosim(ctx: Context) -> CheckResult:
     """The arm co-simulated with two joint FMUs converges to the in-engine reference with the macro step."""
+    from ..cosim.references import Sine, Step
+    from ..cosim.run import robot_reference, run
+    from ..cosim.scenario import JointSource, Scenario
     from ..joint import Joint
     from ..plots.checks import plot_convergence
     from ..plots.common import save_figure
     from ..plots.timeseries import plot_timeseries
-    from .references import Sine, Step
-    from .run import robot_reference, run
-    from .scenario import JointSource, Scenario
 
     joint = JointSource(axis="theta", joint=Joint.from_coefficients({"theta": {"k": 330.0, "c": 0.83}}))
     sc = Scenario(

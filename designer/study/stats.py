@@ -12,9 +12,9 @@ from importlib import resources
 import numpy as np
 import pandas as pd
 
+from ..errors import DesignerError
 from . import space
 from .data import coefficient_columns
-from .errors import DesignerError
 
 ALPHA = 0.05
 #: the paper's Table 4 names of the sources

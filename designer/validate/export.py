@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..checks import CheckResult, Context
+from .checks import CheckResult, Context
 
 #: the joint of the FMU checks: the study's x axis near its middle (rig units, kg) and the study's
 #: 280 g static load, N
@@ -36,7 +36,7 @@ def libcosim_step(path: Path, steps: int, step: float) -> object:
     from libcosimpy.CosimObserver import CosimObserver
     from libcosimpy.CosimSlave import CosimLocalSlave
 
-    from .fmu import value_reference
+    from ..export.fmu import value_reference
 
     log_output_level(CosimLogLevel.ERROR)
     ex = CosimExecution.from_step_size(step_size=int(round(step * 1e9)))
@@ -98,11 +98,11 @@ def check_fmus(ctx: Context) -> CheckResult:
     (co-simulation and model exchange) and in libcosimpy."""
     from fmpy.validation import validate_fmu
 
+    from ..export.fmu import export_fmu
     from ..files import private_tempdir
     from ..joint import Joint
     from ..plots.common import save_figure
     from ..plots.timeseries import plot_timeseries
-    from .fmu import export_fmu
 
     joint = Joint.from_coefficients({"x": FMU_JOINT}, name="report_joint")
     m, c, k = (joint.axes["x"].si()[q] for q in ("m", "c", "k"))
@@ -194,7 +194,7 @@ def _ssp_runs(tmp: Path, joint) -> tuple[dict[str, np.ndarray], dict[str, float]
     the bound SSV only; and the k each run should see (SI)."""
     from fmpy.ssp.simulation import simulate_ssp
 
-    from .ssp import export_ssp, fmpy_parameter_set
+    from ..export.ssp import export_ssp, fmpy_parameter_set
 
     k = joint.axes["x"].si()["k"]
     runs, ks = {}, {}
@@ -345,9 +345,9 @@ def check_mjcf_into(ctx: Context) -> CheckResult:
 
     import mujoco
 
+    from ..export.mjcf import export_mjcf
     from ..files import temporary_folder
     from ..joint import Joint
-    from .mjcf import export_mjcf
 
     joint = Joint.from_coefficients({"theta": {"k": 50.0, "c": 0.5, "m": 1e-5}}, name="report_joint")
     si = joint.axes["theta"].si()

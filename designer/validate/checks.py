@@ -1,8 +1,8 @@
 """The framework of `designer validate`: a check is a function of a `Context` returning a `CheckResult`.
 
-Each check lives beside the code it checks (`designer.data_checks`, `designer.stats_checks`,
-`designer.surrogate_checks`, `designer.export.checks`, `designer.rig.checks`, `designer.cosim.checks`)
-and shares its fixtures with the tests; `run_checks` runs them and `designer.report` renders them.
+One module per subsystem (`designer.validate.study`, `designer.validate.stats`,
+`designer.validate.model`, `designer.validate.export`, `designer.validate.rig`, `designer.validate.cosim`)
+and shares its fixtures with the tests; `run_checks` runs them and `designer.validate.report` renders them.
 """
 
 from __future__ import annotations
@@ -53,8 +53,8 @@ class Context:
     def surrogate(self) -> Any:
         """The shipped surrogate when it was fitted to this table, else one fitted to it now."""
         if self._surrogate is None:
-            from .data import table_hash
-            from .surrogate import Surrogate
+            from ..model.surrogate import Surrogate
+            from ..study.data import table_hash
 
             sur = Surrogate.load()
             if sur.table_hash != table_hash(self.table):
@@ -67,15 +67,15 @@ Check = Callable[[Context], CheckResult]
 
 #: the checks `designer validate` runs, in report order: (module, function)
 CHECKS: tuple[tuple[str, str], ...] = (
-    ("designer.data_checks", "check_dataset"),
-    ("designer.stats_checks", "check_table4"),
-    ("designer.stats_checks", "check_main_effects"),
-    ("designer.surrogate_checks", "check_surrogate_loo"),
-    ("designer.export.checks", "check_fmus"),
-    ("designer.export.checks", "check_mjcf_into"),
-    ("designer.export.checks", "check_ssp"),
-    ("designer.rig.checks", "check_identification"),
-    ("designer.cosim.checks", "check_cosim"),
+    ("designer.validate.study", "check_dataset"),
+    ("designer.validate.stats", "check_table4"),
+    ("designer.validate.stats", "check_main_effects"),
+    ("designer.validate.model", "check_surrogate_loo"),
+    ("designer.validate.export", "check_fmus"),
+    ("designer.validate.export", "check_mjcf_into"),
+    ("designer.validate.export", "check_ssp"),
+    ("designer.validate.rig", "check_identification"),
+    ("designer.validate.cosim", "check_cosim"),
 )
 
 

@@ -1,0 +1,170 @@
+"""Calibration of the study's surrogate to a user's printer from the user's own runs: the public calls.
+
+`calibrate` updates the study surrogate by the user's measured runs, `new_printer` is the study as a
+prior for a printer not measured yet, `with_runs` adds runs the design loop imagines, and `report`
+says what a calibration found. The model behind them (printer factor, local correction) is in
+`designer.model.correction`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..errors import DesignerError
+from ..study import space
+from .correction import (
+    PRINTER_SD,
+    CalibratedSurface,
+    calibrated,
+    check_printer_sd,
+    evidence,
+    runs_table,
+    settings_of,
+)
+from .prediction import ResponseSurface
+from .surrogate import Surrogate
+
+
+def new_printer(surrogate: Surrogate, *, printer_sd: float = PRINTER_SD) -> Surrogate:
+    """The study surrogate as a prior for a printer not measured yet: every response carries the
+    printer factor's uncertainty, and the local correction the study's own runs observe (no run of
+    the user's). What a user's first print should expect; `calibrate` with runs continues from it."""
+    if surrogate.calibration is not None:
+        return surrogate
+    import pandas as pd
+
+    models = {
+        r: CalibratedSurface.from_base(
+            base,
+            *evidence(surrogate, r, {n: np.zeros(0) for n in space.FACTOR_NAMES}, np.zeros(0)),
+            settings_of(surrogate, r),
+            printer_sd,
+        )
+        for r, base in surrogate.models.items()
+    }
+    empty = pd.DataFrame(columns=list(space.FACTOR_NAMES) + surrogate.responses, dtype=float)
+    return Surrogate(
+        models=models,
+        table_hash=surrogate.table_hash,
+        training=surrogate.training,
+        prior=surrogate,
+        calibration={"table": empty, "printer_sd": printer_sd},
+    )
+
+
+def calibrate(surrogate: Surrogate, runs: Any, *, printer_sd: float = PRINTER_SD) -> Surrogate:
+    """The study surrogate updated by a user's measured runs: a printer factor and a local correction.
+
+    Args:
+        surrogate: the prior, usually the shipped study surrogate (`Surrogate.load()`); a surrogate
+            that is already calibrated is recalibrated from its own prior with all runs.
+        runs: the user's runs, a coefficient table (path or DataFrame: the six factors and any of
+            the surrogate's responses, e.g. k_x and c_x; designer identify's output) with 0 or more
+            rows. Responses missing from the table stay as in the prior.
+        printer_sd: prior standard deviation of log(printer factor).
+
+    Returns:
+        A new `Surrogate` whose responses are `CalibratedSurface`s; with no run, `surrogate` itself.
+
+    Raises:
+        DesignerError: a malformed table, a factor outside what can be printed, no response of the
+            surrogate's axis in the table, a non-positive coefficient, or printer_sd <= 0.
+    """
+    if not isinstance(surrogate, Surrogate) or not surrogate.models:
+        raise DesignerError(
+            f"surrogate={type(surrogate).__name__} is not a fitted Surrogate",
+            "give Surrogate.load() or a fitted Surrogate",
+        )
+    check_printer_sd(printer_sd)
+    prior = surrogate.prior if surrogate.calibration else surrogate
+    table = runs_table(runs, prior)
+    if prior is not surrogate and len(surrogate.calibration["table"]):
+        import pandas as pd
+
+        table = pd.concat([surrogate.calibration["table"], table], ignore_index=True)
+    return calibrated(prior, table, printer_sd)
+
+
+def with_runs(surrogate: Surrogate, rows: list[dict[str, float]]) -> Surrogate:
+    """`surrogate` calibrated on its own runs plus `rows`, runs the tool itself imagines (the six
+    factors and responses by their canonical names, printable), without a user table's checks: the
+    design loop recalibrates on each imagined measurement, where those checks cost half its time."""
+    import pandas as pd
+
+    if not rows:
+        return surrogate
+    if surrogate.calibration is None:
+        return calibrated(surrogate, pd.DataFrame(rows), PRINTER_SD)
+    table = pd.concat([surrogate.calibration["table"], pd.DataFrame(rows)], ignore_index=True)
+    return calibrated(surrogate.prior, table, surrogate.calibration["printer_sd"])
+
+
+def _user_loo(surrogate: Surrogate, response: str) -> dict[str, float] | None:
+    """Each of the user's runs predicted by the surrogate calibrated on the others (the prior and
+    its settings come from the study, so nothing is refitted on the user's runs)."""
+    table = surrogate.calibration["table"]
+    rows = np.flatnonzero(table[response].notna().to_numpy()) if response in table.columns else []
+    if len(rows) < 2:
+        return None
+    errors, inside = [], []
+    for i in rows:
+        others = calibrate(
+            surrogate.prior, table.drop(index=i), printer_sd=surrogate.calibration["printer_sd"]
+        )
+        p = others.model(response).predict(table.loc[[i], list(space.FACTOR_NAMES)]).at(0)
+        y = float(table.loc[i, response])
+        errors.append(abs(p.value - y) / y)
+        inside.append(p.low <= y <= p.high)
+    return {"n": len(rows), "mape": 100 * float(np.median(errors)), "coverage95": float(np.mean(inside))}
+
+
+def _statement(m: ResponseSurface, calibrated: ResponseSurface) -> str:
+    if not isinstance(calibrated, CalibratedSurface):
+        return "no measured value: the study's prediction"
+    if m.predictable:
+        return (
+            f"{m.response}: the study's {m.form} form times your printer's factor, corrected near the "
+            "designs you and the study printed (correlation length "
+            f"{calibrated.length:g} of a factor's half-range); far from them the interval stays as "
+            "wide as the study's plus the factor's uncertainty"
+        )
+    return (
+        f"{m.response} is not predictable from the six factors (the study's nested Q2 "
+        f"{m.accuracy.get('q2', float('nan')):.2f}): your runs set its level for your printer and pin it "
+        "down at the designs you printed; elsewhere its interval stays wide"
+    )
+
+
+def report(surrogate: Surrogate) -> dict[str, Any]:
+    """What a calibration found, as plain data: per response the user's run count, the printer
+    factor with its 95 % interval, and the nested leave-one-out over the user's runs.
+
+    Raises:
+        DesignerError: `surrogate` is not calibrated.
+    """
+    if surrogate.calibration is None:
+        raise DesignerError("surrogate is not calibrated", "give the result of designer.calibrate(...)")
+    table = surrogate.calibration["table"]
+    out: dict[str, Any] = {
+        "surrogate_id": surrogate.id,
+        "prior_id": surrogate.prior.id,
+        "n_runs": len(table),
+        "n_study_runs": len(surrogate.prior.training["run"]),
+        "printer_sd": surrogate.calibration["printer_sd"],
+        "responses": {},
+    }
+    for r, m in surrogate.models.items():
+        base = surrogate.prior.model(r)
+        cal = isinstance(m, CalibratedSurface)
+        out["responses"][r] = {
+            "unit": m.unit,
+            "n_runs": int(m.own.sum()) if cal else 0,
+            "printer_factor": m.printer_factor().to_dict() if cal else None,
+            "settings": m.settings() if cal else None,
+            "loo_user": _user_loo(surrogate, r) if cal else None,
+            "predictable": base.predictable,
+            "statement": _statement(base, m),
+        }
+    return out
