@@ -52,9 +52,9 @@ def main() -> int:
     import mujoco
 
     from designer.errors import DesignerError
-    from designer.validate.export import gain_changes, joint_numbers, other_joint_changes, pose_changes
     from designer.export.mjcf import export_mjcf
     from designer.joint import Joint
+    from designer.validate.export import gain_changes, joint_numbers, other_joint_changes, pose_changes
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--limit", type=int, default=0, help="joints per model (0: all)")

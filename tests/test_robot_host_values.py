@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 
 from designer.errors import DesignerError
-from designer.validate.export import gain_changes, other_joint_changes, pose_changes
 from designer.export.mjcf import export_mjcf
 from designer.export.urdf import export_urdf
 from designer.joint import Joint
+from designer.validate.export import gain_changes, other_joint_changes, pose_changes
 
 mujoco = pytest.importorskip("mujoco")
 
