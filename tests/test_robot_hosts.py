@@ -449,3 +449,64 @@ def test_cli_into_a_mesh_robot_from_its_folder(tmp_path, monkeypatch, capsys):
     code, out, err = run_inprocess([*args, "--m", "1e-05", "--axis", "theta", "-o", "jaco_flex.xml"], capsys)
     assert code == 0, err
     assert Path("jaco_flex.xml").is_file() and "stiffness: 0 -> 224.9 (SI)" in out
+
+
+def _example_robot_data() -> Path:
+    """example-robot-data's installed share folder, the `package://example-robot-data/` of its URDFs."""
+    import importlib.metadata
+
+    try:
+        dist = importlib.metadata.distribution("example-robot-data")
+    except importlib.metadata.PackageNotFoundError:
+        pytest.skip("example-robot-data is not installed")
+    return Path(dist.locate_file("cmeel.prefix/share/example-robot-data"))
+
+
+#: example-robot-data URDFs (ROS package:// meshes, Collada visuals MuJoCo discards) and a joint each
+ERD_ROBOTS = [
+    ("robots/ur_description", "urdf/ur5_robot.urdf", "elbow_joint"),
+    ("robots/panda_description", "urdf/panda.urdf", "panda_joint4"),
+]
+
+
+@pytest.mark.parametrize("sub, file, name", ERD_ROBOTS)
+def test_urdf_into_ros_robots_from_their_folder_checked_in_mujoco(tmp_path, monkeypatch, sub, file, name):
+    """From the robot's folder with relative paths: MuJoCo, which reads URDF damping, resolves the
+    package:// meshes against the folder given for the package and sees only that damping change;
+    without it the export says how to give it."""
+    from designer.export.urdf_packages import mujoco_urdf
+
+    share = _example_robot_data()
+    folder = _linked_folder(share / sub, tmp_path / "robot") / Path(file).parent
+    monkeypatch.chdir(folder)
+    host = Path(Path(file).name)
+    packages = {"example-robot-data": share}
+    with pytest.raises(ValueError, match="package:/example-robot-data"):
+        mujoco.MjModel.from_xml_path(str(host))  # what MuJoCo does with the file as shipped
+    out = export_urdf(
+        JOINT, Path("flex.urdf"), into=host, joint_name=name, axis="theta", package_paths=packages
+    )
+    assert any(n.startswith(f"checked in MuJoCo: {name} damping 0.0005 (SI)") for n in out.notes), out.notes
+    before, after = mujoco_urdf(host, packages), mujoco_urdf(out.path, packages)
+    assert before.nmesh >= 2 and np.array_equal(before.mesh_vert, after.mesh_vert)
+    assert joint_numbers(after, name)["damping"][0] == SI["theta"]["c"]
+    assert other_joint_changes(before, after, name) == [] and pose_changes(before, after) == []
+    unchecked = export_urdf(JOINT, Path("flex2.urdf"), into=host, joint_name=name, axis="theta")
+    said = [n for n in unchecked.notes if n.startswith("not checked in MuJoCo")]
+    assert said and "package_paths={'example-robot-data': 'DIR'}" in said[0]
+
+
+def test_cli_package_path(tmp_path, monkeypatch, capsys):
+    """--package-path NAME=DIR on the command line; a malformed one is one line, exit 2."""
+    from clitools import run_inprocess
+
+    share = _example_robot_data()
+    monkeypatch.chdir(_linked_folder(share / "robots/ur_description", tmp_path / "ur") / "urdf")
+    args = ["export", "urdf", "--into", "ur5_robot.urdf", "--joint", "elbow_joint", "--k", "22", "--c", "0.5"]
+    args += ["--axis", "theta", "-o", "ur5_flex.urdf"]
+    code, out, err = run_inprocess([*args, "--package-path", f"example-robot-data={share}"], capsys)
+    assert code == 0 and "checked in MuJoCo: elbow_joint damping 0.0005 (SI)" in out, err
+    code, out, _ = run_inprocess(args, capsys)
+    assert code == 0 and "--package-path example-robot-data=DIR" in out
+    code, _, err = run_inprocess([*args, "--package-path", "example-robot-data"], capsys)
+    assert code == 2 and "is not NAME=DIR" in err and "Traceback" not in err

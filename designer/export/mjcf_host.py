@@ -17,6 +17,25 @@ from ..files import atomic_path
 from ..joint import Joint
 from . import robot
 
+#: compiled-model arrays that follow from the mass matrix, so they change with a joint's armature
+#: (tendon_lengthspring follows the springref of the joints a fixed tendon couples, unless the host
+#: gives the tendon's springlength, which the edit does not touch)
+DERIVED = {
+    "actuator_acc0",
+    "body_invweight0",
+    "dof_M0",
+    "dof_invweight0",
+    "tendon_invweight0",
+    "tendon_lengthspring",
+}
+
+#: where a compiled model keeps its asset files' names (offsets into its `paths` string): MuJoCo stores
+#: them as the file was opened (a relative host, an absolute temporary file), so they differ with the
+#: same files; what the assets mean (mesh_vert, mesh_face, tex_data, hfield_data, skin_vert...) is compared
+ASSET_NAMES = {"hfield_pathadr", "mesh_pathadr", "skin_pathadr", "tex_pathadr"}
+
+#: compiled-model arrays the parallel edit sets, per joint, degree of freedom or qpos entry
+EDITED = {"jnt_stiffness": "jnt", "dof_damping": "dof", "dof_armature": "dof", "qpos_spring": "qpos"}
 #: what the advice's inertia is when it comes from the compiled robot
 MASS_MATRIX_BASIS = (
     "about the joint axis: MuJoCo's joint-space inertia (armature included) at the reference pose qpos0, "
@@ -144,3 +163,23 @@ def check_joint(after, joint_name: str, k: float, c: float) -> None:
     got = (float(j.stiffness[0]), float(after.dof_damping[j.dofadr[0]]))
     if got != (k, c):
         raise RuntimeError(f"joint {joint_name} compiled with stiffness, damping {got}, not {(k, c)}")
+
+
+def compiled_changes(before, after, joint_name: str, edited: dict[str, str] | None = None) -> list[str]:
+    """The compiled-model arrays (and options) that differ between `before` and `after`, leaving out
+    joint `joint_name`'s entries of the `edited` arrays (default: the parallel edit's, `EDITED`), what
+    MuJoCo derives from the mass matrix and where it stored asset file names."""
+    edited = EDITED if edited is None else edited
+    j = after.joint(joint_name)
+    index = {"jnt": j.id, "dof": j.dofadr[0], "qpos": j.qposadr[0]}
+    changed = []
+    for name in dir(before):
+        a = getattr(before, name)
+        if name.startswith("_") or not isinstance(a, np.ndarray) or name in DERIVED | ASSET_NAMES:
+            continue
+        b = getattr(after, name)
+        if a.shape == b.shape and name in edited:
+            a, b = np.delete(a, index[edited[name]], axis=0), np.delete(b, index[edited[name]], axis=0)
+        if a.shape != b.shape or not np.array_equal(a, b, equal_nan=True):
+            changed.append(name)
+    return changed + [g for g in ("opt", "vis") if repr(getattr(before, g)) != repr(getattr(after, g))]

@@ -12,8 +12,6 @@ from __future__ import annotations
 from functools import partial
 from pathlib import Path
 
-import numpy as np
-
 from ..joint import Joint
 from . import robot, xmltext
 from .mjcf_derived import dampratio_gains, gains_into_text, gains_note
@@ -21,6 +19,7 @@ from .mjcf_host import (
     MASS_MATRIX_BASIS,
     Host,
     check_joint,
+    compiled_changes,
     host_axis,
     mass_diagonal,
     open_host,
@@ -29,42 +28,10 @@ from .mjcf_host import (
 )
 from .stability import StepAdvice, step_advice
 
-#: compiled-model arrays that follow from the mass matrix, so they change with a joint's armature
-#: (tendon_lengthspring follows the springref of the joints a fixed tendon couples, unless the host
-#: gives the tendon's springlength, which the edit does not touch)
-_DERIVED = {
-    "actuator_acc0",
-    "body_invweight0",
-    "dof_M0",
-    "dof_invweight0",
-    "tendon_invweight0",
-    "tendon_lengthspring",
-}
-
-#: where a compiled model keeps its asset files' names (offsets into its `paths` string): MuJoCo stores
-#: them as the file was opened (a relative host, an absolute temporary file), so they differ with the
-#: same files; what the assets mean (mesh_vert, mesh_face, tex_data, hfield_data, skin_vert...) is compared
-_ASSET_NAMES = {"hfield_pathadr", "mesh_pathadr", "skin_pathadr", "tex_pathadr"}
-
-#: compiled-model arrays the parallel edit sets, per joint, degree of freedom or qpos entry
-_EDITED = {"jnt_stiffness": "jnt", "dof_damping": "dof", "dof_armature": "dof", "qpos_spring": "qpos"}
-
 
 def _compare_parallel(before, after, joint_name: str, k: float, c: float) -> None:
     """Raise if compiling the edited model changed anything but the joint and its mass-matrix terms."""
-    j = after.joint(joint_name)
-    index = {"jnt": j.id, "dof": j.dofadr[0], "qpos": j.qposadr[0]}
-    changed = []
-    for name in dir(before):
-        a = getattr(before, name)
-        if name.startswith("_") or not isinstance(a, np.ndarray) or name in _DERIVED | _ASSET_NAMES:
-            continue
-        b = getattr(after, name)
-        if a.shape == b.shape and name in _EDITED:
-            a, b = np.delete(a, index[_EDITED[name]], axis=0), np.delete(b, index[_EDITED[name]], axis=0)
-        if a.shape != b.shape or not np.array_equal(a, b, equal_nan=True):
-            changed.append(name)
-    changed += [g for g in ("opt", "vis") if repr(getattr(before, g)) != repr(getattr(after, g))]
+    changed = compiled_changes(before, after, joint_name)
     check_joint(after, joint_name, k, c)
     if changed:
         raise RuntimeError(f"editing one joint changed the compiled model's {', '.join(changed)}")

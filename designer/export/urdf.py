@@ -11,6 +11,7 @@ default of recomputing inertia from collision shapes gives the same number.
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from pathlib import Path
 
 from .. import units
@@ -18,8 +19,10 @@ from ..errors import DesignerError, check_type
 from ..files import atomic_path, atomic_write, check_suffix
 from ..joint import Joint, check_joint
 from . import robot, urdf_drake, xmltext
+from .mjcf_host import compiled_changes
 from .stability import step_advice
 from .urdf_inertia import moved_inertia
+from .urdf_packages import mujoco_urdf, packages_named
 
 #: a prismatic URDF joint needs limits; these (m) are wide enough never to act on a flexure
 PRISMATIC_LIMIT = 1.0
@@ -313,6 +316,33 @@ def _set_spring(text: str, joint_name: str, k: float, rest: float) -> str:
     return f"{text[:end].rstrip()}\n{lines}\n{text[end:]}"
 
 
+def _mujoco_check(
+    host: Path, path: Path, data: bytes, joint_name: str, package_paths: Mapping[str, str | Path] | None
+) -> tuple[str, ...]:
+    """Compile the host URDF and its edited copy (`data`, to be written at `path`) in MuJoCo and raise
+    unless only the joint's damping differs; the note saying so, or why MuJoCo could not check it."""
+    from lxml import etree
+
+    try:
+        before = mujoco_urdf(host, package_paths)
+    except DesignerError as exc:
+        if packages_named(host.read_text(errors="replace")) and "package://" in exc.problem:
+            return (f"not checked in MuJoCo: {exc}",)
+        if "MuJoCo cannot load" in exc.problem:
+            return (f"not checked in MuJoCo: {exc.problem}",)
+        raise
+    encoding = etree.fromstring(data).getroottree().docinfo.encoding or "utf-8"
+    after = mujoco_urdf(path, package_paths, data.decode(encoding))
+    changed = compiled_changes(before, after, joint_name, {"dof_damping": "dof"})
+    if changed:
+        raise RuntimeError(f"MuJoCo reads more than {joint_name}'s damping changed: {', '.join(changed)}")
+    damping = float(after.joint(joint_name).damping[0])
+    return (
+        f"checked in MuJoCo: {joint_name} damping {damping:.4g} (SI), every other compiled value as the "
+        "host's",
+    )
+
+
 def export_urdf(
     joint: Joint,
     path: str | Path,
@@ -322,6 +352,7 @@ def export_urdf(
     axis: str | None = None,
     rest: float | None = None,
     allow_outside_range: bool = False,
+    package_paths: Mapping[str, str | Path] | None = None,
 ) -> robot.RobotExport:
     """Write `joint` as URDF at `path` (.urdf) and return the path and the stated step advice.
 
@@ -332,6 +363,9 @@ def export_urdf(
     the joint's limits; outside them a given rest is refused unless `allow_outside_range`); its links
     are left as they are (URDF has no armature, so the flexure's own moving inertia is not added).
     The advice uses the inertia the joint moves according to the links' `<inertial>` (see `urdf_inertia`).
+    MuJoCo, which reads URDF damping, then compiles the host and the copy and must see only that
+    damping change; `package_paths` ({package name: folder}) resolves `package://` file names for it
+    (see `urdf_packages`). A host MuJoCo cannot load is written unchecked, and the notes say why.
 
     Raises:
         DesignerError: a wrong suffix, a missing mass, or an `into` problem.
@@ -350,9 +384,10 @@ def export_urdf(
             rest=rest,
             allow_outside_range=allow_outside_range,
         )
+        checked = _mujoco_check(Path(into), path, data, joint_name, package_paths)
         with atomic_path(path) as tmp:
             tmp.write_bytes(data)
-        return robot.RobotExport(path, advice, notes + READERS)
+        return robot.RobotExport(path, advice, notes + checked + READERS)
     text, advice = urdf_text(robot.with_masses(joint), rest=rest or 0.0)
     with atomic_write(path) as fh:
         fh.write(text)
