@@ -232,3 +232,17 @@ def test_series_puts_the_drive_friction_and_spring_on_the_motor_and_says_so(tmp_
     data.xfrc_applied[model.body("shin").id, 3:] = [0.0, 5.0, 0.0]  # torque about the joint axis y
     mujoco.mj_step(model, data, nstep=4000)
     assert data.qpos[knee.qposadr[0]] == pytest.approx(5.0 / k, rel=1e-3)
+
+
+def test_mjcf_into_a_urdf_says_what_to_do(tmp_path):
+    """MuJoCo loads a URDF, so the export got as far as 'joint not written in the file (an <include>)'."""
+    host = tmp_path / "arm.urdf"
+    host.write_text(
+        '<robot name="arm"><link name="a"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" '
+        'ixz="0" iyz="0"/></inertial></link><link name="b"><inertial><mass value="1"/><inertia ixx="1" '
+        'iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link><joint name="j" type="continuous">'
+        '<parent link="a"/><child link="b"/></joint></robot>'
+    )
+    with pytest.raises(DesignerError, match="is a URDF: .*export urdf with into= this file") as refused:
+        export_mjcf(JOINT, tmp_path / "out.xml", into=host, joint_name="j")
+    assert "\n" not in str(refused.value) and not (tmp_path / "out.xml").exists()

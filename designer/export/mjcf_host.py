@@ -92,6 +92,12 @@ def open_host(host: str | Path, joint_name: str) -> Host:
             f"its hinge and slide joints are: {', '.join(have) or 'none'}",
         )
     tree = etree.parse(str(host))
+    if tree.getroot().tag == "robot":
+        raise DesignerError(
+            f"into={str(host)!r} is a URDF: MuJoCo reads it, but designer writes MJCF into MJCF files only",
+            "export urdf with into= this file, or save it as MJCF first (MuJoCo's compile tool, or "
+            "mujoco.MjSpec.from_file(...).to_xml())",
+        )
     found = tree.getroot().xpath("//worldbody//body/joint[@name=$n]", n=joint_name)
     if len(found) != 1:
         raise DesignerError(
