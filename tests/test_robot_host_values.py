@@ -237,7 +237,8 @@ def test_series_puts_the_drive_friction_and_spring_on_the_motor_and_says_so(tmp_
 def test_mjcf_into_a_urdf_says_what_to_do(tmp_path):
     """MuJoCo loads a URDF, so the export got as far as 'joint not written in the file (an <include>)'."""
     host = tmp_path / "arm.urdf"
-    inertial = '<inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>'
+    inertia = '<inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/>'
+    inertial = f'<inertial><mass value="1"/>{inertia}</inertial>'
     host.write_text(
         f'<robot name="arm"><link name="a">{inertial}</link><link name="b">{inertial}</link>'
         '<joint name="j" type="continuous"><parent link="a"/><child link="b"/></joint></robot>'
