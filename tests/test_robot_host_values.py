@@ -5,12 +5,12 @@ and damping."""
 
 from __future__ import annotations
 
-import importlib.util
 import math
 from pathlib import Path
 
 import numpy as np
 import pytest
+from robot_packages import example_robot_data, package_dir
 
 from designer.errors import DesignerError
 from designer.export.mjcf import export_mjcf
@@ -87,10 +87,10 @@ def test_parallel_rest_outside_the_range_takes_the_keyframe_and_says_so(tmp_path
 def test_ant_ankle_rest_moves_inside_its_range(tmp_path):
     """gymnasium's ant (angles in degrees, no keyframe): ankle_1's range [30, 70] deg excludes its
     springref 0; the rest becomes 30 deg, written in degrees, and nothing else of the ant changes."""
-    spec = importlib.util.find_spec("gymnasium")
-    if spec is None:
+    folder = package_dir("gymnasium", "envs/mujoco/assets")
+    if folder is None:
         pytest.skip("gymnasium is not installed")
-    source = Path(next(iter(spec.submodule_search_locations))) / "envs/mujoco/assets/ant.xml"
+    source = folder / "ant.xml"
     host = tmp_path / "ant.xml"
     host.write_bytes(source.read_bytes())
     before = mujoco.MjModel.from_xml_path(str(host))
@@ -99,17 +99,6 @@ def test_ant_ankle_rest_moves_inside_its_range(tmp_path):
     assert after.qpos_spring[after.joint("ankle_1").qposadr[0]] == pytest.approx(math.radians(30), rel=1e-12)
     assert "the range's nearest value 0.5236 rad" in " | ".join(out.notes)
     assert other_joint_changes(before, after, "ankle_1") == [] and pose_changes(before, after) == []
-
-
-def example_robot_data() -> Path:
-    """example-robot-data's installed share folder (the `package://example-robot-data/` of its URDFs)."""
-    import importlib.metadata
-
-    try:
-        dist = importlib.metadata.distribution("example-robot-data")
-    except importlib.metadata.PackageNotFoundError:
-        pytest.skip("example-robot-data is not installed")
-    return Path(dist.locate_file("cmeel.prefix/share/example-robot-data"))
 
 
 def _panda_urdf() -> Path:

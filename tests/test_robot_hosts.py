@@ -12,7 +12,6 @@ both files), not from the exporter's self-check.
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import os
 import shutil
@@ -20,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from robot_packages import example_robot_data, linked_folder, package_dir
 
 from designer.errors import DesignerError
 from designer.export.mjcf import export_mjcf
@@ -34,13 +34,6 @@ JOINT = Joint.from_coefficients(
     {"theta": {"k": 50.0, "c": 0.5, "m": 1e-5}, "x": {"k": 0.8, "c": 2e-3, "m": 0.01}}
 )
 SI = {"theta": JOINT.axes["theta"].si(), "x": JOINT.axes["x"].si()}
-
-
-def _package_dir(name: str, sub: str) -> Path | None:
-    spec = importlib.util.find_spec(name)
-    if spec is None or not spec.submodule_search_locations:
-        return None
-    return Path(next(iter(spec.submodule_search_locations))) / sub
 
 
 #: (package, folder in it, file): every MJCF model these packages ship that has a hinge or slide joint
@@ -68,7 +61,7 @@ REFUSALS = {
 def _mjcf_cases() -> list:
     cases = []
     for package, (module, sub) in MJCF_FOLDERS.items():
-        folder = _package_dir(module, sub)
+        folder = package_dir(module, sub)
         if folder is None:
             cases.append(
                 pytest.param(package, None, marks=pytest.mark.skip(reason=f"{module} is not installed"))
@@ -190,7 +183,7 @@ def test_mjcf_into_every_model_the_packages_ship(copies, package, path):
 
 
 def test_mjcf_into_refuses_a_rest_outside_the_range_and_takes_one_inside(copies):
-    folder = _package_dir("gymnasium", "envs/mujoco/assets")
+    folder = package_dir("gymnasium", "envs/mujoco/assets")
     if folder is None:
         pytest.skip("gymnasium is not installed")
     host = copies(folder / "ant.xml")
@@ -359,7 +352,7 @@ def test_urdf_into_pybullet_data_robots_gives_drake_the_spring(tmp_path, file, n
 def test_a_new_rest_on_a_joint_a_fixed_tendon_couples(copies, package, sub, file, name):
     """MuJoCo derives the tendon's spring length from the new springref: the export runs (it exited 3
     before), the rest is exact, and nothing else of the host changes."""
-    folder = _package_dir(package, sub)
+    folder = package_dir(package, sub)
     if folder is None:
         pytest.skip(f"{package} is not installed")
     host = copies(folder / file)
@@ -382,13 +375,6 @@ MESH_HOSTS = [
 ]
 
 
-def _linked_folder(source: Path, target: Path) -> Path:
-    """`source`'s files linked into `target` (nothing copied, nothing written into site-packages:
-    the exports are new files beside the links, so the model's relative paths resolve as shipped)."""
-    shutil.copytree(source, target, copy_function=os.symlink, ignore=shutil.ignore_patterns("__pycache__"))
-    return target
-
-
 def _asset_files(model) -> list[str]:
     """Each mesh and texture file a compiled model read, as the absolute path it resolved to."""
     paths = bytes(model.paths)
@@ -407,10 +393,10 @@ def test_mesh_robots_from_their_own_folder_with_relative_paths(
     """As a user types it: in the robot's folder, relative --into and -o. MuJoCo stores asset file names
     as the file was opened, so a check of the compiled model's name offsets saw 'a change' on every host
     with two or more meshes (exit 3); what the assets mean is compared instead."""
-    source = _package_dir(package, sub)
+    source = package_dir(package, sub)
     if source is None or not source.is_dir():
         pytest.skip(f"{package} is not installed")
-    folder = _linked_folder(source, tmp_path / "robot") / Path(model).parent
+    folder = linked_folder(source, tmp_path / "robot") / Path(model).parent
     monkeypatch.chdir(folder)
     host = Path(Path(model).name)
     before = mujoco.MjModel.from_xml_path(str(host))
@@ -430,10 +416,10 @@ def test_cli_into_a_mesh_robot_from_its_folder(tmp_path, monkeypatch, capsys):
     """The command line the issue typed, in the robot's folder: exit 0 (it was 3)."""
     from clitools import run_inprocess
 
-    source = _package_dir("dm_control", "third_party/kinova")
+    source = package_dir("dm_control", "third_party/kinova")
     if source is None:
         pytest.skip("dm_control is not installed")
-    monkeypatch.chdir(_linked_folder(source, tmp_path / "kinova"))
+    monkeypatch.chdir(linked_folder(source, tmp_path / "kinova"))
     args = [
         "export",
         "mjcf",
@@ -451,17 +437,6 @@ def test_cli_into_a_mesh_robot_from_its_folder(tmp_path, monkeypatch, capsys):
     assert Path("jaco_flex.xml").is_file() and "stiffness: 0 -> 224.9 (SI)" in out
 
 
-def _example_robot_data() -> Path:
-    """example-robot-data's installed share folder, the `package://example-robot-data/` of its URDFs."""
-    import importlib.metadata
-
-    try:
-        dist = importlib.metadata.distribution("example-robot-data")
-    except importlib.metadata.PackageNotFoundError:
-        pytest.skip("example-robot-data is not installed")
-    return Path(dist.locate_file("cmeel.prefix/share/example-robot-data"))
-
-
 #: example-robot-data URDFs (ROS package:// meshes, Collada visuals MuJoCo discards) and a joint each
 ERD_ROBOTS = [
     ("robots/ur_description", "urdf/ur5_robot.urdf", "elbow_joint"),
@@ -476,8 +451,8 @@ def test_urdf_into_ros_robots_from_their_folder_checked_in_mujoco(tmp_path, monk
     without it the export says how to give it."""
     from designer.export.urdf_packages import mujoco_urdf
 
-    share = _example_robot_data()
-    folder = _linked_folder(share / sub, tmp_path / "robot") / Path(file).parent
+    share = example_robot_data()
+    folder = linked_folder(share / sub, tmp_path / "robot") / Path(file).parent
     monkeypatch.chdir(folder)
     host = Path(Path(file).name)
     packages = {"example-robot-data": share}
@@ -500,8 +475,8 @@ def test_cli_package_path(tmp_path, monkeypatch, capsys):
     """--package-path NAME=DIR on the command line; a malformed one is one line, exit 2."""
     from clitools import run_inprocess
 
-    share = _example_robot_data()
-    monkeypatch.chdir(_linked_folder(share / "robots/ur_description", tmp_path / "ur") / "urdf")
+    share = example_robot_data()
+    monkeypatch.chdir(linked_folder(share / "robots/ur_description", tmp_path / "ur") / "urdf")
     args = ["export", "urdf", "--into", "ur5_robot.urdf", "--joint", "elbow_joint", "--k", "22", "--c", "0.5"]
     args += ["--axis", "theta", "-o", "ur5_flex.urdf"]
     code, out, err = run_inprocess([*args, "--package-path", f"example-robot-data={share}"], capsys)
