@@ -44,13 +44,13 @@ def new_printer(surrogate: Surrogate, *, printer_sd: float = PRINTER_SD) -> Surr
         )
         for r, base in surrogate.models.items()
     }
-    empty = pd.DataFrame(columns=list(space.FACTOR_NAMES) + surrogate.responses, dtype=float)
+    columns = {c: np.zeros(0) for c in [*space.FACTOR_NAMES, *surrogate.responses]}
     return Surrogate(
         models=models,
         table_hash=surrogate.table_hash,
         training=surrogate.training,
         prior=surrogate,
-        calibration={"table": empty, "printer_sd": printer_sd},
+        calibration={"table": pd.DataFrame(columns), "columns": columns, "printer_sd": printer_sd},
     )
 
 
@@ -90,15 +90,21 @@ def calibrate(surrogate: Surrogate, runs: Any, *, printer_sd: float = PRINTER_SD
 def with_runs(surrogate: Surrogate, rows: list[dict[str, float]]) -> Surrogate:
     """`surrogate` calibrated on its own runs plus `rows`, runs the tool itself imagines (the six
     factors and responses by their canonical names, printable), without a user table's checks: the
-    design loop recalibrates on each imagined measurement, where those checks cost half its time."""
-    import pandas as pd
-
+    design loop recalibrates on each imagined measurement, where those checks (and a table's
+    bookkeeping) would cost most of its time."""
     if not rows:
         return surrogate
+    names = list(dict.fromkeys(c for row in rows for c in row))
+    new = {c: np.array([row.get(c, np.nan) for row in rows], dtype=float) for c in names}
     if surrogate.calibration is None:
-        return calibrated(surrogate, pd.DataFrame(rows), PRINTER_SD)
-    table = pd.concat([surrogate.calibration["table"], pd.DataFrame(rows)], ignore_index=True)
-    return calibrated(surrogate.prior, table, surrogate.calibration["printer_sd"])
+        return calibrated(surrogate, new, PRINTER_SD)
+    old = surrogate.calibration["columns"]
+    n_old = len(old[space.FACTOR_NAMES[0]])
+    both = {
+        c: np.concatenate([old.get(c, np.full(n_old, np.nan)), new.get(c, np.full(len(rows), np.nan))])
+        for c in dict.fromkeys([*old, *new])
+    }
+    return calibrated(surrogate.prior, both, surrogate.calibration["printer_sd"])
 
 
 def _user_loo(surrogate: Surrogate, response: str) -> dict[str, float] | None:
@@ -125,10 +131,10 @@ def _statement(m: ResponseSurface, calibrated: ResponseSurface) -> str:
         return "no measured value: the study's prediction"
     if m.predictable:
         return (
-            f"{m.response}: the study's {m.form} form times your printer's factor, corrected near the "
-            "designs you and the study printed (correlation length "
-            f"{calibrated.length:g} of a factor's half-range); far from them the interval stays as "
-            "wide as the study's plus the factor's uncertainty"
+            f"{m.response}: the study's {m.form} form through your printer's departure (its factor, "
+            "width and height offsets, infill, layer and raster adhesion, and a smooth rest), corrected "
+            f"near the designs you and the study printed (correlation length {calibrated.length:g} of a "
+            "factor's half-range); far from your prints the interval keeps what they leave open"
         )
     return (
         f"{m.response} is not predictable from the six factors (the study's nested Q2 "
@@ -139,7 +145,9 @@ def _statement(m: ResponseSurface, calibrated: ResponseSurface) -> str:
 
 def report(surrogate: Surrogate) -> dict[str, Any]:
     """What a calibration found, as plain data: per response the user's run count, the printer
-    factor with its 95 % interval, and the nested leave-one-out over the user's runs.
+    factor with its 95 % interval, what the runs say of each mechanism of the printer's departure
+    (`designer.model.mechanisms`: posterior value and 95 % interval beside the prior sd), and the
+    nested leave-one-out over the user's runs.
 
     Raises:
         DesignerError: `surrogate` is not calibrated.
@@ -162,6 +170,7 @@ def report(surrogate: Surrogate) -> dict[str, Any]:
             "unit": m.unit,
             "n_runs": int(m.own.sum()) if cal else 0,
             "printer_factor": m.printer_factor().to_dict() if cal else None,
+            "mechanisms": m.mechanisms() if cal else None,
             "settings": m.settings() if cal else None,
             "loo_user": _user_loo(surrogate, r) if cal else None,
             "predictable": base.predictable,
