@@ -115,7 +115,7 @@ def load(path: str | Path) -> Scenario:
         duration=d.required(sim, "duration", "simulation."),
         step=d.required(sim, "step", "simulation."),
         algorithm=sim.get("algorithm", "gauss-seidel"),
-        integrator=sim.get("integrator", "euler"),
+        integrator=sim.get("integrator"),
         outputs=outputs,
         validation_steps=tuple(d.number({"steps": s}, "steps", "validation.") for s in steps),
         validation_duration=d.number(val, "duration", "validation."),
