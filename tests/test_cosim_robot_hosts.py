@@ -123,3 +123,28 @@ def test_an_actuator_through_a_tendon_on_the_joint_is_refused(tmp_path):
     with pytest.raises(DesignerError, match="actuator 'm' drives joint 'j1' through tendon 't'") as refused:
         cosim.run(cosim.load(tmp_path / "s.toml"))
     assert "\n" not in str(refused.value)
+
+
+def test_a_ros_urdf_robot_with_its_package_folder(tmp_path, monkeypatch):
+    """example-robot-data's UR5 (meshes named package://example-robot-data/...) from its own folder:
+    MuJoCo loads it once the scenario names the package's folder; without it, one line says how."""
+    from robot_packages import example_robot_data
+
+    share = example_robot_data()
+    monkeypatch.chdir(linked_folder(share / "robots" / "ur_description", tmp_path / "ur") / "urdf")
+    scenario = (
+        '[simulation]\nduration = 0.2\nstep = 1e-3\n[robot]\nmodel = "ur5_robot.urdf"\nPACKAGES\n'
+        "[joints.elbow_joint]\ncoefficients = { k = 224934, c = 4773.24 }\n"
+        'reference = { type = "step", amplitude = 0.3, at = 0.05 }\n'
+    )
+    Path("bare.toml").write_text(scenario.replace("PACKAGES", ""))
+    with pytest.raises(DesignerError, match=r'package_paths = \{ example-robot-data = "DIR" \}') as refused:
+        cosim.load("bare.toml")
+    assert "\n" not in str(refused.value)
+    Path("ur5.toml").write_text(
+        scenario.replace("PACKAGES", f'package_paths = {{ example-robot-data = "{share}" }}')
+    )
+    with cosim.prepare(cosim.load("ur5.toml")) as session:
+        result = session.run()
+        assert session.master.systems["robot"].model.nmesh == 7
+    assert abs(result.column("robot.elbow_joint.s")[-1]) < 0.05  # the forearm follows its motor

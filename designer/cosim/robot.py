@@ -53,8 +53,35 @@ def planar_arm_xml(lengths: Sequence[float] = ARM_LENGTHS, masses: Sequence[floa
     return f'<mujoco model="planar_arm"><option gravity="0 0 -9.81"/><worldbody>{body}</worldbody></mujoco>'
 
 
-def load_spec(path: str | Path | None = None, lengths=ARM_LENGTHS, masses=ARM_MASSES):
-    """A MuJoCo spec from an MJCF or URDF file, or the built-in planar arm when `path` is None."""
+def _urdf_text(path: Path, package_paths: Mapping[str, str | Path] | None) -> str:
+    """A URDF's text with its file names resolved (see `designer.export.urdf_packages`).
+
+    Raises:
+        DesignerError: a package the URDF names that `package_paths` does not.
+    """
+    from ..export.urdf_packages import packages_named, resolved_urdf
+
+    missing = sorted(packages_named(path.read_text(errors="replace")) - set(package_paths or {}))
+    if missing:
+        raise DesignerError(
+            f"robot model {path.name} names files by package://{missing[0]}/..., which MuJoCo cannot resolve",
+            f'give the package\'s folder: [robot] package_paths = {{ {missing[0]} = "DIR" }} in a scenario '
+            "file (package_paths= in Python), as ROS's package path would",
+        )
+    return resolved_urdf(path, package_paths)
+
+
+def load_spec(
+    path: str | Path | None = None,
+    lengths=ARM_LENGTHS,
+    masses=ARM_MASSES,
+    package_paths: Mapping[str, str | Path] | None = None,
+):
+    """A MuJoCo spec from an MJCF or URDF file, or the built-in planar arm when `path` is None.
+
+    A URDF's `package://NAME/` file names resolve against `package_paths[NAME]` (a folder), as ROS's
+    package path would (see `designer.export.urdf_packages`); MuJoCo knows no packages.
+    """
     import mujoco
 
     if path is None:
@@ -63,7 +90,11 @@ def load_spec(path: str | Path | None = None, lengths=ARM_LENGTHS, masses=ARM_MA
     if not path.is_file():
         raise DesignerError(f"robot model {path} does not exist", "give the path of an MJCF or URDF file")
     try:
+        if path.suffix.lower() == ".urdf":
+            return mujoco.MjSpec.from_string(_urdf_text(path, package_paths))
         return mujoco.MjSpec.from_file(str(path))
+    except DesignerError:
+        raise
     except Exception as exc:  # mujoco raises a bare ValueError with its parser message
         raise DesignerError(
             f"MuJoCo cannot load {path}: {exc}", "give an MJCF or URDF file MuJoCo reads"

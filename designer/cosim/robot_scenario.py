@@ -11,6 +11,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import DesignerError
+from ..export.urdf_packages import check_package_paths
 from .host import host_integrator, integrator_name, take_host_actuators
 from .kernel import run_master
 from .master import Master, Series, System, Trace
@@ -37,10 +38,16 @@ class RobotScenario(Scenario):
     model: Path | None = None
     lengths: tuple[float, ...] = ARM_LENGTHS
     masses: tuple[float, ...] = ARM_MASSES
+    #: a URDF's package://NAME/ folders {NAME: folder}, as ROS's package path
+    package_paths: Mapping[str, Path] = field(default_factory=dict)
 
     kind: ClassVar[str] = "robot"
     keyword: ClassVar[str] = "joints"
     interface: ClassVar[str] = "force"
+
+    def model_spec(self):
+        """The robot model's MuJoCo spec, as the scenario names it (see `robot.load_spec`)."""
+        return load_spec(self.model, self.lengths, self.masses, self.package_paths)
 
     def own_fields(self) -> dict[str, Any]:
         out: dict[str, Any] = {}
@@ -55,7 +62,13 @@ class RobotScenario(Scenario):
                     "give one length and one mass per link",
                 )
             out |= {"lengths": lengths, "masses": masses}
-        spec = load_spec(out.get("model"), out.get("lengths", self.lengths), out.get("masses", self.masses))
+        out["package_paths"] = check_package_paths(self.package_paths)
+        spec = load_spec(
+            out.get("model"),
+            out.get("lengths", self.lengths),
+            out.get("masses", self.masses),
+            out["package_paths"],
+        )
         check_joints(spec, list(self.joints))
         for name, src in self.joints.items():
             if not isinstance(src, JointSource):
@@ -120,7 +133,7 @@ class RobotScenario(Scenario):
         ref_fine = _angles(robot_reference(self, laws, fine, duration, "rk4"), joints)
         same = _angles(trace(case, duration=duration), joints)
         same_ref = _angles(robot_reference(self, laws, self.step, duration, self.integrator), joints)
-        integrator = self.integrator or integrator_name(load_spec(self.model, self.lengths, self.masses))
+        integrator = self.integrator or integrator_name(self.model_spec())
         explicit = (
             f" (under {integrator}: a force set each step, as co-simulated)" if integrator in IMPLICIT else ""
         )
@@ -179,7 +192,7 @@ def robot_system(
     the run and its reference alike. `as_cosimulated`: under an implicit integrator the in-engine laws
     are explicit, as the co-simulation exchanges its torques (see `SpringDamper`); the sweeps'
     open-loop rollout needs them implicit."""
-    spec = load_spec(sc.model, sc.lengths, sc.masses)
+    spec = sc.model_spec()
     notes = free_host_joints(spec, [j for j, src in sc.joints.items() if not src.keep_host])
     notes += take_host_actuators(spec, list(sc.joints))
     name, said = host_integrator(spec, integrator or sc.integrator)

@@ -25,7 +25,7 @@ from .scenario import OUTPUTS, JointSource, Scenario
 KEYS = {
     "": ("simulation", "robot", "joints", "rig", "outputs", "validation"),
     "simulation": ("duration", "step", "algorithm", "integrator"),
-    "robot": ("model", "lengths", "masses"),
+    "robot": ("model", "lengths", "masses", "package_paths"),
     "joint": (
         "fmu",
         "coefficients",
@@ -160,8 +160,17 @@ def _robot(doc: Mapping, d: _Doc, common: dict) -> RobotScenario:
     for key, value in (("lengths", lengths), ("masses", masses)):
         if not isinstance(value, list):
             raise DesignerError(f"{d.where('robot.' + key)} must be a list of numbers", "e.g. [0.08, 0.06]")
+    packages = robot.get("package_paths", {})
+    if not isinstance(packages, dict):
+        raise DesignerError(
+            f"{d.where('robot.package_paths')} must be a table",
+            'e.g. package_paths = { my_robot = "../my_robot" }',
+        )
     return RobotScenario(
         model=None if model == "arm" else d.file(model, "robot.model"),
+        package_paths={
+            name: d.file(folder, f"robot.package_paths.{name}") for name, folder in packages.items()
+        },
         lengths=tuple(d.number({"lengths": x}, "lengths", "robot.") for x in lengths),
         masses=tuple(d.number({"masses": x}, "masses", "robot.") for x in masses),
         joints=joints,

@@ -12,7 +12,6 @@ import pandas as pd
 from .. import units
 from ..cosim.host import integrator_name
 from ..cosim.rig_scenario import RigScenario
-from ..cosim.robot import load_spec
 from ..cosim.robot_scenario import RobotScenario
 from ..files import atomic_folder, atomic_path, atomic_write
 from ..study import space
@@ -136,7 +135,7 @@ def engine_check(spec: Spec, *, cases: Sequence[Case], frame: pd.DataFrame) -> d
         "cases": [c.index for c in picks],
         "max_angle_difference_rad": angle,
         "max_metric_difference": metric_diff,
-        "integrator": sc.integrator or integrator_name(load_spec(sc.model, sc.lengths, sc.masses)),
+        "integrator": sc.integrator or integrator_name(sc.model_spec()),
     }
 
 
