@@ -148,3 +148,18 @@ def test_a_ros_urdf_robot_with_its_package_folder(tmp_path, monkeypatch):
         result = session.run()
         assert session.master.systems["robot"].model.nmesh == 7
     assert abs(result.column("robot.elbow_joint.s")[-1]) < 0.05  # the forearm follows its motor
+
+
+def test_a_joint_name_that_is_no_identifier(tmp_path):
+    """gymnasium-robotics' Franka names its joints 'robot:panda0_joint4': the joint FMU's model name is
+    made an identifier (it was refused: "joint name 'joint_robot:j1' is not an identifier")."""
+    (tmp_path / "arm.xml").write_text(
+        '<mujoco><worldbody><body name="l"><joint name="robot:j1" type="hinge" axis="0 1 0"/>'
+        '<geom type="capsule" fromto="0 0 0 0.2 0 0" size="0.01" mass="0.1"/></body></worldbody></mujoco>'
+    )
+    (tmp_path / "s.toml").write_text(
+        '[simulation]\nduration = 0.05\nstep = 1e-3\n[robot]\nmodel = "arm.xml"\n[joints."robot:j1"]\n'
+        "coefficients = { k = 330, c = 0.83 }\n"
+    )
+    result = cosim.run(cosim.load(tmp_path / "s.toml"))
+    assert len(result.column("robot.robot:j1.q")) == 51

@@ -8,6 +8,7 @@ README documents every key. This is the one place that decides a file's scenario
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -151,7 +152,8 @@ def _robot(doc: Mapping, d: _Doc, common: dict) -> RobotScenario:
     joints, motors = {}, {}
     for name, spec in joints_doc.items():
         key = f"joints.{name}"
-        joints[name] = _joint_source(spec, key, d, f"joint_{name}")
+        # the FMU's model name: robot joint names may hold what an identifier cannot ('robot:joint4')
+        joints[name] = _joint_source(spec, key, d, "joint_" + re.sub(r"\W", "_", name))
         motors[name] = _reference(
             spec.get("reference", {"type": "step", "amplitude": 0.0}), f"{key}.reference", d
         )
