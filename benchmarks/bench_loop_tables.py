@@ -31,7 +31,7 @@ def _cell(row: dict | None) -> str:
 
 def tables(results: list[dict]) -> str:
     names = [r["truth"] + (" (smooth)" if r.get("smooth") else "") for r in results]
-    head = "| | " + " | ".join(names) + " |\n| --- |" + " --- |" * len(names) + "\n"
+    head = "| | " + " | ".join(names) + " |\n| --- |" + " --- |" * len(names)
     out = ["| prints to a hit within +-10 %" + head[1:]]
     out.append(
         "| the loop: `calibrate`, `next --n 1` | " + " | ".join(_prints(r["loop"]) for r in results) + " |"
