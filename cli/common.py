@@ -219,6 +219,17 @@ FLAGS: tuple[Flag, ...] = (
     Flag(
         r"\bmotor_bandwidth=", "--motor-bandwidth ", "motor_inertia=0 and motor_bandwidth=0 must be positive"
     ),
+    Flag(
+        r"\brest=(?=\S+ (rad|m) is outside the range)",
+        "--rest ",
+        "rest=2 rad is outside the range [-1, 1] rad of robot joint 'knee'",
+    ),
+    Flag(
+        r"\bpackage_paths=\{'([^']+)': 'DIR'\}",
+        r"--package-path \1=DIR",
+        "as ROS's package path would: package_paths={'arm': 'DIR'}",
+    ),
+    Flag(r"\bpackage_paths\['([^']+)'\]=", r"--package-path \1=", "package_paths['arm']='x' is not a folder"),
 )
 
 
