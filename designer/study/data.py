@@ -36,7 +36,7 @@ PLAUSIBLE = {
 
 # accepted unit suffixes per factor and per (quantity, rotational)
 _FACTOR_SUFFIXES = {
-    "density": ("pct", "percent"),
+    "density": ("pct", "percent", "%"),
     "length": ("mm",),
     "width": ("mm",),
     "height": ("mm",),
@@ -70,8 +70,12 @@ def axes_present(table: pd.DataFrame) -> list[str]:
 
 
 def _canonical_name(col: str, source: str) -> str | None:
-    """Map a column name to its canonical name, checking any unit suffix; None if not ours."""
+    """Map a column name to its canonical name, checking any unit suffix (`k_x_N/mm`, or in
+    brackets as spreadsheets write it, `k_x [N/mm]`); None if not ours."""
     name = col.strip()
+    bracket = re.match(r"^(.*?)\s*\[\s*(.*?)\s*\]$", name)
+    if bracket:
+        name = f"{bracket[1]}_{bracket[2]}"
     for fac, suffixes in _FACTOR_SUFFIXES.items():
         if name == fac:
             return fac
@@ -266,7 +270,11 @@ def read_frame(path: str | Path) -> pd.DataFrame:
     from ..files import check_table_file
 
     check_table_file(path, parquet=is_parquet(path))
-    return pd.read_parquet(path) if is_parquet(path) else pd.read_csv(path)
+    if is_parquet(path):
+        return pd.read_parquet(path)
+    with open(path, "rb") as fh:  # Excel's "CSV (comma delimited)" may start with a line sep=,
+        excel = fh.readline().lstrip(b"\xef\xbb\xbf").strip() == b"sep=,"
+    return pd.read_csv(path, skiprows=1 if excel else 0)
 
 
 def write_frame(frame: pd.DataFrame, path: str | Path) -> Path:
