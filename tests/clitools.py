@@ -134,7 +134,14 @@ def make_inputs(folder: Path) -> None:
     (folder / "stifness.toml").write_text(arm.replace("coefficients", "stifness"))
 
 
+#: a short co-simulation of the arm with one joint (0.1 s): for tests of outputs, not of results
+ARM_SCENARIO = (
+    '[simulation]\nduration = 0.1\nstep = 1e-3\n[robot]\nmodel = "arm"\n[joints.j1]\naxis = "theta"\n'
+    'coefficients = { k = 330, c = 0.83 }\nreference = { type = "step", amplitude = 0.3, at = 0.05 }\n'
+)
 FACTORS = {"density": 60, "length": 24, "width": 4.5, "height": 9, "layer": 0.16, "raster": 0}
+#: the study's centre design as command-line flags
+SIX_FLAGS = [a for n, v in FACTORS.items() for a in (f"--{n}", str(v))]
 
 
 def _make_logs(folder: Path) -> None:

@@ -9,13 +9,7 @@ from __future__ import annotations
 import os
 
 import pytest
-from clitools import FACTORS, run_process
-
-ARM = (
-    '[simulation]\nduration = 0.1\nstep = 1e-3\n[robot]\nmodel = "arm"\n[joints.j1]\naxis = "theta"\n'
-    'coefficients = { k = 330, c = 0.83 }\nreference = { type = "step", amplitude = 0.3, at = 0.05 }\n'
-)
-SIX = [a for n, v in FACTORS.items() for a in (f"--{n}", str(v))]
+from clitools import ARM_SCENARIO, SIX_FLAGS, run_process
 
 
 def name(size: int, suffix: str) -> str:
@@ -33,7 +27,7 @@ CASES = {
     "doe 255": (lambda o: ["doe", "-o", o], name(255, ".csv")),
     "plot effects 250": (lambda o: ["plot", "effects", "-o", o], name(250, ".png")),
     "rig simulate + sidecar 254": (
-        lambda o: ["rig", "simulate", "--k", "0.8", "--c", "2e-3", "--duration", "1", *SIX, "-o", o],
+        lambda o: ["rig", "simulate", "--k", "0.8", "--c", "2e-3", "--duration", "1", *SIX_FLAGS, "-o", o],
         name(254, ".csv"),
     ),
     "cosim folder 255": (lambda o: ["cosim", "arm.toml", "-o", o], name(255, "")),
@@ -44,7 +38,7 @@ CASES = {
 def test_a_legal_long_output_name_is_written(case, tmp_path):
     args, out = CASES[case]
     (tmp_path / "tmp").mkdir()
-    (tmp_path / "arm.toml").write_text(ARM)
+    (tmp_path / "arm.toml").write_text(ARM_SCENARIO)
     env = dict(os.environ, TMPDIR=str(tmp_path / "tmp"), XDG_CACHE_HOME=str(tmp_path / "cache"))
     r = run_process(args(out), tmp_path, env=env)
     assert r.returncode == 0, r.stderr
@@ -56,7 +50,7 @@ def test_a_legal_long_output_name_is_written(case, tmp_path):
 def test_a_log_whose_sidecar_name_cannot_exist_is_refused_before_work(tmp_path):
     out = name(255, ".csv")  # the sidecar, .json, would be 256 bytes
     r = run_process(
-        ["rig", "simulate", "--k", "0.8", "--c", "2e-3", "--duration", "1", *SIX, "-o", out], tmp_path
+        ["rig", "simulate", "--k", "0.8", "--c", "2e-3", "--duration", "1", *SIX_FLAGS, "-o", out], tmp_path
     )
     assert r.returncode == 2, r.stderr
     assert "256 bytes" in r.stderr and r.stderr.count("\n") == 1, r.stderr

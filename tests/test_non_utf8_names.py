@@ -12,14 +12,9 @@ import shutil
 from pathlib import Path
 
 import pytest
-from clitools import FACTORS, run_process
+from clitools import ARM_SCENARIO, SIX_FLAGS, run_process
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-SIX = [a for n, v in FACTORS.items() for a in (f"--{n}", str(v))]
-ARM = (
-    '[simulation]\nduration = 0.1\nstep = 1e-3\n[robot]\nmodel = "arm"\n[joints.j1]\naxis = "theta"\n'
-    'coefficients = { k = 330, c = 0.83 }\nreference = { type = "step", amplitude = 0.3, at = 0.05 }\n'
-)
 
 
 def raw(name: bytes) -> str:
@@ -40,7 +35,7 @@ def run(args: list[str], cwd: Path):
 def test_a_rig_log_so_named_is_written_and_identified(tmp_path):
     log = raw(b"log\xff.csv")
     chirp = ["--duration", "20", "--f0", "1", "--f1", "3"]
-    run(["rig", "simulate", "--k", "0.8", "--c", "2e-3", *chirp, *SIX, "-o", log], tmp_path)
+    run(["rig", "simulate", "--k", "0.8", "--c", "2e-3", *chirp, *SIX_FLAGS, "-o", log], tmp_path)
     assert (tmp_path / log).stat().st_size > 0
     assert json.loads((tmp_path / raw(b"log\xff.json")).read_text())["factors"]["width"] == 4.5
     r = run(["identify", log, "-o", raw(b"table\xff.csv"), "--json"], tmp_path)
@@ -49,7 +44,7 @@ def test_a_rig_log_so_named_is_written_and_identified(tmp_path):
 
 
 def test_cosim_writes_into_a_folder_so_named(tmp_path):
-    (tmp_path / "arm.toml").write_text(ARM)
+    (tmp_path / "arm.toml").write_text(ARM_SCENARIO)
     run(["cosim", "arm.toml", "-o", raw(b"res\xff")], tmp_path)
     assert json.loads((tmp_path / raw(b"res\xff") / "metrics.json").read_text())
 

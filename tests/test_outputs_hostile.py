@@ -6,15 +6,11 @@ and the user's files stay as they were."""
 from __future__ import annotations
 
 import pytest
-from clitools import FACTORS, assert_clean_failure, run_inprocess, snapshot
+from clitools import ARM_SCENARIO, SIX_FLAGS, assert_clean_failure, run_inprocess, snapshot
 
 from designer.errors import DesignerError
 from designer.files import atomic_folder
 
-ARM = (
-    '[simulation]\nduration = 0.2\nstep = 1e-3\n[robot]\nmodel = "arm"\n[joints.j1]\naxis = "theta"\n'
-    'coefficients = { k = 330, c = 0.83 }\nreference = { type = "step", amplitude = 0.3, at = 0.05 }\n'
-)
 SWEEP = (
     'scenario = "arm.toml"\n[sweep]\npath = "engine"\ncheck = 0\n[cases]\ntype = "grid"\n'
     "[cases.joints.j1]\nk = [300, 330]\n"
@@ -43,7 +39,7 @@ def test_a_folder_named_like_an_output_file_is_refused_before_work(
 ):
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path.parent / "cache"))
-    (tmp_path / "arm.toml").write_text(ARM)
+    (tmp_path / "arm.toml").write_text(ARM_SCENARIO)
     (tmp_path / "sweep.toml").write_text(SWEEP)
     users_folder(tmp_path / folder, name)
     before = snapshot(tmp_path)
@@ -71,11 +67,10 @@ def test_moving_results_in_never_replaces_a_folder_with_a_file(tmp_path):
 def rig_log(tmp_path_factory):
     """A rig log that identifies (20 s, 1-3 Hz), with its factor sidecar."""
     folder = tmp_path_factory.mktemp("log")
-    factors = [a for n, v in FACTORS.items() for a in (f"--{n}", str(v))]
     args = ["rig", "simulate", "--k", "0.8", "--c", "2e-3", "--duration", "20", "--f0", "1", "--f1", "3"]
     from designer_cli.main import run
 
-    assert run([*args, *factors, "-o", str(folder / "log.csv")]) == 0
+    assert run([*args, *SIX_FLAGS, "-o", str(folder / "log.csv")]) == 0
     return folder / "log.csv"
 
 
