@@ -43,6 +43,31 @@ def read_toml(path: str | Path, *, what: str) -> tuple[Path, dict[str, Any]]:
     if not path.is_file():
         raise DesignerError(f"{what} file {path} does not exist", f"give the path of a .toml {what} file")
     try:
-        return path, tomllib.loads(path.read_text(encoding="utf-8-sig"))  # a BOM (Windows editors) is fine
+        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))  # a BOM (Windows editors) is fine
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise DesignerError(f"{path.name} is not valid TOML: {exc}", "fix the syntax") from None
+    except RecursionError:
+        data = None
+    if data is None or nesting(data) > MAX_NESTING:
+        raise DesignerError(
+            f"{path.name} nests tables or arrays more than {MAX_NESTING} deep",
+            f"a {what} file nests a few levels (see the README's {what} format)",
+        )
+    return path, data
+
+
+#: the deepest nesting of tables and arrays a scenario or sweep file may have (they use 4 or 5)
+MAX_NESTING = 16
+
+
+def nesting(value: Any) -> int:
+    """How deep tables and arrays nest in `value` (parsed TOML), walked without recursion."""
+    deepest, stack = 0, [(value, 0)]
+    while stack:
+        v, depth = stack.pop()
+        deepest = max(deepest, depth)
+        if depth > MAX_NESTING:
+            break
+        children = v.values() if isinstance(v, dict) else v if isinstance(v, list) else ()
+        stack.extend((c, depth + 1) for c in children)
+    return deepest
