@@ -227,18 +227,20 @@ class Scenario:
         raise NotImplementedError
 
 
-def check_memory(sc: Scenario) -> None:
-    """Refuse a run whose results would not fit in memory, before anything is allocated.
+def check_memory(sc: Scenario, duration: float | None = None) -> None:
+    """Refuse a run whose results would not fit in memory, before anything is allocated; `duration`
+    (s) replaces the scenario's (`Session.run(duration=)`).
 
     Raises:
         DesignerError: with the estimate and what is available.
     """
     from ..limits import check_memory as check
 
-    rows = sc.duration / sc.step + 1
+    duration = sc.duration if duration is None else duration
+    rows = duration / sc.step + 1
     check(
         8.0 * rows * (sc.signals() + 1),
-        what=f"duration = {sc.duration:g} s at step = {sc.step:g} s ({rows:.3g} steps)",
+        what=f"duration = {duration:g} s at step = {sc.step:g} s ({rows:.3g} steps)",
         fix="shorten the duration or lengthen the step",
     )
 

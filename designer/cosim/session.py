@@ -19,16 +19,19 @@ from __future__ import annotations
 
 import contextlib
 import math
+import numbers
 from collections.abc import Mapping
 from pathlib import Path
 
-from ..errors import DesignerError, check_type
+import numpy as np
+
+from ..errors import DesignerError, check_type, describe
 from ..files import temporary_folder
 from .fmu import FmuDescription, FmuSystem, unpack
 from .kernel import ENGINES, Bound, bind, run_master
 from .master import Master, Trace
 from .result import Result
-from .scenario import PARAMETER_FIELDS, JointSource, Progress, Scenario
+from .scenario import PARAMETER_FIELDS, JointSource, Progress, Scenario, check_memory, positive
 
 
 def _unpacked(src: JointSource, interface: str, folder: Path) -> Path:
@@ -115,6 +118,9 @@ class Session:
             DesignerError: an unknown system or parameter, or a value that is not a finite number.
         """
         out: dict[str, dict[str, float]] = {name: {} for name in self.systems}
+        example = 'give {"j1": {"theta.k": 0.3, "theta.c": 8e-4}} (SI, by joint)'
+        if parameters is not None and not isinstance(parameters, Mapping):
+            raise DesignerError(f"parameters is {describe(parameters)}, not a mapping", example)
         for name, values in (parameters or {}).items():
             if name not in self.systems:
                 raise DesignerError(
@@ -122,6 +128,8 @@ class Session:
                     f"its joints: {', '.join(self.systems)}",
                 )
             axis = self.scenario.sources()[name].axis
+            if not isinstance(values, Mapping):
+                raise DesignerError(f"parameters['{name}'] is {describe(values)}, not a mapping", example)
             for key, value in values.items():
                 field = str(key).partition(".")[2]
                 if not str(key).startswith(f"{axis}.") or field not in PARAMETER_FIELDS:
@@ -129,7 +137,9 @@ class Session:
                         f"parameters['{name}'] has '{key}', not a parameter of axis {axis}",
                         f"use {', '.join(f'{axis}.{f}' for f in PARAMETER_FIELDS)}",
                     )
-                if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                # numpy's float32 and int64 are numbers too; a bool (numpy's included) is not one
+                real = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+                if not real or not math.isfinite(value):
                     raise DesignerError(
                         f"parameters['{name}']['{key}'] = {value!r} is not a finite number",
                         "give its value in SI",
@@ -171,6 +181,9 @@ class Session:
         sc = self.scenario
         case = self.parameters(None) if case is None else case
         step = sc.step if step is None else step
+        if duration is not None:
+            duration = positive(duration, "duration")
+            check_memory(sc, duration)
         if step not in self._masters:
             self._masters[step] = self._master(step)
         master = self._masters[step]

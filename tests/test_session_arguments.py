@@ -1,0 +1,51 @@
+"""Issue 37, cause 10 (in part): `Session.run` with wrong types raised plain AttributeError or
+TypeError (a str or int for parameters, a str duration) or tried to allocate a duration of 1e300 s,
+and refused numpy's float32 and int64 numbers. Now: DesignerError naming the argument, numpy scalars
+accepted and run like Python floats."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from clitools import ARM_SCENARIO
+
+from designer.cosim import load
+from designer.cosim.session import prepare
+from designer.errors import DesignerError
+
+
+@pytest.fixture(scope="module")
+def session(tmp_path_factory):
+    path = tmp_path_factory.mktemp("arm") / "arm.toml"
+    path.write_text(ARM_SCENARIO)
+    with prepare(load(path)) as s:
+        yield s
+
+
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        ({"parameters": "j1"}, "parameters is a str"),
+        ({"parameters": 5}, "parameters is an int"),
+        ({"parameters": {"j1": 0.3}}, "parameters['j1'] is a float"),
+        ({"parameters": {"j1": {"theta.k": "0.3"}}}, "is not a finite number"),
+        ({"parameters": {"j1": {"theta.k": np.bool_(True)}}}, "is not a finite number"),
+        ({"duration": "2"}, "duration"),
+        ({"duration": 1e300}, "memory"),
+        ({"duration": -1.0}, "duration"),
+    ],
+    ids=["str", "int", "joint float", "text value", "numpy bool", "str duration", "1e300 s", "negative"],
+)
+def test_wrong_arguments_are_named(session, kwargs, words):
+    with pytest.raises(DesignerError, match=words.replace("[", r"\[").replace("]", r"\]")):
+        session.run(**kwargs)
+
+
+def test_numpy_numbers_run_as_python_floats(session):
+    session.run({"j1": {"theta.offset": np.int64(0)}}, duration=0.01)
+    plain = session.run({"j1": {"theta.k": 0.25, "theta.c": 8.3e-4}}, duration=0.05)
+    numpy = session.run(
+        {"j1": {"theta.k": np.float32(0.25), "theta.c": np.float64(8.3e-4)}}, duration=np.float64(0.05)
+    )
+    assert numpy.laws["j1"]["k"] == 0.25 and numpy.laws["j1"]["c"] == 8.3e-4
+    assert np.allclose(numpy.values, plain.values, rtol=1e-6, atol=1e-12)
