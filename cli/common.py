@@ -179,6 +179,7 @@ FLAGS: tuple[tuple[str, str], ...] = (
     (r"\bstop=(?=\S+ is not in)", "--stop "),
     (r"\bload_filter=", "--load-filter "),
     (r"\ballow_outside_range=True\b", "--allow-outside-range"),
+    (r"\baccept_implausible=True\b", "--accept-implausible"),
     (r"\btargets=\{'k': 0\.8\}", "--target k=0.8"),
     # export mjcf/urdf/sdf/modelica/ssp
     (r"\binto=", "--into "),

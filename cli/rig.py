@@ -38,12 +38,24 @@ def identify(
             "load_filter, else none)"
         ),
     ] = None,
+    runs: Annotated[
+        Path | None,
+        typer.Option(
+            "--runs", help="runs table of the prints (designer print's): fill the row of the print each log's sidecar names"
+        ),
+    ] = None,
+    accept_implausible: Annotated[
+        bool, typer.Option(help="with --runs, keep a k or c no printer can give (a unit slip is refused)")
+    ] = False,
     json_out: JsonOpt = False,
 ) -> None:
     """Identify m, c, k per axis from rig logs (F = m r'' + c r' + k r); exit 1 if any log fails.
 
     A force sensor's own low-pass lags the load like a delay and biases c (a 2nd-order Butterworth
     at 200 Hz: about -45 % of c at 0.8 N/mm); give it with --load-filter.
+
+    With --runs, each log's sidecar names its print ({"print": "P1"}) and its k and c go into that
+    print's row of the runs table designer print wrote, which designer calibrate reads.
 
     Example: designer identify run1.csv run2.parquet --load-delay 0.002 -o table.csv
     """
@@ -53,6 +65,8 @@ def identify(
 
     if output is not None:
         check_output(output, suffixes=TABLE_SUFFIXES)
+    if runs is not None:
+        check_output(runs, suffixes=TABLE_SUFFIXES)
     if load_delay is not None and load_delay != load_delay:
         raise DesignerError("--load-delay is NaN", "give the delay in seconds, e.g. --load-delay 0.002")
     with progress("identifying") as bar:
@@ -63,6 +77,11 @@ def identify(
         from designer.study.data import write_frame
 
         write_frame(results_table(passed), output)
+    filled = None
+    if runs is not None and passed:
+        from designer.printing.runs import fill_file
+
+        filled = fill_file(runs, passed, accept_implausible=accept_implausible)
     if json_out:
         print_json(
             {
@@ -71,6 +90,7 @@ def identify(
                 "failed": [str(r.path) for r in results if not r.ok],
                 "warnings": [f"{r.path}: {w}" for r in results for w in r.warnings],
                 "table": str(output) if wrote else None,
+                "runs": filled,
             }
         )
     else:
@@ -81,6 +101,11 @@ def identify(
             console.print(f"wrote {output} ({len(passed)} of {len(results)} logs)")
         elif output is not None:
             console.print(f"no log passed: {output} not written")
+        if filled is not None:
+            console.print(
+                f"filled {', '.join(filled['filled'])} in {runs}"
+                + (f"; not measured yet: {', '.join(filled['waiting'])}" if filled["waiting"] else "")
+            )
     if len(passed) < len(results):
         raise typer.Exit(1)
 

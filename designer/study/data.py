@@ -36,7 +36,7 @@ PLAUSIBLE = {
 
 # accepted unit suffixes per factor and per (quantity, rotational)
 _FACTOR_SUFFIXES = {
-    "density": ("pct", "percent"),
+    "density": ("pct", "percent", "%"),
     "length": ("mm",),
     "width": ("mm",),
     "height": ("mm",),
@@ -70,8 +70,12 @@ def axes_present(table: pd.DataFrame) -> list[str]:
 
 
 def _canonical_name(col: str, source: str) -> str | None:
-    """Map a column name to its canonical name, checking any unit suffix; None if not ours."""
+    """Map a column name to its canonical name, checking any unit suffix (`length_mm`, or in
+    brackets: `length [mm]`, `k_x [N/mm]`); None if not ours."""
     name = col.strip()
+    bracketed = re.fullmatch(r"(\S+)\s*\[\s*(.+?)\s*\]", name)
+    if bracketed:
+        name = f"{bracketed[1]}_{bracketed[2]}"
     for fac, suffixes in _FACTOR_SUFFIXES.items():
         if name == fac:
             return fac
