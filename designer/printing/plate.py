@@ -24,8 +24,9 @@ from ..errors import DesignerError
 from . import settings
 from .specimen import Specimen
 
-#: the 3MF relationship type the slicers' configuration files are attached with
-RELATIONSHIP = "http://schemas.openxmlformats.org/package/2006/relationships/metadata/thumbnail"
+#: the relationship type the slicers' configuration files are attached with (the slicers find them
+#: by path; a 3MF reader keeps attachments of the types it is told to read)
+RELATIONSHIP = "http://schemas.slic3r.org/3mf/2017/06/config"
 SPACING_MM = 10.0
 PRUSA_PLATE = "/Metadata/Slic3r_PE.config"
 PRUSA_OBJECTS = "/Metadata/Slic3r_PE_model.config"
