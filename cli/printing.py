@@ -17,11 +17,15 @@ _FACTOR_HELP = "one design's setting (give all six, or --from)"
 
 
 def print_(
-    output: Annotated[Path, typer.Option("-o", "--output", help="Folder for the plate, STLs, .ini files (and runs.csv).")],
+    output: Annotated[
+        Path, typer.Option("-o", "--output", help="Folder for the plate, STLs, .ini files (and runs.csv).")
+    ],
     from_: Annotated[
         Path | None, typer.Option("--from", help="designer next --json (its prints) or suggest --json output")
     ] = None,
-    candidate: Annotated[int | None, typer.Option(help="candidate of a suggest output (default 1, the best)")] = None,
+    candidate: Annotated[
+        int | None, typer.Option(help="candidate of a suggest output (default 1, the best)")
+    ] = None,
     density: Annotated[float | None, typer.Option(help=_FACTOR_HELP)] = None,
     length: Annotated[float | None, typer.Option(help=_FACTOR_HELP)] = None,
     width: Annotated[float | None, typer.Option(help=_FACTOR_HELP)] = None,
@@ -29,11 +33,15 @@ def print_(
     layer: Annotated[float | None, typer.Option(help=_FACTOR_HELP)] = None,
     raster: Annotated[float | None, typer.Option(help=_FACTOR_HELP)] = None,
     ids: Annotated[
-        list[str] | None, typer.Option("--id", help="print id to engrave, one per design (default P1, P2, ...)")
+        list[str] | None,
+        typer.Option("--id", help="print id to engrave, one per design (default P1, P2, ...)"),
     ] = None,
     runs: Annotated[
         Path | None,
-        typer.Option("--runs", help="runs table to append this batch to (ids continue its own); default OUTPUT/runs.csv"),
+        typer.Option(
+            "--runs",
+            help="runs table to append this batch to (ids continue its own); default OUTPUT/runs.csv",
+        ),
     ] = None,
     axis: AxisOpt = "x",
     block_length: Annotated[float, typer.Option(help="clamping block along the beam, mm")] = 12.0,
@@ -52,16 +60,26 @@ def print_(
     Example: designer next --k 0.8 --n 3 --json > next.json && designer print --from next.json -o prints
     """
     from designer.files import check_output, check_output_folder
-    from designer.printing import batch, runs as runs_table
+    from designer.printing import batch
+    from designer.printing import runs as runs_table
     from designer.printing.specimen import Clamp
 
     check_output_folder(output)
     if runs is not None:
         check_output(runs, suffixes=(".csv", ".parquet", ".pq"))
-    given = {"density": density, "length": length, "width": width, "height": height, "layer": layer, "raster": raster}
+    given = {
+        "density": density,
+        "length": length,
+        "width": width,
+        "height": height,
+        "layer": layer,
+        "raster": raster,
+    }
     one = {n: v for n, v in given.items() if v is not None}
     if from_ is not None and one:
-        raise DesignerError("both --from and design settings are given", "give --from FILE or the six settings")
+        raise DesignerError(
+            "both --from and design settings are given", "give --from FILE or the six settings"
+        )
     if from_ is None:
         if len(one) < 6:
             missing = ", ".join(f"--{n}" for n, v in given.items() if v is None)
@@ -91,8 +109,12 @@ def print_(
         )
     for note in made.notes:
         console.print(f"- {note}")
-    console.print(f"plate: {files['plate']} (open in PrusaSlicer, OrcaSlicer or Bambu Studio: each object has its settings)")
-    console.print(f"per print: {', '.join(Path(s).name for s in files['stl'])} with the .ini of the same name")
+    console.print(
+        f"plate: {files['plate']} (PrusaSlicer, OrcaSlicer or Bambu Studio: each object carries its settings)"
+    )
+    console.print(
+        f"per print: {', '.join(Path(s).name for s in files['stl'])} with the .ini of the same name"
+    )
     console.print(
         f"runs table: {files['runs']}; after the rig, name the print in each log's sidecar "
         '({"print": "P1"}) and run designer identify LOGS --runs ' + files["runs"]
@@ -101,11 +123,15 @@ def print_(
 
 def _read_json(path: Path) -> dict:
     if not path.exists():
-        raise DesignerError(f"no such file: {path}", "give the output of designer next --json or suggest --json")
+        raise DesignerError(
+            f"no such file: {path}", "give the output of designer next --json or suggest --json"
+        )
     try:
         return json.loads(path.read_text())
     except (OSError, ValueError, UnicodeDecodeError) as exc:
-        raise DesignerError(f"cannot read {path}: {exc}", "give the output of designer next --json or suggest --json") from None
+        raise DesignerError(
+            f"cannot read {path}: {exc}", "give the output of designer next --json or suggest --json"
+        ) from None
 
 
 def register(app: typer.Typer) -> None:

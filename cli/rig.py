@@ -41,7 +41,8 @@ def identify(
     runs: Annotated[
         Path | None,
         typer.Option(
-            "--runs", help="runs table of the prints (designer print's): fill the row of the print each log's sidecar names"
+            "--runs",
+            help="the prints' runs table (designer print's): fill the row of the print a log's sidecar names",
         ),
     ] = None,
     accept_implausible: Annotated[

@@ -33,7 +33,11 @@ class Moves:
     def select(self, obj: str, kind: str | None = None) -> np.ndarray:
         """Rows of the segments of object `obj` (and of feature `kind` when given)."""
         return np.array(
-            [i for i, (o, k) in enumerate(zip(self.objects, self.kinds)) if o == obj and kind in (None, k)],
+            [
+                i
+                for i, (o, k) in enumerate(zip(self.objects, self.kinds, strict=True))
+                if o == obj and kind in (None, k)
+            ],
             dtype=int,
         )
 

@@ -28,7 +28,9 @@ DESIGNS = [
     {"density": 85.0, "length": 28.3, "width": 3.2, "height": 12.0, "layer": 0.12, "raster": 0.0},
 ]
 SLICER = shutil.which("prusa-slicer")
-needs_slicer = pytest.mark.skipif(SLICER is None, reason="PrusaSlicer's command line (prusa-slicer) is not installed")
+needs_slicer = pytest.mark.skipif(
+    SLICER is None, reason="PrusaSlicer's command line (prusa-slicer) is not installed"
+)
 
 
 @pytest.fixture(scope="module")
@@ -40,7 +42,9 @@ def made(tmp_path_factory):
 
 
 def slice_(args: list[str], out: Path) -> gcode.Moves:
-    run = subprocess.run([SLICER, *args, "--export-gcode", "--output", str(out)], capture_output=True, text=True, timeout=300)
+    run = subprocess.run(
+        [SLICER, *args, "--export-gcode", "--output", str(out)], capture_output=True, text=True, timeout=300
+    )
     assert run.returncode == 0 and out.exists(), run.stdout[-2000:] + run.stderr[-2000:]
     return gcode.read(out)
 
@@ -53,7 +57,9 @@ def test_specimen_is_a_closed_solid_with_its_id_engraved():
     assert mesh.is_watertight and mesh.is_winding_consistent
     length = 2 * clamp.length + params["length"]
     assert np.allclose(mesh.bounds, [[0, 0, 0], [length, clamp.width, clamp.height]])
-    solid = 2 * clamp.length * clamp.width * clamp.height + params["length"] * params["width"] * params["height"]
+    solid = (
+        2 * clamp.length * clamp.width * clamp.height + params["length"] * params["width"] * params["height"]
+    )
     engraved = solid - mesh.volume
     assert 0 < engraved < clamp.depth * (clamp.length - 2 * clamp.margin) * (clamp.width - 2 * clamp.margin)
     # the engraving: a section just under the top of the first block has holes, the second none
@@ -95,21 +101,28 @@ def test_plate_reads_back_in_lib3mf(made):
     attachments = {model.GetAttachment(i).GetPath() for i in range(model.GetAttachmentCount())}
     assert attachments == {plate.PRUSA_PLATE, plate.PRUSA_OBJECTS, plate.ORCA_OBJECTS, plate.ORCA_PLATE}
     # each dialect's object settings name the 3D model's resource ids
-    for uri, keys in ((plate.PRUSA_OBJECTS, ("layer_height", "fill_density", "fill_angle")),
-                      (plate.ORCA_OBJECTS, ("layer_height", "sparse_infill_density", "infill_direction"))):
+    for uri, keys in (
+        (plate.PRUSA_OBJECTS, ("layer_height", "fill_density", "fill_angle")),
+        (plate.ORCA_OBJECTS, ("layer_height", "sparse_infill_density", "infill_direction")),
+    ):
         root = ET.fromstring(bytes(model.FindAttachment(uri).WriteToBuffer()))
         for obj in root.iter("object"):
             meta = {m.get("key"): m.get("value") for m in obj.findall("metadata")}
             rid, *_ = found[meta["name"]]
             assert int(obj.get("id")) == rid
             params = next(p.params for p in prepared.prints if p.print_id == meta["name"])
-            assert [meta[k] for k in keys] == [f"{params['layer']:g}", f"{params['density']:g}%", f"{params['raster']:g}"]
+            assert [meta[k] for k in keys] == [
+                f"{params['layer']:g}",
+                f"{params['density']:g}%",
+                f"{params['raster']:g}",
+            ]
     project = json.loads(bytes(model.FindAttachment(plate.ORCA_PLATE).WriteToBuffer()))
     assert project["nozzle_temperature"] == ["210"] and project["hot_plate_temp"] == ["60"]
 
 
-def check_gcode(moves: gcode.Moves, obj: str, params: dict, clamp: Clamp = Clamp()) -> None:
+def check_gcode(moves: gcode.Moves, obj: str, params: dict) -> None:
     """Everything the print asked of the slicer, read back from its G-code."""
+    clamp = Clamp()
     assert list(gcode.layer_heights(moves, obj)) == [params["layer"]]
     z = (params["height"] + clamp.height) / 2  # a layer through the blocks only
     raster = params["raster"]
@@ -153,23 +166,55 @@ def test_runs_template(made):
     _, files = made
     runs = pd.read_csv(files["runs"])
     assert list(runs.columns) == [
-        "print", "density [%]", "length [mm]", "width [mm]", "height [mm]", "layer [mm]", "raster [deg]",
-        "k_x [N/mm]", "c_x [N.s/mm]", "log",
+        "print",
+        "density [%]",
+        "length [mm]",
+        "width [mm]",
+        "height [mm]",
+        "layer [mm]",
+        "raster [deg]",
+        "k_x [N/mm]",
+        "c_x [N.s/mm]",
+        "log",
     ]
-    assert list(runs["print"]) == ["P1", "P2", "P3"] and runs[["k_x [N/mm]", "c_x [N.s/mm]"]].isna().all().all()
+    assert (
+        list(runs["print"]) == ["P1", "P2", "P3"] and runs[["k_x [N/mm]", "c_x [N.s/mm]"]].isna().all().all()
+    )
 
 
 def test_print_cli_design_and_bad_input(tmp_path, capsys):
     out = tmp_path / "one"
-    args = ["print", "--density", "60", "--length", "24", "--width", "4.5", "--height", "9", "--layer", "0.16", "--raster", "0"]
+    args = [
+        "print",
+        "--density",
+        "60",
+        "--length",
+        "24",
+        "--width",
+        "4.5",
+        "--height",
+        "9",
+        "--layer",
+        "0.16",
+        "--raster",
+        "0",
+    ]
     code, text, err = run_inprocess([*args, "-o", out], capsys)
     assert code == 0, err
-    assert "P1: infill 60 %" in text and sorted(p.name for p in out.iterdir()) == ["P1.ini", "P1.stl", "plate.3mf", "runs.csv"]
+    assert "P1: infill 60 %" in text and sorted(p.name for p in out.iterdir()) == [
+        "P1.ini",
+        "P1.stl",
+        "plate.3mf",
+        "runs.csv",
+    ]
     assert trimesh.load(out / "P1.stl").is_watertight
     # a second batch appended to the first one's table continues its ids
     code, text, err = run_inprocess([*args, "--runs", out / "runs.csv", "-o", tmp_path / "two"], capsys)
     assert code == 0, err
-    assert list(pd.read_csv(out / "runs.csv")["print"]) == ["P1", "P2"] and (tmp_path / "two" / "P2.stl").exists()
+    assert (
+        list(pd.read_csv(out / "runs.csv")["print"]) == ["P1", "P2"]
+        and (tmp_path / "two" / "P2.stl").exists()
+    )
     for bad, words in (
         (["print", "--density", "60", "-o", tmp_path / "x"], "missing --length"),
         ([*args, "--id", "Q!", "-o", tmp_path / "x"], "cannot be engraved"),

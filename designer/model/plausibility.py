@@ -59,7 +59,8 @@ def check_measured(surrogate: Surrogate, table: Any, *, accept_implausible: bool
     if accept_implausible or table is None or len(table) == 0:
         return
     prior = surrogate.prior if surrogate.calibration else surrogate
-    responses = [r for r in prior.responses if r in table.columns]
+    # stiffness first: the response a printer factor is best known for
+    responses = sorted((r for r in prior.responses if r in table.columns), key=lambda r: r[0] != "k")
     if not responses:
         return
     designs = table[list(space.FACTOR_NAMES)]
@@ -77,10 +78,11 @@ def check_measured(surrogate: Surrogate, table: Any, *, accept_implausible: bool
         i = int(bad[0])
         unit = units.rig_unit(q, axis)
         ratio = measured[i] / float(p.value[i])
+        pi = f"{float(p.value[i]):.3g} [{float(p.low[i]):.3g}, {float(p.high[i]):.3g}] {unit}"
         label = f" (print {table['print'].iloc[i]})" if "print" in table.columns else ""
         raise DesignerError(
             f"runs: {r} of row {i + 1}{label} is {measured[i]:.4g} {unit}, {ratio:.3g} times the study's "
-            f"prediction there ({float(p.value[i]):.3g} [{float(p.low[i]):.3g}, {float(p.high[i]):.3g}] {unit}): "
+            f"prediction there ({pi}): "
             f"a printer factor far outside its prior ({low_f:.2f}-{high_f:.2f} at 95 %)",
             f"{likely_slip(q, axis, ratio)}; if the value is right, pass accept_implausible=True",
         )

@@ -40,7 +40,9 @@ def designs_from(doc: Mapping[str, Any], candidate: int | None = None) -> list[d
         DesignerError: neither output, or a candidate it does not hold.
     """
     if not isinstance(doc, Mapping):
-        raise DesignerError("the file is not a designer next or suggest JSON output", "give designer next --json's output")
+        raise DesignerError(
+            "the file is not a designer next or suggest JSON output", "give designer next --json's output"
+        )
     if "prints" in doc and "recommendation" in doc:
         if candidate is not None:
             raise DesignerError("candidate is for a suggest output", "a next output's prints are all printed")
@@ -60,9 +62,7 @@ def designs_from(doc: Mapping[str, Any], candidate: int | None = None) -> list[d
     )
 
 
-def prepare(
-    designs: Sequence[Mapping[str, Any]], ids: Sequence[str], clamp: Clamp | None = None
-) -> Batch:
+def prepare(designs: Sequence[Mapping[str, Any]], ids: Sequence[str], clamp: Clamp | None = None) -> Batch:
     """The specimens of `designs` (the six settings; a density of "any", a solid section, prints
     at 100 %) with `ids`, each beam's height rounded to whole layers.
 
@@ -89,7 +89,9 @@ def prepare(
     return Batch(prints=prints, notes=notes)
 
 
-def write_batch(batch: Batch, folder: str | Path, *, runs_path: str | Path | None = None, axis: str = "x") -> dict[str, Any]:
+def write_batch(
+    batch: Batch, folder: str | Path, *, runs_path: str | Path | None = None, axis: str = "x"
+) -> dict[str, Any]:
     """Write the plate, each print's STL and PrusaSlicer `.ini`, and the runs table.
 
     The files go into `folder` (filled beside it and moved in at the end); the runs table is
@@ -107,7 +109,8 @@ def write_batch(batch: Batch, folder: str | Path, *, runs_path: str | Path | Non
         clash = sorted(set(existing[runs.PRINT]) & set(rows[runs.PRINT]))
         if clash:
             raise DesignerError(
-                f"{runs_path} already holds print(s) {', '.join(clash)}", "give new print ids (or leave them to designer)"
+                f"{runs_path} already holds print(s) {', '.join(clash)}",
+                "give new print ids (or leave them to designer)",
             )
         rows = pd.concat([existing, rows], ignore_index=True)
     folder = Path(folder)

@@ -50,7 +50,9 @@ def template(prints: Sequence[tuple[str, dict[str, float]]], axis: str = "x") ->
 def next_ids(existing: pd.DataFrame | None, n: int, prefix: str = "P") -> list[str]:
     """`n` print ids continuing the `prefix`-numbered ids of an existing runs table (P1, P2, ...)."""
     used = [] if existing is None or PRINT not in existing.columns else list(existing[PRINT].astype(str))
-    numbers = [int(m[1]) for u in used if (m := re.fullmatch(rf"{re.escape(prefix)}(\d+)", u.strip().upper()))]
+    numbers = [
+        int(m[1]) for u in used if (m := re.fullmatch(rf"{re.escape(prefix)}(\d+)", u.strip().upper()))
+    ]
     start = max(numbers, default=0) + 1
     return [f"{prefix}{i}" for i in range(start, start + n)]
 
@@ -60,7 +62,8 @@ def read_runs(path: str | Path) -> pd.DataFrame:
     raw = read_frame(path)
     if PRINT not in raw.columns:
         raise DesignerError(
-            f"{Path(path).name}: no '{PRINT}' column", "give the runs table designer print wrote (one row per print id)"
+            f"{Path(path).name}: no '{PRINT}' column",
+            "give the runs table designer print wrote (one row per print id)",
         )
     raw[PRINT] = raw[PRINT].astype(str).str.strip().str.upper()
     return raw
@@ -79,7 +82,9 @@ def measured(table: Any, source: str = "runs") -> tuple[pd.DataFrame, list[str]]
     measured_cols = [c for c in named.columns if re.fullmatch(r"[ck]_(x|y|z|theta|phi|psi)", str(c))]
     if not measured_cols:
         return load_table(raw), []  # load_table names what is missing
-    cells = named[measured_cols].notna() & named[measured_cols].astype(str).apply(lambda col: col.str.strip() != "")
+    cells = named[measured_cols].notna() & named[measured_cols].astype(str).apply(
+        lambda col: col.str.strip() != ""
+    )
     empty = ~cells.any(axis=1)
     partial = cells.any(axis=1) & ~cells.all(axis=1)
     if partial.any():
@@ -93,11 +98,17 @@ def measured(table: Any, source: str = "runs") -> tuple[pd.DataFrame, list[str]]
         )
     notes = []
     if empty.any():
-        ids = list(raw.loc[empty, PRINT].astype(str)) if PRINT in raw.columns else [str(i + 1) for i in np.flatnonzero(empty)]
+        ids = (
+            list(raw.loc[empty, PRINT].astype(str))
+            if PRINT in raw.columns
+            else [str(i + 1) for i in np.flatnonzero(empty)]
+        )
         notes.append(f"not measured yet, left out: {', '.join(ids)}")
     kept = raw.loc[~empty].reset_index(drop=True)
     if kept.empty:
-        raise DesignerError(f"{source}: no print is measured yet", "identify the prints' rig logs into it first")
+        raise DesignerError(
+            f"{source}: no print is measured yet", "identify the prints' rig logs into it first"
+        )
     return load_table(kept), notes
 
 
@@ -159,13 +170,16 @@ def fill(runs: pd.DataFrame, results: Sequence[Any], axis: str = "x") -> tuple[p
             table_row = {n: float(factors[n].iloc[i]) for n in space.FACTOR_NAMES}
             off = [n for n in space.FACTOR_NAMES if not np.isclose(res.factors[n], table_row[n], atol=0.011)]
             if off:
+                logged = ", ".join(f"{n} {res.factors[n]:g}" for n in off)
                 raise DesignerError(
-                    f"{res.path}: print {print_id}'s sidecar gives {', '.join(f'{n} {res.factors[n]:g}' for n in off)}, "
+                    f"{res.path}: print {print_id}'s sidecar gives {logged}, "
                     f"the runs table {', '.join(f'{n} {table_row[n]:g}' for n in off)}",
                     "the prints may be mixed up: check the id engraved on the specimen",
                 )
         if axis not in res.axes:
-            raise DesignerError(f"{res.path}: no {axis} axis identified", f"log the {axis} axis of print {print_id}")
+            raise DesignerError(
+                f"{res.path}: no {axis} axis identified", f"log the {axis} axis of print {print_id}"
+            )
         fit = res.axes[axis]
         out.loc[i, k_col], out.loc[i, c_col], out.loc[i, LOG] = fit.k, fit.c, str(res.path)
         filled.append(print_id)

@@ -67,10 +67,10 @@ class Specimen:
 
 def beam_box(params: dict[str, float], clamp: Clamp) -> dict[str, float]:
     """Where the beam of `params` sits between the blocks of `clamp` (mm)."""
-    l, b, h = params["length"], params["width"], params["height"]
+    length, b, h = params["length"], params["width"], params["height"]
     return {
         "x0": clamp.length,
-        "x1": clamp.length + l,
+        "x1": clamp.length + length,
         "y0": (clamp.width - b) / 2,
         "y1": (clamp.width + b) / 2,
         "z0": 0.0,
@@ -99,7 +99,9 @@ def _label(manifold3d: Any, print_id: str, clamp: Clamp) -> Any:
     top = clamp.height
     cut = None
     for u0, v0, u1, v1 in strokes(print_id, glyph_w, glyph_h, clamp.stroke):
-        part = _box(manifold3d, x_top - v1, x_top - v0, y_start + u0, y_start + u1, top - clamp.depth, top + 1.0)
+        part = _box(
+            manifold3d, x_top - v1, x_top - v0, y_start + u0, y_start + u1, top - clamp.depth, top + 1.0
+        )
         cut = part if cut is None else cut + part
     return cut
 
@@ -116,9 +118,11 @@ def specimen(params: dict[str, float], print_id: str, clamp: Clamp | None = None
 
     clamp = (clamp or Clamp()).checked()
     print_id = check_print_id(print_id)
-    l, b, h = (float(params[n]) for n in ("length", "width", "height"))
-    if min(l, b, h) <= 0:
-        raise DesignerError(f"a beam of {l:g} x {b:g} x {h:g} mm", "give a positive length, width and height")
+    length, b, h = (float(params[n]) for n in ("length", "width", "height"))
+    if min(length, b, h) <= 0:
+        raise DesignerError(
+            f"a beam of {length:g} x {b:g} x {h:g} mm", "give a positive length, width and height"
+        )
     if b >= clamp.width or h >= clamp.height:
         raise DesignerError(
             f"the beam ({b:g} mm wide, {h:g} mm high) does not fit the {clamp.width:g} x {clamp.height:g} mm "

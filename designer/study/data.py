@@ -130,6 +130,13 @@ def normalise(raw: pd.DataFrame, source: str = "table") -> pd.DataFrame:
             "a coefficient table needs density, length, width, height, layer, raster",
         )
     if not axes_present(table):
+        alone = [c for c in coefficient_columns(table) if not c.startswith("m_")]
+        if alone:
+            pairs = ", ".join(f"{'c' if c[0] == 'k' else 'k'}{c[1:]}" for c in alone)
+            raise DesignerError(
+                f"{source}: {', '.join(alone)} without {pairs}",
+                "give both k and c of an axis (designer identify writes both)",
+            )
         raise DesignerError(
             f"{source}: no coefficient columns",
             "give c_<axis> and k_<axis> for at least one axis (x y z theta phi psi)",
