@@ -28,6 +28,19 @@ The truth:
   print as much as the surrogate's nested cross-validation says it errs there. c keeps the spline
   (the factors do not predict it).
 - A printer multiplies k by ``factor_k`` and c by ``factor_c``, each drawn uniformly in 0.6-1.5.
+- Mechanism printers (``Printer(seed, mechanism=...)``, one of ``MECHANISMS``): real printers differ
+  from the study's by mechanisms, not by one factor. Each is the physics of the truth above applied
+  to what this printer actually prints:
+  ``extrusion``: over- or under-extrusion, the printed width and height are the nominal plus offsets
+  drawn in -0.1..+0.3 mm each (TPU is mostly over-extruded), and k and c are the truth's at the printed
+  section;
+  ``adhesion``: weaker or stronger bonds between layers, k and c times exp(-loss) with
+  ``loss = a s (1 + r [raster 45])``, s = (layer - 0.12) / 0.08 in 0..1, a in -0.05..0.3 and r in
+  -0.6..0.6 (the raster turns the bond lines against the load);
+  ``infill``: another infill pattern, whose stiffness scales as density^p of the study's cubic one
+  (p in 0.6..1.8: the infill prints at the effective density 100 (density/100)^p);
+  ``combined``: all three at once.
+  On top of each, the overall factors above.
 - A print scatters log-normally around its printer's truth: 2.5 % for k and for c (the study's
   replicate pair, runs 28 and 35, differs by 2.5 % in k).
 
@@ -35,7 +48,7 @@ API (designs are mappings or DataFrames with the columns ``FACTORS``, in the stu
 length/width/height mm, layer mm, raster deg):
 - ``Truth(draw=None, scale=DEPARTURE_SCALE)``: ``k(designs)`` N/mm, ``c(designs)`` N.s/mm,
   ``solid_fraction(designs)`` (arrays).
-- ``Printer(seed, drawn=False, scale=DEPARTURE_SCALE)``: ``factor_k``, ``factor_c``, ``k(designs)``,
+- ``Printer(seed, drawn=False, scale=DEPARTURE_SCALE, mechanism=None)``: ``factor_k``, ``factor_c``, ``k(designs)``,
   ``c(designs)`` (its truth), ``prints(designs, rng)`` -> a coefficient table (``density_pct,
   length_mm, width_mm, height_mm, layer_mm, raster_deg, k_x_N_per_mm, c_x_Ns_per_mm``), one row per
   print.
@@ -71,6 +84,12 @@ LEVELS = {"layer": (0.12, 0.16, 0.2), "raster": (0.0, 45.0)}
 WALL_MM = 0.8
 LINE_MM = 0.4
 PRINTER_FACTORS = (0.6, 1.5)
+#: the mechanism printers' kinds and the ranges their parameters are drawn from
+MECHANISMS = ("extrusion", "adhesion", "infill", "combined")
+OFFSET_MM = (-0.1, 0.3)
+ADHESION_LOSS = (-0.05, 0.3)
+ADHESION_RASTER = (-0.6, 0.6)
+INFILL_EXPONENT = (0.6, 1.8)
 PRINT_NOISE = 0.025
 STUDY = Path(__file__).resolve().parents[1] / "designer" / "bundled" / "study_table3_x.csv"
 # smoothing of the splines on the scaled log data. k: the spline passes the study's runs within
@@ -218,10 +237,17 @@ def grid(fixed: Mapping[str, float] | None = None, points: int = 9) -> pd.DataFr
 
 
 class Printer:
-    """One user's printer and spool: the study's truth times its own factors, and its print scatter."""
+    """One user's printer and spool: the study's truth times its own factors, through its own
+    mechanism (`mechanism`, see the module docstring), and its print scatter."""
 
     def __init__(
-        self, seed: int, *, noise: float = PRINT_NOISE, drawn: bool = False, scale: float = DEPARTURE_SCALE
+        self,
+        seed: int,
+        *,
+        noise: float = PRINT_NOISE,
+        drawn: bool = False,
+        scale: float = DEPARTURE_SCALE,
+        mechanism: str | None = None,
     ):
         rng = np.random.default_rng(seed)
         self.seed = seed
@@ -229,12 +255,40 @@ class Printer:
         self.noise = noise
         self._truth = Truth(draw=seed if drawn else None, scale=scale)
         self._grids: dict[tuple, tuple[pd.DataFrame, np.ndarray]] = {}
+        if mechanism is not None and mechanism not in MECHANISMS:
+            raise ValueError(f"mechanism {mechanism!r} is not one of {MECHANISMS}")
+        self.mechanism = mechanism
+        draws = np.random.default_rng([seed, 35])  # the mechanism's own stream: the factors stay as above
+        both = mechanism == "combined"
+        self.offsets = draws.uniform(*OFFSET_MM, size=2) if mechanism == "extrusion" or both else np.zeros(2)
+        self.adhesion = (
+            (draws.uniform(*ADHESION_LOSS), draws.uniform(*ADHESION_RASTER))
+            if mechanism == "adhesion" or both
+            else (0.0, 0.0)
+        )
+        self.exponent = draws.uniform(*INFILL_EXPONENT) if mechanism == "infill" or both else 1.0
+
+    def printed(self, designs) -> pd.DataFrame:
+        """What this printer makes of nominal designs: the section with its offsets, the infill at its
+        effective density."""
+        d = _frame(designs).copy()
+        d["width"] = d["width"] + self.offsets[0]
+        d["height"] = d["height"] + self.offsets[1]
+        d["density"] = 100.0 * (d["density"] / 100.0) ** self.exponent
+        return d
+
+    def _bond(self, designs) -> np.ndarray:
+        """exp(-loss) of the layer bonds at nominal designs."""
+        d = _frame(designs)
+        s = (d["layer"].to_numpy() - 0.12) / 0.08
+        a, r = self.adhesion
+        return np.exp(-a * s * (1.0 + r * (d["raster"].to_numpy() == 45.0)))
 
     def k(self, designs) -> np.ndarray:
-        return self.factor_k * self._truth.k(designs)
+        return self.factor_k * self._truth.k(self.printed(designs)) * self._bond(designs)
 
     def c(self, designs) -> np.ndarray:
-        return self.factor_c * self._truth.c(designs)
+        return self.factor_c * self._truth.c(self.printed(designs)) * self._bond(designs)
 
     def prints(self, designs, rng: np.random.Generator) -> pd.DataFrame:
         """Print and measure each design once: a coefficient table in the study's column names."""
@@ -270,6 +324,7 @@ class Printer:
         return {f: float(g.iloc[i][f]) for f in FACTORS}, bool(miss[i] <= tolerance)
 
 
-def printers(n: int, seed: int = 0, *, drawn: bool = False) -> list[Printer]:
-    """`n` printers with independent factors (seeds seed, seed + 1, ...), and drawn truths if `drawn`."""
-    return [Printer(seed + i, drawn=drawn) for i in range(n)]
+def printers(n: int, seed: int = 0, *, drawn: bool = False, mechanism: str | None = None) -> list[Printer]:
+    """`n` printers with independent factors (seeds seed, seed + 1, ...), drawn truths if `drawn`, and
+    each its own draw of `mechanism`."""
+    return [Printer(seed + i, drawn=drawn, mechanism=mechanism) for i in range(n)]

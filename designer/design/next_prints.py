@@ -180,10 +180,45 @@ def _batch_p(surrogate: Surrogate, scorer: _Scorer, designs: list[dict[str, floa
     return total / DRAWS
 
 
-def _predictable_targets(sug: Any) -> dict[str, float]:
-    return {
+def _predictable_targets(sug: Any, axis: str) -> dict[str, float]:
+    """The predictable target values of a suggestion's goals: what a print can raise the chance of.
+
+    Raises:
+        DesignerError: there is none.
+    """
+    targets = {
         q: t.value for q, t in sug.targets.items() if t.has_value and sug.predictability[q]["predictable"]
     }
+    if not targets:
+        raise DesignerError(
+            "no predictable target value is given, so no print can raise the chance of landing on it",
+            f"give k= a target value (k_{axis} is predictable); min or max goals have no landing chance",
+        )
+    return targets
+
+
+def _chance_text(best: Candidate, targets: Mapping[str, float], tolerance: float) -> str:
+    """The recommendation's chance in words: of the predictable targets (what the loop acts on) and,
+    with other goals, of meeting every goal at once (the responses are independent given the model)."""
+    band = f"+-{100 * tolerance:g} %"
+    text = f"{' and '.join(targets)} within {band} with probability {float(best.p_within or 0.0):.2f}"
+    if set(best.probability) - set(targets):
+        every = float(np.prod(list(best.probability.values())))
+        text += f" ({' and '.join(best.probability)} all within {band}: {every:.2f})"
+    return text
+
+
+def _doubt_text(surrogate: Surrogate) -> str:
+    """What the stated chance counts: the printer's departure from the study, as far as the user's
+    prints leave it open."""
+    n = len(next(iter(surrogate.calibration["columns"].values()), []))
+    mechanisms = "its factor, width and height offsets, infill, layer and raster adhesion"
+    if n == 0:
+        return f"counting how your printer may depart from the study's ({mechanisms})"
+    return (
+        f"counting the doubt your {n} print(s) leave about how your printer departs from the study's "
+        f"({mechanisms})"
+    )
 
 
 def _check_arguments(n: int, stop: float) -> None:
@@ -274,16 +309,11 @@ def next_prints(
     if surrogate.calibration is None:
         surrogate = new_printer(surrogate)
         statements.append(
-            "not calibrated to your printer yet: P includes its unknown printer/material factor "
-            "(suggest states P for the study's own printer)"
+            "not calibrated to your printer yet: P counts how an unmeasured printer may depart from "
+            "the study's (suggest states P for the study's own printer)"
         )
     sug = suggest(surrogate, k=k, c=c, axis=axis, fixed=fixed, top=POOL, tolerance=tolerance)
-    targets = _predictable_targets(sug)
-    if not targets:
-        raise DesignerError(
-            "no predictable target value is given, so no print can raise the chance of landing on it",
-            f"give k= a target value (k_{axis} is predictable); min or max goals have no landing chance",
-        )
+    targets = _predictable_targets(sug, axis)
     scorer = _Scorer(surrogate, axis, targets, tolerance)
     best = sug.candidates[0]
     p_now = float(best.p_within or 0.0)
@@ -293,10 +323,11 @@ def next_prints(
             "no print is proposed: the target lies outside what the data supports (see above)"
         ]
         return NextPrints(axis, goals, tolerance, best, p_now, False, [], p_now, statements, False)
+    chance = _chance_text(best, targets, tolerance)
     if p_now >= stop:
         text = (
-            f"print design #1: it lands within +-{100 * tolerance:g} % with probability {p_now:.2f} "
-            f"(>= {stop:g}); no other print is expected to do better first"
+            f"print design #1: {chance} (>= {stop:g}), {_doubt_text(surrogate)}; no other print is "
+            "expected to do better first"
         )
         return NextPrints(axis, goals, tolerance, best, p_now, True, [], p_now, statements + [text])
     chosen = _greedy_batch(surrogate, scorer, sug.candidates, best, int(n), progress)
@@ -307,8 +338,8 @@ def next_prints(
     if progress is not None:
         progress(1.0)
     statements += [
-        f"the best design now lands within +-{100 * tolerance:g} % with probability {p_now:.2f}; "
-        f"after printing and measuring these {len(chosen)}, the best is expected to land with {p_after:.2f}",
+        f"the best design now: {chance}, {_doubt_text(surrogate)}; after printing and measuring these "
+        f"{len(chosen)}, the best is expected to land with {p_after:.2f}",
         "then: add the measured coefficients to your runs table, designer calibrate, designer next again",
     ]
     if len(chosen) < n:

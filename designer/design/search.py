@@ -26,6 +26,11 @@ N_STARTS = 12
 #: designs closer than this in normalised factor space are the same design
 DISTINCT = 0.05
 #: measured runs listed when a target lies between the predicted and the measured range
+#: points per free continuous factor of the grid that backs up the search where no design it found
+#: meets the targets (IPOPT is local: a calibrated surface has bumps at the user's prints)
+GRID_POINTS = 5
+#: grid designs nearest the targets that IPOPT polishes
+GRID_BEST = 4
 IPOPT = {
     "ipopt.print_level": 0,
     "print_time": False,
@@ -189,3 +194,38 @@ def reachable_range(problem: Problem, q: str, box: Box) -> tuple[float, float]:
             design = as_solid(box.design(np.asarray(sol["x"]).ravel(), combo))  # as printed
             values.append(float(f([design[n] for n in space.FACTOR_NAMES])[0]))
     return min(values), max(values)
+
+
+def grid(box: Box, fixed: Mapping[str, float]) -> list[dict[str, float]]:
+    """Printable designs on a grid over the search box: GRID_POINTS values per free continuous factor
+    (fixed ones held), every categorical combination, each as printed."""
+    axes = [
+        np.linspace(lo, hi, GRID_POINTS) if hi > lo else np.array([lo])
+        for lo, hi in zip(box.lbu, box.ubu, strict=True)
+    ]
+    coded = np.array(list(itertools.product(*axes)))
+    held = {f.name: fixed[f.name] for f in space.CONTINUOUS if f.name in fixed}
+    return [
+        as_solid(space.round_printable(box.design(u, combo) | held)) for combo in box.combos for u in coded
+    ]
+
+
+def polish(
+    problem: Problem,
+    box: Box,
+    targets: Mapping[str, Target],
+    info: Mapping[str, Mapping[str, Any]],
+    designs: list[dict[str, float]],
+    fixed: Mapping[str, float],
+) -> list[dict[str, float]]:
+    """IPOPT on the search's cost from each of `designs` (within its categorical combination)."""
+    params = weights(targets, info)
+    held = {f.name: fixed[f.name] for f in space.CONTINUOUS if f.name in fixed}
+    out = []
+    for d in designs:
+        combo = tuple(d[f.name] for f in space.CATEGORICAL)
+        u0 = (np.array([d[f.name] for f in space.CONTINUOUS]) - box.lows) / box.spans
+        p = np.concatenate([combo, box.lows, box.spans, params])
+        u = problem.solve(np.clip(u0, box.lbu, box.ubu), (box.lbu, box.ubu), p)
+        out.append(as_solid(space.round_printable(box.design(u, combo) | held)))
+    return out

@@ -25,7 +25,18 @@ from ..model.prediction import Prediction
 from ..model.surrogate import Surrogate, check_surrogate
 from ..study import space
 from .candidates import Candidate, Suggestion
-from .search import DISTINCT, Box, Problem, distance, reachable_range, search, search_box
+from .search import (
+    DISTINCT,
+    GRID_BEST,
+    Box,
+    Problem,
+    distance,
+    grid,
+    polish,
+    reachable_range,
+    search,
+    search_box,
+)
 from .targets import TOLERANCE, Target, make_target, probability_within
 
 N_NEAREST_RUNS = 3
@@ -113,13 +124,18 @@ def suggest(
     problem = Problem(surrogate, axis)
     raw = search(problem, box, targets, info, search_fixed)
     ranked = rank(surrogate, axis, raw, targets, info, tolerance)
+    judged = judged_targets(targets, info)
+    if not any(meets(c, judged, tolerance) for c in ranked):  # IPOPT is local: back it up with a grid
+        near = grid_nearest(surrogate, axis, box, targets, judged, search_fixed)
+        raw += near + polish(problem, box, targets, info, near, search_fixed)
+        ranked = rank(surrogate, axis, raw, targets, info, tolerance)
     spans = {f.name: float(s) for f, s in zip(space.CONTINUOUS, box.spans, strict=True)}
     picked: list[Candidate] = []
     for cand in ranked:
         if len(picked) < top and all(distance(cand.params, o.params, spans) > DISTINCT for o in picked):
             picked.append(cand)
     sug = Suggestion(axis, targets, picked, True, [], info, surrogate.id, fixed, tolerance)
-    assess(sug, surrogate, problem, box)
+    assess(sug, surrogate, problem, box, ranked)
     if len(picked) < top:
         sug.statements.append(
             f"{len(picked)} distinct design(s) instead of the {top} asked for: every start of the search "
@@ -217,13 +233,49 @@ def pi_text(p: Prediction, unit: str) -> str:
     return f"{p.value:.3g} [{p.low:.2g}, {p.high:.2g}] {unit}"
 
 
-def assess(sug: Suggestion, surrogate: Surrogate, problem: Problem, box: Box) -> None:
-    """Fill reachable, statements, ranges and nearest runs of a suggestion, goal by goal."""
+def judged_targets(targets: Mapping[str, Target], info: Mapping[str, Mapping[str, Any]]) -> list[str]:
+    """The goals reachability is judged on: the predictable target values, else every target value."""
+    scored = [q for q, t in targets.items() if t.has_value and info[q]["predictable"]]
+    return scored or [q for q, t in targets.items() if t.has_value]
+
+
+def meets(candidate: Candidate, judged: list[str], tolerance: float) -> bool:
+    """Whether a candidate's prediction lies within the tolerance of every judged target."""
+    return all(abs(candidate.rel_error[q]) <= tolerance for q in judged)
+
+
+def grid_nearest(
+    surrogate: Surrogate,
+    axis: str,
+    box: Box,
+    targets: Mapping[str, Target],
+    judged: list[str],
+    fixed: Mapping[str, float],
+) -> list[dict[str, float]]:
+    """The GRID_BEST designs of the printable grid whose predictions come nearest every judged target."""
+    designs = grid(box, fixed)
+    preds = grid_predictions(surrogate, axis, designs, judged)
+    miss = np.max([np.abs(preds[q] / targets[q].value - 1.0) for q in judged], axis=0)
+    return [designs[i] for i in np.argsort(miss, kind="stable")[:GRID_BEST]]
+
+
+def grid_predictions(
+    surrogate: Surrogate, axis: str, designs: list[dict[str, float]], quantities: list[str]
+) -> dict[str, np.ndarray]:
+    """Predicted values of `quantities` at `designs`, shape (n,) each."""
+    cols = {n: np.array([d[n] for d in designs]) for n in space.FACTOR_NAMES}
+    preds = surrogate.predict(cols, responses=[f"{q}_{axis}" for q in quantities], allow_extrapolation=True)
+    return {q: np.asarray(preds[f"{q}_{axis}"].value, dtype=float) for q in quantities}
+
+
+def assess(
+    sug: Suggestion, surrogate: Surrogate, problem: Problem, box: Box, ranked: list[Candidate]
+) -> None:
+    """Fill reachable, statements, ranges and nearest runs of a suggestion, goal by goal. A target is
+    reachable when any design the search found (`ranked`) is predicted within the tolerance of it."""
     best = sug.candidates[0]
     tol = sug.tolerance
-    scored = [q for q, t in sug.targets.items() if t.has_value and sug.predictability[q]["predictable"]]
-    judged = scored or [q for q, t in sug.targets.items() if t.has_value]
-    sug.reachable = all(abs(best.rel_error[q]) <= tol for q in judged)
+    sug.reachable = any(meets(c, judged_targets(sug.targets, sug.predictability), tol) for c in ranked)
     for q, t in sug.targets.items():
         model = surrogate.model(f"{q}_{sug.axis}")
         unit = model.unit
@@ -247,7 +299,17 @@ def assess(sug: Suggestion, surrogate: Surrogate, problem: Problem, box: Box) ->
                 f"{q} = {t.value:g} {unit} is reached within {band}: predicted {pi_text(p, unit)}; {prob}"
             )
             continue
+        reached = [c for c in ranked if abs(c.rel_error[q]) <= tol]
+        if reached:
+            sug.statements.append(
+                f"{q} = {t.value:g} {unit} is reached within {band} (a design is predicted at "
+                f"{pi_text(reached[0].predicted[q], unit)}); design #1, predicted at {pi_text(p, unit)} "
+                f"({100 * best.rel_error[q]:+.0f} %), ranks first by its chance: {prob}"
+            )
+            continue
         lo_r, hi_r = reachable_range(problem, q, box)
+        on_grid = grid_predictions(surrogate, sug.axis, grid(box, sug.fixed), [q])[q]
+        lo_r, hi_r = min(lo_r, float(on_grid.min()), p.value), max(hi_r, float(on_grid.max()), p.value)
         sug.ranges[q]["predicted"] = [lo_r, hi_r]
         obs_lo, obs_hi = model.observed_range
         sug.statements.append(
@@ -265,6 +327,14 @@ def assess(sug: Suggestion, surrogate: Surrogate, problem: Problem, box: Box) ->
                 f"{q} = {t.value:g} {unit} lies outside the measured range of {q}_{sug.axis}: "
                 "the data does not support it"
             )
+
+    if len(best.probability) > 1:
+        every = float(np.prod(list(best.probability.values())))
+        sug.statements.append(
+            f"every goal at once: design #1 meets {' and '.join(best.probability)} within "
+            f"+-{100 * tol:.0f} % together with probability {every:.2f} (the product: given the model, "
+            "the responses scatter independently)"
+        )
 
 
 def unpredictable_statement(sug: Suggestion, q: str, t: Target, p: Prediction, unit: str) -> str:

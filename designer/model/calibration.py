@@ -45,13 +45,13 @@ def new_printer(surrogate: Surrogate, *, printer_sd: float = PRINTER_SD) -> Surr
         )
         for r, base in surrogate.models.items()
     }
-    empty = pd.DataFrame(columns=list(space.FACTOR_NAMES) + surrogate.responses, dtype=float)
+    columns = {c: np.zeros(0) for c in [*space.FACTOR_NAMES, *surrogate.responses]}
     return Surrogate(
         models=models,
         table_hash=surrogate.table_hash,
         training=surrogate.training,
         prior=surrogate,
-        calibration={"table": empty, "printer_sd": printer_sd},
+        calibration={"table": pd.DataFrame(columns), "columns": columns, "printer_sd": printer_sd},
     )
 
 
@@ -97,15 +97,21 @@ def calibrate(
 def with_runs(surrogate: Surrogate, rows: list[dict[str, float]]) -> Surrogate:
     """`surrogate` calibrated on its own runs plus `rows`, runs the tool itself imagines (the six
     factors and responses by their canonical names, printable), without a user table's checks: the
-    design loop recalibrates on each imagined measurement, where those checks cost half its time."""
-    import pandas as pd
-
+    design loop recalibrates on each imagined measurement, where those checks (and a table's
+    bookkeeping) would cost most of its time."""
     if not rows:
         return surrogate
+    names = list(dict.fromkeys(c for row in rows for c in row))
+    new = {c: np.array([row.get(c, np.nan) for row in rows], dtype=float) for c in names}
     if surrogate.calibration is None:
-        return calibrated(surrogate, pd.DataFrame(rows), PRINTER_SD)
-    table = pd.concat([surrogate.calibration["table"], pd.DataFrame(rows)], ignore_index=True)
-    return calibrated(surrogate.prior, table, surrogate.calibration["printer_sd"])
+        return calibrated(surrogate, new, PRINTER_SD)
+    old = surrogate.calibration["columns"]
+    n_old = len(old[space.FACTOR_NAMES[0]])
+    both = {
+        c: np.concatenate([old.get(c, np.full(n_old, np.nan)), new.get(c, np.full(len(rows), np.nan))])
+        for c in dict.fromkeys([*old, *new])
+    }
+    return calibrated(surrogate.prior, both, surrogate.calibration["printer_sd"])
 
 
 def _user_loo(surrogate: Surrogate, response: str) -> dict[str, float] | None:

@@ -37,6 +37,7 @@ import numpy as np
 
 from ..errors import DesignerError, number_argument
 from ..study import space
+from . import mechanisms
 from .forms import as_printed
 from .prediction import Prediction, ResponseSurface
 
@@ -57,6 +58,9 @@ LIKELIHOOD_DROP = 2.0
 MATERN_FLOOR = 1e-24
 #: the largest size of the local correction, as a multiple of the study's predictive spread
 MAX_AMPLITUDE = 4.0
+#: sd (log space) of a printer's own smooth departure from the study beyond the mechanism terms: the
+#: study's runs are evidence of what every printer shares, not exact at their designs for yours
+LOCAL_SD = 0.06
 
 
 def coded(X: Mapping[str, Any]) -> np.ndarray:
@@ -207,12 +211,13 @@ class CalibratedSurface(ResponseSurface):
 
     runs: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))  # (n, 6) designs, factor order
     observed: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (n,) measured values
-    #: (n,) 1 for the user's runs (they carry the printer factor), 0 for the study's own runs
+    #: (n,) 1 for the user's runs (they carry the printer's departure), 0 for the study's own runs
     own: np.ndarray = field(default_factory=lambda: np.zeros(0))
     length: float = 1.0
     amplitude: float = 1.0
     noise: float = MIN_NOISE
     printer_sd: float = PRINTER_SD
+    local_sd: float = LOCAL_SD
 
     @classmethod
     def from_base(
@@ -246,16 +251,23 @@ class CalibratedSurface(ResponseSurface):
         mu0, s0 = _log_moments(base, X)
         self._Zu = coded(X)
         self._sgu = self.amplitude * _local_sd(s0, self.noise)
-        K = self._prior_cov(self._Zu, self._sgu, self.own, self._Zu, self._sgu, self.own)
-        K += self.noise**2 * np.eye(len(mu0))
+        self._Sb = mechanisms.prior_variances(self.printer_sd)
+        #: the mechanism terms at the runs, zero for the study's (its printer is the reference)
+        self._Hu = np.zeros((len(self.own), len(self._Sb)))
+        mine = self.own > 0
+        self._Hu[mine] = mechanisms.basis(base, self.runs[mine])
+        R = _correlation(self._Zu, self._Zu, self.length)
+        K = self._cross(R, self._sgu, self._Hu, self.own) + self.noise**2 * np.eye(len(mu0))
         self._Kinv = np.linalg.inv(K) if len(mu0) else np.zeros((0, 0))
         self._alpha = self._Kinv @ (np.log(self.observed) - mu0)
 
-    def _prior_cov(
-        self, Za: np.ndarray, sa: np.ndarray, ua: np.ndarray, Zb: np.ndarray, sb: np.ndarray, ub: np.ndarray
-    ) -> np.ndarray:
-        """Prior covariance of log y between designs a and b (u: 1 on the user's printer, 0 the study's)."""
-        return self.printer_sd**2 * np.outer(ua, ub) + np.outer(sa, sb) * _correlation(Za, Zb, self.length)
+    def _cross(self, R: np.ndarray, sa: np.ndarray, Ha: np.ndarray, ua: np.ndarray) -> np.ndarray:
+        """Prior covariance of log y between designs a (rows) and the runs (columns), given their
+        correlation R (na, n): the study model's error, shared by every printer, plus on the user's
+        printer (u = 1) the mechanism terms and the printer's own departure."""
+        shared = np.outer(sa, self._sgu) * R
+        printer = (Ha * self._Sb) @ self._Hu.T + self.local_sd**2 * np.outer(ua, self.own) * R
+        return shared + printer
 
     @property
     def transform(self) -> str:
@@ -266,8 +278,12 @@ class CalibratedSurface(ResponseSurface):
         mu0, s0 = _log_moments(self._base, X)
         Z = coded(X)
         sg = _local_sd(s0, self.noise)
-        C = self._prior_cov(Z, self.amplitude * sg, np.ones(len(Z)), self._Zu, self._sgu, self.own)
-        prior = s0**2 + (self.amplitude**2 - 1) * sg**2 + self.printer_sd**2
+        designs = np.column_stack(
+            [np.broadcast_to(np.asarray(X[n], dtype=float), len(Z)) for n in space.FACTOR_NAMES]
+        )
+        H = mechanisms.basis(self._base, designs)
+        C = self._cross(_correlation(Z, self._Zu, self.length), self.amplitude * sg, H, np.ones(len(Z)))
+        prior = s0**2 + (self.amplitude**2 - 1) * sg**2 + H**2 @ self._Sb + self.local_sd**2
         var = prior - np.einsum("ij,jk,ik->i", C, self._Kinv, C)
         return mu0 + C @ self._alpha, np.sqrt(np.maximum(var, self.noise**2))
 
@@ -282,27 +298,42 @@ class CalibratedSurface(ResponseSurface):
         mu0 = ca.log(value0)
         s0 = (ca.log(hi0) - mu0) / self.t95
         sg = ca.sqrt(ca.fmax(s0**2 - self.noise**2, 0.25 * s0**2))
-        var, mu = s0**2 + (self.amplitude**2 - 1) * sg**2 + self.printer_sd**2, mu0
+        h = mechanisms.symbolic(self._base, x)
+        prior = s0**2 + (self.amplitude**2 - 1) * sg**2 + ca.dot(ca.DM(self._Sb), h * h) + self.local_sd**2
+        var, mu = prior, mu0
         if len(self._Zu):
             z = ca.vertcat(*_coded_symbolic(x))
             d2 = ca.sum1((ca.repmat(z, 1, len(self._Zu)) - ca.DM(self._Zu.T)) ** 2).T
-            local = self.amplitude * sg * ca.DM(self._sgu) * matern52(d2, self.length)
-            c = self.printer_sd**2 * ca.DM(self.own) + local
+            R = matern52(d2, self.length)
+            c = self.amplitude * sg * ca.DM(self._sgu) * R + self.local_sd**2 * ca.DM(self.own) * R
+            c += ca.mtimes(ca.DM(self._Hu * self._Sb), h)
             var, mu = var - ca.bilin(ca.DM(self._Kinv), c, c), mu + ca.dot(c, ca.DM(self._alpha))
         half = self.t95 * ca.sqrt(ca.fmax(var, self.noise**2))
         out = [ca.exp(mu), ca.exp(mu - half), ca.exp(mu + half)]
         return ca.Function(self.response, [x], out, ["x"], ["value", "lo", "hi"])
 
+    def mechanisms(self) -> dict[str, dict[str, Any]]:
+        """What the user's runs say of each mechanism term (`designer.model.mechanisms`): posterior
+        mean and 95 % interval of its coefficient, beside its prior sd. The factor as exp(beta)."""
+        SH = self._Hu * self._Sb  # (n, terms)
+        mean = SH.T @ self._alpha
+        var = self._Sb - np.einsum("it,ij,jt->t", SH, self._Kinv, SH)
+        half = 1.96 * np.sqrt(np.maximum(var, 0.0))
+        out = {}
+        for i, (name, sd) in enumerate(zip(mechanisms.names(), np.sqrt(self._Sb), strict=True)):
+            value, low, high = mean[i], mean[i] - half[i], mean[i] + half[i]
+            if name == mechanisms.FACTOR:
+                value, low, high = np.exp([value, low, high])
+            out[name] = {"value": float(value), "low": float(low), "high": float(high), "prior_sd": float(sd)}
+        return out
+
     def printer_factor(self) -> Prediction:
         """The estimated printer/material factor exp(b) with its 95 % interval."""
-        b = self.printer_sd**2 * float(self.own @ self._alpha)
-        var = self.printer_sd**2 - self.printer_sd**4 * float(self.own @ self._Kinv @ self.own)
-        half = 1.96 * np.sqrt(max(var, 0.0))
-        return Prediction(float(np.exp(b)), float(np.exp(b - half)), float(np.exp(b + half)))
+        return Prediction.from_dict(self.mechanisms()[mechanisms.FACTOR])
 
     def page_data(self) -> dict[str, Any]:
         """What the profiler page needs to evaluate this calibration itself (profile.html's
-        `calibrated`): the coded runs and the solved system, plain lists."""
+        `calibrated`): the coded runs, the mechanism terms and the solved system, plain lists."""
         return {
             "factors": [[f.name, (f.low + f.high) / 2, (f.high - f.low) / 2] for f in space.FACTORS],
             "wall": space.WALL_MM,
@@ -310,9 +341,11 @@ class CalibratedSurface(ResponseSurface):
             "runs": self._Zu.tolist(),
             "own": self.own.tolist(),
             "sgu": self._sgu.tolist(),
+            "hs": (self._Hu * self._Sb).tolist(),
+            "sb": self._Sb.tolist(),
             "kinv": self._Kinv.tolist(),
             "alpha": self._alpha.tolist(),
-            "tau2": self.printer_sd**2,
+            "local2": self.local_sd**2,
             "noise": self.noise,
             "length": self.length,
             "amplitude": self.amplitude,
@@ -324,6 +357,8 @@ class CalibratedSurface(ResponseSurface):
             "amplitude": self.amplitude,
             "noise": self.noise,
             "printer_sd": self.printer_sd,
+            "local_sd": self.local_sd,
+            "mechanisms": {m.name: m.sd for m in mechanisms.TERMS},
         }
 
 
@@ -358,43 +393,57 @@ def study_runs(prior: Surrogate, response: str) -> tuple[dict[str, np.ndarray], 
     return X, np.asarray(prior.training[response], dtype=float)
 
 
+def _study_evidence(prior: Surrogate, response: str) -> tuple[np.ndarray, np.ndarray]:
+    """The study's runs of `response` as printed, (n, 6) in factor order, and their values (n,):
+    computed once per study surface (the design loop recalibrates many times)."""
+    base = prior.models[response]
+    if "_study_evidence" not in base.__dict__:
+        X, y = study_runs(prior, response)
+        ok = np.isfinite(y)
+        printed = as_printed({n: v[ok] for n, v in X.items()})
+        designs = np.column_stack([printed[n] for n in space.FACTOR_NAMES]).reshape(-1, 6)
+        base.__dict__["_study_evidence"] = (designs, y[ok])
+    return base.__dict__["_study_evidence"]
+
+
 def evidence(
     prior: Surrogate, response: str, user: Mapping[str, np.ndarray], observed: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(designs (n, 6) as printed, measured values (n,), own (n,)): the study's runs (own 0: the
-    study's printer, no printer factor) and the user's (own 1), where the local correction is observed.
-    The study's runs observe it directly: each one's residual from the study's own prediction is the
-    model's error there (plus print scatter)."""
-    X, y = study_runs(prior, response)
-    ok = np.isfinite(y)
-    parts = [({n: v[ok] for n, v in X.items()}, y[ok], 0.0), (user, observed, 1.0)]
-    designs, values, own = [], [], []
-    for X, y, u in parts:
-        printed = as_printed(dict(X))
-        designs.append(np.column_stack([printed[n] for n in space.FACTOR_NAMES]).reshape(-1, 6))
-        values.append(np.asarray(y, dtype=float))
-        own.append(np.full(len(y), u))
-    return np.vstack(designs), np.concatenate(values), np.concatenate(own)
+    study's printer, the reference) and the user's (own 1), where the correction is observed.
+    The study's runs observe the model's error directly: each one's residual from the study's own
+    prediction is that error there (plus print scatter)."""
+    study, values = _study_evidence(prior, response)
+    printed = as_printed({n: np.asarray(user[n], dtype=float) for n in space.FACTOR_NAMES})
+    mine = np.column_stack([printed[n] for n in space.FACTOR_NAMES]).reshape(-1, 6)
+    observed = np.asarray(observed, dtype=float)
+    own = np.r_[np.zeros(len(values)), np.ones(len(observed))]
+    return np.vstack([study, mine]), np.concatenate([values, observed]), own
 
 
-def calibrated(prior: Surrogate, table: Any, printer_sd: float) -> Surrogate:
-    """`calibrate`'s work once its arguments are checked: `prior` uncalibrated, `table` the user's
-    runs (load_table's columns)."""
-    if table.empty:
+def calibrated(prior: Surrogate, runs: Any, printer_sd: float) -> Surrogate:
+    """`calibrate`'s work once its arguments are checked: `prior` uncalibrated, `runs` the user's
+    runs as columns (a DataFrame or a mapping of equal-length arrays, load_table's names; NaN where a
+    response was not measured)."""
+    import pandas as pd
+
+    cols = {str(c): np.asarray(runs[c], dtype=float) for c in runs.keys()}
+    if not cols or not len(cols[space.FACTOR_NAMES[0]]):
         return prior
+    n = len(cols[space.FACTOR_NAMES[0]])
     models: dict[str, ResponseSurface] = {}
     for r, base in prior.models.items():
-        rows = table[r].notna().to_numpy() if r in table.columns else np.zeros(len(table), bool)
+        rows = np.isfinite(cols[r]) if r in cols else np.zeros(n, bool)
         if not rows.any():
             models[r] = base
             continue
-        user = {n: table.loc[rows, n].to_numpy(dtype=float) for n in space.FACTOR_NAMES}
-        designs, observed, own = evidence(prior, r, user, table.loc[rows, r].to_numpy(dtype=float))
+        user = {name: cols[name][rows] for name in space.FACTOR_NAMES}
+        designs, observed, own = evidence(prior, r, user, cols[r][rows])
         settings = settings_of(prior, r)
         models[r] = CalibratedSurface.from_base(base, designs, observed, own, settings, printer_sd)
-    keep = list(space.FACTOR_NAMES) + [r for r in prior.responses if r in table.columns]
-    table = table.loc[:, keep].reset_index(drop=True)
-    return replace(prior, models=models, prior=prior, calibration={"table": table, "printer_sd": printer_sd})
+    keep = {c: cols[c] for c in [*space.FACTOR_NAMES, *(r for r in prior.responses if r in cols)]}
+    calibration = {"table": pd.DataFrame(keep), "columns": keep, "printer_sd": printer_sd}
+    return replace(prior, models=models, prior=prior, calibration=calibration)
 
 
 def check_printer_sd(printer_sd: Any) -> float:
