@@ -57,12 +57,15 @@ def calibrate(
     from designer.files import check_output
     from designer.model.calibration import calibrate as run_calibrate
     from designer.model.calibration import report
-    from designer.printing.runs import measured
+    from designer.model.plausibility import check_measured
+    from designer.printing.runs import measured, settings_and_coefficients
 
     if out is not None:
         check_output(out, suffixes=[".json"])
     table, notes = measured(runs, source=runs.name)
-    calibrated = run_calibrate(load_surrogate(surrogate), table, accept_implausible=accept_implausible)
+    prior = load_surrogate(surrogate)
+    check_measured(prior, table, accept_implausible=accept_implausible)  # names each print by its id
+    calibrated = run_calibrate(prior, table[settings_and_coefficients(table)], accept_implausible=True)
     if out is not None:
         calibrated.save(out)
     data = report(calibrated) | {"out": str(out) if out else None, "notes": notes}

@@ -124,7 +124,7 @@ def test_a_k_in_n_per_m_is_refused_naming_the_unit(tmp_path, capsys, printer):
     code, _, err = run_inprocess(["calibrate", runs, "-o", tmp_path / "mine.json"], capsys)
     assert_clean_failure(code, err, allowed=(2,))
     assert (
-        "k_x of row 1 (print P1) is 930 N/mm" in err
+        "k_x of print P1 is 930 N/mm" in err
         and "N/m rather than N/mm" in err
         and "--accept-implausible" in err
     )
@@ -140,7 +140,7 @@ def test_a_load_logged_in_kn_is_refused_naming_the_unit(tmp_path, capsys):
     log = rig_log(tmp_path, "P1", design, 0.9, 2.2e-3, load_scale=1e-3)
     code, _, err = run_inprocess(["identify", log, "--runs", runs], capsys)
     assert_clean_failure(code, err, allowed=(2,))
-    assert "k_x of row 1 (print P1) is 0.0009" in err and "load logged in kN" in err, err
+    assert "k_x of print P1 is 0.0009" in err and "load logged in kN" in err, err
     assert pd.read_csv(runs)["k_x [N/mm]"].isna().all()  # nothing written
 
 

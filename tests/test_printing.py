@@ -73,8 +73,17 @@ def test_specimen_is_a_closed_solid_with_its_id_engraved():
     assert np.allclose(hi - lo, [0, params["width"], params["height"]], atol=1e-9)
 
 
+def test_writing_a_plate_leaves_the_locale(made, tmp_path):
+    import locale
+
+    before = locale.setlocale(locale.LC_ALL)
+    plate.write_plate(made[0].prints[:1], tmp_path / "one.3mf")
+    assert locale.setlocale(locale.LC_ALL) == before  # lib3mf's writer sets the C locale and leaves it
+
+
 def test_plate_reads_back_in_lib3mf(made):
     import lib3mf
+
 
     prepared, files = made
     wrapper = lib3mf.get_wrapper()

@@ -79,9 +79,9 @@ def check_measured(surrogate: Surrogate, table: Any, *, accept_implausible: bool
         unit = units.rig_unit(q, axis)
         ratio = measured[i] / float(p.value[i])
         pi = f"{float(p.value[i]):.3g} [{float(p.low[i]):.3g}, {float(p.high[i]):.3g}] {unit}"
-        label = f" (print {table['print'].iloc[i]})" if "print" in table.columns else ""
+        where = f"print {table['print'].iloc[i]}" if "print" in table.columns else f"row {i + 1}"
         raise DesignerError(
-            f"runs: {r} of row {i + 1}{label} is {measured[i]:.4g} {unit}, {ratio:.3g} times the study's "
+            f"runs: {r} of {where} is {measured[i]:.4g} {unit}, {ratio:.3g} times the study's "
             f"prediction there ({pi}): "
             f"a printer factor far outside its prior ({low_f:.2f}-{high_f:.2f} at 95 %)",
             f"{likely_slip(q, axis, ratio)}; if the value is right, pass accept_implausible=True",

@@ -15,10 +15,13 @@ Each object's id in those files is its resource id in the 3D model, as the slice
 
 from __future__ import annotations
 
+import contextlib
 import json
+import locale
 import xml.etree.ElementTree as ET
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
+from typing import Any
 
 from ..errors import DesignerError
 from . import settings
@@ -88,15 +91,23 @@ def _prusa_plate() -> bytes:
     return ("\n".join(lines) + "\n").encode()
 
 
+@contextlib.contextmanager
+def locale_kept() -> Iterator[None]:
+    """Restore the process's locale after the block: lib3mf's writer sets the C locale (for its
+    decimal points) and leaves it so, which turns Python's default text encoding into ASCII."""
+    saved = locale.setlocale(locale.LC_ALL)
+    try:
+        yield
+    finally:
+        locale.setlocale(locale.LC_ALL, saved)
+
+
 def write_plate(prints: Sequence[Specimen], path: str | Path) -> Path:
     """Write `prints` as one 3MF plate (atomically) and return its path.
 
     Raises:
         DesignerError: no print, two prints with one id, or a plate the bed cannot hold.
     """
-    import lib3mf
-    import numpy as np
-
     from ..files import atomic_path
 
     if not prints:
@@ -104,6 +115,17 @@ def write_plate(prints: Sequence[Specimen], path: str | Path) -> Path:
     names = [p.print_id for p in prints]
     if len(set(names)) < len(names):
         raise DesignerError(f"two prints share an id among {names}", "give every print its own id")
+    with locale_kept(), atomic_path(path) as tmp:
+        _model(prints).QueryWriter("3mf").WriteToFile(str(tmp))
+    return Path(path)
+
+
+def _model(prints: Sequence[Specimen]) -> Any:
+    """The lib3mf model of the plate: meshes, build items, metadata and the slicers' configs."""
+    import lib3mf
+    import numpy as np
+
+    names = [p.print_id for p in prints]
     wrapper = lib3mf.get_wrapper()
     model = wrapper.CreateModel()
     model.SetUnit(lib3mf.ModelUnit.MilliMeter)
@@ -129,9 +151,7 @@ def write_plate(prints: Sequence[Specimen], path: str | Path) -> Path:
     }
     for uri, data in parts.items():
         model.AddAttachment(uri, RELATIONSHIP).ReadFromBuffer(bytearray(data))
-    with atomic_path(path) as tmp:
-        model.QueryWriter("3mf").WriteToFile(str(tmp))
-    return Path(path)
+    return model
 
 
 def _position(lib3mf, v) -> object:

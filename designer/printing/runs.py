@@ -112,6 +112,14 @@ def measured(table: Any, source: str = "runs") -> tuple[pd.DataFrame, list[str]]
     return load_table(kept), notes
 
 
+def settings_and_coefficients(table: pd.DataFrame) -> list[str]:
+    """The columns of a loaded table that calibration reads: the six settings and the coefficients
+    (the print ids and log paths ride along in the file, not into the model)."""
+    from ..study.data import coefficient_columns
+
+    return list(space.FACTOR_NAMES) + coefficient_columns(table)
+
+
 def sidecar_print(log: str | Path) -> str | None:
     """The print id a rig log's JSON sidecar names (`"print"`), or None."""
     from ..rig.logs import sidecar_path
