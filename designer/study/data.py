@@ -3,7 +3,8 @@
 A coefficient table has one row per specimen: the six factors (`density`, `length`, `width`,
 `height`, `layer`, `raster`) and, per identified axis, `c_<axis>`, `k_<axis>` and optionally
 `m_<axis>`, all in rig units (see `designer.units`). Column names may carry the study's unit
-suffixes (`density_pct`, `k_x_N_per_mm`, ...); a suffix naming another unit is rejected.
+suffixes (`density_pct`, `k_x_N_per_mm`, ...) or a unit in brackets (`density [%]`, `k_x [N/mm]`,
+as `designer print`'s runs table names them); a unit other than the table's is rejected.
 """
 
 from __future__ import annotations
