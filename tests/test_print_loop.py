@@ -15,6 +15,7 @@ import pandas as pd
 import pytest
 from clitools import assert_clean_failure, run_inprocess
 from physics_logs import make_log
+from test_cli_campaign import SIX
 from test_printing import SLICER, check_gcode, slice_
 
 from designer.model.surrogate import Surrogate
@@ -96,21 +97,7 @@ def test_whole_loop_on_files(tmp_path, monkeypatch, capsys, printer):
 
 
 def _template(tmp_path: Path, capsys) -> Path:
-    args = [
-        "print",
-        "--density",
-        "60",
-        "--length",
-        "24",
-        "--width",
-        "4.5",
-        "--height",
-        "9",
-        "--layer",
-        "0.16",
-        "--raster",
-        "0",
-    ]
+    args = ["print", *SIX]
     code, _, err = run_inprocess([*args, "-o", tmp_path / "one"], capsys)
     assert code == 0, err
     return tmp_path / "one" / "runs.csv"

@@ -17,6 +17,7 @@ import pandas as pd
 import pytest
 import trimesh
 from clitools import assert_clean_failure, run_inprocess
+from test_cli_campaign import SIX
 
 from designer.printing import batch, plate, settings
 from designer.printing.specimen import Clamp, specimen
@@ -83,7 +84,6 @@ def test_writing_a_plate_leaves_the_locale(made, tmp_path):
 
 def test_plate_reads_back_in_lib3mf(made):
     import lib3mf
-
 
     prepared, files = made
     wrapper = lib3mf.get_wrapper()
@@ -193,21 +193,7 @@ def test_runs_template(made):
 
 def test_print_cli_design_and_bad_input(tmp_path, capsys):
     out = tmp_path / "one"
-    args = [
-        "print",
-        "--density",
-        "60",
-        "--length",
-        "24",
-        "--width",
-        "4.5",
-        "--height",
-        "9",
-        "--layer",
-        "0.16",
-        "--raster",
-        "0",
-    ]
+    args = ["print", *SIX]
     code, text, err = run_inprocess([*args, "-o", out], capsys)
     assert code == 0, err
     assert "P1: infill 60 %" in text and sorted(p.name for p in out.iterdir()) == [

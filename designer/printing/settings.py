@@ -95,20 +95,26 @@ def prusa_ini(params: Mapping[str, float], print_id: str) -> str:
     return "\n".join(lines) + "\n"
 
 
+#: OrcaSlicer / Bambu Studio's names of PrusaSlicer's per-object options
+ORCA_NAMES = {
+    "layer_height": "layer_height",
+    "fill_density": "sparse_infill_density",
+    "fill_pattern": "sparse_infill_pattern",
+    "fill_angle": "infill_direction",
+    "perimeters": "wall_loops",
+    "top_solid_layers": "top_shell_layers",
+    "bottom_solid_layers": "bottom_shell_layers",
+    "top_solid_min_thickness": "top_shell_thickness",
+    "bottom_solid_min_thickness": "bottom_shell_thickness",
+}
+
+
 def orca_object(params: Mapping[str, float]) -> dict[str, str]:
-    """OrcaSlicer / Bambu Studio's per-object options of one print (model_settings.config)."""
-    layers = str(solid_layers(params["layer"]))
+    """OrcaSlicer / Bambu Studio's per-object options of one print (model_settings.config): the
+    PrusaSlicer options under their names, the line widths and no small infill turned solid."""
     width = _number(space.NOZZLE_MM)
-    return {
-        "layer_height": _number(params["layer"]),
-        "sparse_infill_density": f"{_number(params['density'])}%",
-        "sparse_infill_pattern": INFILL_PATTERN,
-        "infill_direction": _number(params["raster"]),
-        "wall_loops": str(PERIMETERS),
-        "top_shell_layers": layers,
-        "bottom_shell_layers": layers,
-        "top_shell_thickness": _number(space.WALL_MM),
-        "bottom_shell_thickness": _number(space.WALL_MM),
+    options = {ORCA_NAMES[key]: value for key, value in prusa_object(params).items()}
+    return options | {
         "outer_wall_line_width": width,
         "inner_wall_line_width": width,
         "sparse_infill_line_width": width,
