@@ -94,6 +94,20 @@ def test_whole_loop_on_files(tmp_path, monkeypatch, capsys, printer):
     code, out, err = run_inprocess(["next", "--k", "0.8", "--n", "3", "--surrogate", "mine.json"], capsys)
     assert code == 0, err
     assert "Design #1 now" in out
+    # one story per output: suggest says which printer it assumes, and once calibrated, c_x (now
+    # pinned at the printed designs) is no longer said to be the same for every design
+    code, out, err = run_inprocess(["suggest", "--k", "0.8", "--json"], capsys)
+    study = said(json.loads(out))
+    code, out, err = run_inprocess(["suggest", "--k", "0.8", "--surrogate", "mine.json", "--json"], capsys)
+    yours = said(json.loads(out))
+    assert any(s.startswith("printer: the study's own") for s in study)
+    assert any(s.startswith("printer: yours, the study calibrated on 3 run(s)") for s in yours)
+    assert not any("every design gets the same prediction" in s for s in yours), yours
+
+
+def said(suggestion: dict) -> list[str]:
+    """Every sentence a suggest --json output states."""
+    return suggestion["statements"] + [p["statement"] for p in suggestion["predictability"].values()]
 
 
 def _template(tmp_path: Path, capsys) -> Path:

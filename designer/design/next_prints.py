@@ -319,9 +319,9 @@ def next_prints(
     p_now = float(best.p_within or 0.0)
     goals = {q: t.goal for q, t in sug.targets.items()}
     if not sug.reachable:
-        statements += [st for st in sug.statements if "distinct design" not in st] + [
-            "no print is proposed: the target lies outside what the data supports (see above)"
-        ]
+        statements += [
+            st for st in sug.statements if "distinct design" not in st and not st.startswith("printer:")
+        ] + ["no print is proposed: the target lies outside what the data supports (see above)"]
         return NextPrints(axis, goals, tolerance, best, p_now, False, [], p_now, statements, False)
     chance = _chance_text(best, targets, tolerance)
     if p_now >= stop:
@@ -340,7 +340,9 @@ def next_prints(
     statements += [
         f"the best design now: {chance}, {_doubt_text(surrogate)}; after printing and measuring these "
         f"{len(chosen)}, the best is expected to land with {p_after:.2f}",
-        "then: add the measured coefficients to your runs table, designer calibrate, designer next again",
+        "then: designer print makes them (a 3MF plate, each object with its settings, and the runs table); "
+        "measure each, designer identify fills the table from the rig logs, designer calibrate, "
+        "designer next again",
     ]
     if len(chosen) < n:
         statements.append(f"{len(chosen)} distinct design(s) instead of {n}: the search found no more")

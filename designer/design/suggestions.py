@@ -49,7 +49,14 @@ def predictability(surrogate: Surrogate, axis: str) -> dict[str, dict[str, Any]]
         m = surrogate.model(f"{q}_{axis}")
         q2 = m.accuracy["q2"]
         label = "nested leave-one-out" if m.loo_nested else "leave-one-out"
-        if not m.predictable:
+        own = int(np.sum(getattr(m, "own", 0)))  # the user's runs of a calibrated response
+        if not m.predictable and own:
+            text = (
+                f"{q}_{axis} is not predictable from the six factors on the study's runs ({label} Q2 = "
+                f"{q2:.2f}): your {own} run(s) set its level for your printer and pin it down near the "
+                "designs you printed; elsewhere its interval stays wide"
+            )
+        elif not m.predictable:
             text = (
                 f"{q}_{axis} is not predictable from the six factors: no form beats the mean of the "
                 f"runs ({label} Q2 = {q2:.2f}); every design gets the same prediction"
@@ -136,12 +143,26 @@ def suggest(
             picked.append(cand)
     sug = Suggestion(axis, targets, picked, True, [], info, surrogate.id, fixed, tolerance)
     assess(sug, surrogate, problem, box, ranked)
+    sug.statements.append(printer_statement(surrogate))
     if len(picked) < top:
         sug.statements.append(
             f"{len(picked)} distinct design(s) instead of the {top} asked for: every start of the search "
             "ended at one of these" + (" (the fixed factors leave little to choose)" if fixed else "")
         )
     return sug
+
+
+def printer_statement(surrogate: Surrogate) -> str:
+    """Which printer the predictions and P are for: the study's own, or the user's once calibrated."""
+    if surrogate.calibration is None:
+        return (
+            "printer: the study's own (one Ender 3, one spool of TPU); yours departs from it by a factor "
+            "of its own: designer next states P with that unknown, designer calibrate learns it"
+        )
+    n = len(surrogate.calibration["table"])
+    if not n:
+        return "printer: yours, not measured yet: P counts how it may depart from the study's printer"
+    return f"printer: yours, the study calibrated on {n} run(s) of yours"
 
 
 MAPPING_EXAMPLES = {
