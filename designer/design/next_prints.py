@@ -23,8 +23,9 @@ from typing import Any
 import numpy as np
 
 from ..errors import DesignerError, number_argument
-from ..model.calibration import new_printer, with_runs
+from ..model.calibration import new_printer
 from ..model.prediction import Prediction
+from ..model.rotational import derived_statement, with_axis, with_runs
 from ..model.surrogate import Surrogate, check_surrogate
 from ..study import space
 from .candidates import Candidate
@@ -312,6 +313,8 @@ def next_prints(
             "not calibrated to your printer yet: P counts how an unmeasured printer may depart from "
             "the study's (suggest states P for the study's own printer)"
         )
+    surrogate = with_axis(surrogate, axis)  # a rotational goal through the PRB relation
+    statements += derived_statement(surrogate, axis)
     sug = suggest(surrogate, k=k, c=c, axis=axis, fixed=fixed, top=POOL, tolerance=tolerance)
     targets = _predictable_targets(sug, axis)
     scorer = _Scorer(surrogate, axis, targets, tolerance)

@@ -22,6 +22,7 @@ import numpy as np
 from .. import units
 from ..errors import DesignerError, check_type, number_argument
 from ..model.prediction import Prediction
+from ..model.rotational import PRBSurface, derived_statement, with_axis
 from ..model.surrogate import Surrogate, check_surrogate
 from ..study import space
 from .candidates import Candidate, Suggestion
@@ -56,6 +57,12 @@ def predictability(surrogate: Surrogate, axis: str) -> dict[str, dict[str, Any]]
                 f"{q2:.2f}): your {own} run(s) set its level for your printer and pin it down near the "
                 "designs you printed; elsewhere its interval stays wide"
             )
+        elif not m.predictable and isinstance(m, PRBSurface):
+            text = (
+                f"{q}_{axis} is not predictable from the six factors ({q}_{m.base.axis}'s {label} Q2 = "
+                f"{q2:.2f}): its prediction is {q}_{m.base.axis}'s mean carried through the relation, so it "
+                "follows the length alone"
+            )
         elif not m.predictable:
             text = (
                 f"{q}_{axis} is not predictable from the six factors: no form beats the mean of the "
@@ -89,7 +96,8 @@ def suggest(
     Args:
         surrogate: the fitted surrogate (`Surrogate.load()` for the shipped one).
         k, c: a target value, "min" or "max"; None leaves that response free.
-        axis: the surrogate's axis the goals are on.
+        axis: the surrogate's axis the goals are on; a rotational axis it lacks (theta: N.mm/rad)
+            is derived from x through the pseudo-rigid-body relation (`designer.model.rotational`).
         fixed: factors held at a value, e.g. {"width": 4.5}.
         top: how many distinct candidates to return (fewer are explained in `statements`).
         importance, bounds, weight: per response, the composite's importance, the desirability's
@@ -107,6 +115,7 @@ def suggest(
             non-positive target, importance or weight, bounds not enclosing a target, top < 1, or
             tolerance not in (0, 1).
     """
+    surrogate = with_axis(surrogate, axis)  # a rotational goal through the PRB relation
     check_request(surrogate, axis, k is None and c is None, top, tolerance)
     for name, value in (("fixed", fixed), ("importance", importance), ("bounds", bounds), ("weight", weight)):
         if value is not None:
@@ -143,7 +152,7 @@ def suggest(
             picked.append(cand)
     sug = Suggestion(axis, targets, picked, True, [], info, surrogate.id, fixed, tolerance)
     assess(sug, surrogate, problem, box, ranked)
-    sug.statements.append(printer_statement(surrogate))
+    sug.statements += [printer_statement(surrogate), *derived_statement(surrogate, axis)]
     if len(picked) < top:
         sug.statements.append(
             f"{len(picked)} distinct design(s) instead of the {top} asked for: every start of the search "
