@@ -59,11 +59,6 @@ class Specimen:
     clamp: Clamp
     mesh: Any  # trimesh.Trimesh
 
-    @property
-    def beam(self) -> dict[str, float]:
-        """The beam's box: x0, x1 (along the beam), y0, y1, z0, z1, mm, in the mesh's coordinates."""
-        return beam_box(self.params, self.clamp)
-
 
 def beam_box(params: dict[str, float], clamp: Clamp) -> dict[str, float]:
     """Where the beam of `params` sits between the blocks of `clamp` (mm)."""
