@@ -26,7 +26,7 @@ from mujoco import rollout
 
 from designer import cosim, sweep
 from designer.cosim.robot import SpringDamper
-from designer.cosim.session import robot_system
+from designer.cosim.robot_scenario import robot_system
 from designer.sweep.evaluate import si_law
 from designer.sweep.executors import SerialExecutor
 from designer.sweep.spec import Cases, Spec, with_duration

@@ -44,13 +44,14 @@ def calibrate(
 ) -> None:
     """Calibrate the study's surrogate to your printer with your own measured runs.
 
-    The study's surrogate is the prior; your runs estimate a printer/material factor per response
-    (with its 95 % interval) and a local correction that is strong near the designs you printed and
-    fades away from them. The result is a surrogate file every --surrogate option accepts.
-    The report gives the nested leave-one-out accuracy over your runs (each predicted from the others).
-    The runs table designer print writes is read as filled: prints not measured yet are left out.
-    A k or c whose implied printer factor lies far outside its prior (a value in N/m, a load in kN)
-    is refused, naming the likely unit, unless --accept-implausible.
+    The study's surrogate is the prior; your runs estimate how your printer departs from the study's
+    (a factor per response with its 95 % interval, width and height offsets, infill, layer and raster
+    adhesion: those your runs pin down are printed) and a local correction that is strong near the
+    designs you printed and fades away from them. The result is a surrogate file every --surrogate
+    option accepts. The report gives the nested leave-one-out accuracy over your runs (each predicted
+    from the others). The runs table designer print writes is read as filled: prints not measured yet
+    are left out. A k or c whose implied printer factor lies far outside its prior (a value in N/m, a
+    load in kN) is refused, naming the likely unit, unless --accept-implausible.
 
     Example: designer calibrate my_runs.csv -o mine.json
     """
@@ -98,7 +99,33 @@ def _print_calibration(data: dict) -> None:
                 f"{100 * nested['coverage95']:.0f} % inside the 95 % PI"
             )
         console.print(line)
+        pinned = _pinned(m["mechanisms"])
+        if pinned:
+            console.print(f"  what your prints say of the printer: {pinned}")
         console.print(f"  {m['statement']}")
+
+
+#: how each mechanism reads in the calibrate report (value formats with units)
+_MECHANISM_TEXT = {
+    "width_offset": ("width offset", "{:+.2f} mm"),
+    "height_offset": ("height offset", "{:+.2f} mm"),
+    "infill": ("infill exponent change", "{:+.2f}"),
+    "layer": ("layer adhesion", "{:+.2f} per 0.04 mm"),
+    "raster": ("raster", "{:+.2f}"),
+    "layer_raster": ("layer x raster", "{:+.2f}"),
+}
+
+
+def _pinned(mechanisms: dict) -> str:
+    """The mechanisms the runs narrowed to under 70 % of their prior sd, as 'name value [low, high]'."""
+    parts = []
+    for name, (label, fmt) in _MECHANISM_TEXT.items():
+        m = mechanisms[name]
+        if (m["high"] - m["low"]) / (2 * 1.96) < 0.7 * m["prior_sd"]:
+            parts.append(
+                f"{label} {fmt.format(m['value'])} [{fmt.format(m['low'])}, {fmt.format(m['high'])}]"
+            )
+    return "; ".join(parts)
 
 
 def next_(

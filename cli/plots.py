@@ -288,10 +288,10 @@ def validate_cmd(
 
     Example: designer validate -o report/
     """
-    from designer.files import check_output
+    from designer.files import check_output_folder
     from designer.validate.report import validate
 
-    check_output(output, kind="folder", estimate_bytes=20e6)
+    check_output_folder(output, estimate_bytes=20e6)
     quiet_mujoco()
     with progress_bar("validating") as bar:
         results, page, md, seconds = validate(output, table=table, progress=bar)

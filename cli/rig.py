@@ -61,8 +61,9 @@ def identify(
     Example: designer identify run1.csv run2.parquet --load-delay 0.002 -o table.csv
     """
     from designer.files import check_output
-    from designer.rig.identify import ESTIMATOR, results_table
+    from designer.rig.axis_fit import ESTIMATOR
     from designer.rig.identify import identify as run
+    from designer.rig.identify import results_table
 
     if output is not None:
         check_output(output, suffixes=TABLE_SUFFIXES)
@@ -150,6 +151,8 @@ def _print_identification(res) -> None:
             for r in f.c_frequency["rows"]
         )
         console.print(f"  {f.axis}: c(frequency) [{cu}] {freq} (p equal {f.c_frequency['p_equal']:.2g})")
+    for note in res.notes:
+        console.print(f"  note: {note}")
     for w in res.warnings:
         console.print(f"  warning: {_as_flags(w)}")
     for a, why in res.failures.items():

@@ -66,45 +66,56 @@ def _probe(folder: Path, path: Path) -> None:
 def check_output(
     path: str | Path,
     *,
-    kind: str = "file",
     suffixes: Iterable[str] | None = None,
     estimate_bytes: float = 0,
 ) -> Path:
-    """Check before any work that `path` can be written; returns it resolved.
+    """Check before any work that the file `path` can be written; returns it resolved.
 
     Args:
-        path: the file (or folder, when kind="folder") to be written.
-        kind: "file" (its folder must exist) or "folder" (made with its parents when missing).
+        path: the file to be written (its folder must exist).
         suffixes: accepted file suffixes, lower case with the dot (None: any).
         estimate_bytes: expected size; the target's disk must have this much free plus 1 MiB.
 
     Raises:
-        DesignerError: a folder where a file is expected or the reverse, a wrong suffix, a folder that
-            is missing or cannot be written, or too little free space (with the estimate).
+        DesignerError: a folder where a file is expected, a wrong suffix, a folder that is missing or
+            cannot be written, or too little free space (with the estimate).
     """
-    if kind not in ("file", "folder"):
-        raise ValueError(f"kind={kind!r}: use 'file' or 'folder'")
     p = Path(path).expanduser().absolute()
-    if kind == "file" and p.is_dir():
+    if p.is_dir():
         raise DesignerError(
             f"cannot write {path}: it is a folder", f"give a file name, e.g. {Path(path) / 'out'}"
         )
-    if kind == "folder" and p.exists() and not p.is_dir():
-        raise DesignerError(f"cannot write into {path}: it is a file", "give a folder (new or existing)")
-    if suffixes is not None and kind == "file":
+    if suffixes is not None:
         allowed = sorted(suffixes)
         if p.suffix.lower() not in allowed:
             raise DesignerError(
                 f"cannot write {path}: the suffix '{p.suffix}' is not {' or '.join(allowed)}",
                 f"name the file with {' or '.join(allowed)}",
             )
-    folder = p if (kind == "folder" and p.is_dir()) else p.parent
+    if not p.parent.is_dir():
+        raise DesignerError(f"cannot write {path}: folder {p.parent} does not exist", "create it first")
+    return _room(p, p.parent, path, estimate_bytes)
+
+
+def check_output_folder(path: str | Path, *, estimate_bytes: float = 0) -> Path:
+    """Check, before any work, that `path` is or can become a writable folder (made with its parents
+    when missing, by its writer); returns it resolved.
+
+    Raises:
+        DesignerError: `path` is a file, it (or its nearest existing parent) is not a writable folder,
+            or its disk has too little free space for `estimate_bytes` (with the estimate).
+    """
+    p = Path(path).expanduser().absolute()
+    if p.exists() and not p.is_dir():
+        raise DesignerError(f"cannot write into {path}: it is a file", "give a folder (new or existing)")
+    folder = p if p.is_dir() else _existing_ancestor(p)
     if not folder.is_dir():
-        if kind == "file":
-            raise DesignerError(f"cannot write {path}: folder {folder} does not exist", "create it first")
-        folder = _existing_ancestor(p)
-        if not folder.is_dir():
-            raise DesignerError(f"cannot create {path}: {folder} is not a folder", "choose another path")
+        raise DesignerError(f"cannot create {path}: {folder} is not a folder", "choose another path")
+    return _room(p, folder, path, estimate_bytes)
+
+
+def _room(p: Path, folder: Path, path: str | Path, estimate_bytes: float) -> Path:
+    """`p` once `folder` (where it goes) is writable and its disk has `estimate_bytes` free plus 1 MiB."""
     _probe(folder, Path(path))
     free = shutil.disk_usage(folder).free
     if estimate_bytes + _SPARE_BYTES > free:
@@ -210,7 +221,7 @@ def atomic_folder(path: str | Path) -> Iterator[Path]:
     Raises:
         DesignerError: `path` is a file, or its folder cannot be created or written.
     """
-    target = _followed(check_output(path, kind="folder"))
+    target = _followed(check_output_folder(path))
     target.parent.mkdir(parents=True, exist_ok=True)
     stage = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent))
     try:
@@ -384,15 +395,6 @@ def check_table_file(path: str | Path, *, parquet: bool) -> None:
                 f"cannot read {p}: it is separated by {used[0]}, not commas",
                 "save it as comma-separated CSV (decimal point '.'), or as Parquet",
             )
-
-
-def check_output_folder(path: str | Path) -> Path:
-    """Check, before any work, that `path` is or can become a writable folder; returns it.
-
-    Raises:
-        DesignerError: `path` is a file, or it (or its nearest existing parent) is not writable.
-    """
-    return check_output(path, kind="folder")
 
 
 def check_suffix(path: str | Path, suffixes: tuple[str, ...], *, what: str) -> Path:

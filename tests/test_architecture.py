@@ -191,3 +191,15 @@ def test_the_checker_sees_a_cycle_and_a_private_import(tmp_path):
         assert _imports("designer._probe_b", b) == [("designer._probe_a", "g")]
     finally:
         del MODULES["designer._probe_a"], MODULES["designer._probe_b"]
+
+
+def test_only_the_scenario_loader_branches_on_a_kind():
+    """Robot and rig scenarios (and FMU modes, value types, case types) dispatch through their types:
+    the TOML loader decides the scenario's type, and nothing else writes `kind ==`."""
+    branching = sorted(
+        f"{name} line {i}"
+        for name, path in MODULES.items()
+        for i, line in enumerate(path.read_text().splitlines(), 1)
+        if re.search(r"\bkind\s*[!=]=", line)
+    )
+    assert all(b.startswith("designer.cosim.scenario_file ") for b in branching), branching

@@ -103,7 +103,12 @@ def test_one_run_at_a_study_design_moves_the_prediction_by_the_models_amount(stu
     Hu = H * u[:, None]
     Z = coded(X)
     rho = Matern(length_scale=length, nu=2.5)(Z)
-    K = (Hu * sb) @ Hu.T + local**2 * np.outer(u, u) * rho + np.outer(sg, sg) * rho + noise**2 * np.eye(len(u))
+    K = (
+        (Hu * sb) @ Hu.T
+        + local**2 * np.outer(u, u) * rho
+        + np.outer(sg, sg) * rho
+        + noise**2 * np.eye(len(u))
+    )
     r = np.log(np.r_[table["k_x"], run["k_x"]]) - np.log(p.value)
     c = K[-1] - noise**2 * (np.arange(len(u)) == len(u) - 1)
     shift = c @ np.linalg.solve(K, r)
@@ -348,3 +353,45 @@ def test_the_loop_lands_on_a_simulated_printer_within_four_prints(study, seed, k
         runs = pd.concat([runs, run], ignore_index=True)
     else:
         pytest.fail(f"printer {seed} (factor {printer.factor_k:.2f}) missed k = {k} four times")
+
+
+#: one print as the design loop makes it: the study's suggestion for 0.36 N/mm, on a printer whose k
+#: there came out 0.363 N/mm. Before the grid backed the search, `next --k 0.342` answered "out of
+#: reach ... the surrogate predicts k_x from 0.242 to 2.04 N/mm; the nearest design is predicted at
+#: 0.397 (+16 %)", though its own model predicts 0.342 within +-10 % at printable designs.
+ONE_PRINT = {
+    "density": [100.0], "length": [30.0], "width": [7.0], "height": [14.0], "layer": [0.2],
+    "raster": [45.0], "k_x": [0.36293000791563435], "c_x": [0.0014389662741348668],
+}  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("runs", "fixed", "targets"),
+    [
+        (ONE_PRINT, {}, (0.342061313697906, 0.3, 0.43)),
+        ("3:0.656", {}, (0.3488, 1.6)),
+        ("12,30:0.656", {"raster": 0.0}, (0.3488, 0.43)),
+        ("5,18,40:1.45", {}, (0.3, 1.6)),
+    ],
+)
+def test_next_is_never_out_of_reach_where_a_printable_design_is_predicted_within_tolerance(
+    study, table, runs, fixed, targets
+):
+    """The printable grid of tests/printers.py (not the tool's search) says where the calibrated model
+    itself predicts a target within +-10 %: there `next` must answer, not say "out of reach"; and the
+    range it states when it does say so holds its own nearest design."""
+    if isinstance(runs, str):  # study rows, measured at a printer factor
+        rows, factor = runs.split(":")
+        runs = _rows(table, [int(i) for i in rows.split(",")], scale=float(factor))
+    cal = designer.calibrate(study, pd.DataFrame(runs))
+    grid = printers.grid(fixed, points=6)
+    predicted = cal.predict(grid)["k_x"].value
+    for k in targets:
+        nxt = designer.next_prints(cal, k=k, fixed=fixed, n=1)
+        if np.any(np.abs(predicted / k - 1) <= 0.1):
+            assert nxt.reachable, (k, nxt.statements)
+            assert not any("out of reach" in s for s in nxt.statements), nxt.statements
+        sug = designer.suggest(cal, k=k, fixed=fixed)
+        if not sug.reachable:
+            lo, hi = sug.ranges["k"]["predicted"]
+            assert lo <= sug.candidates[0].predicted["k"].value <= hi

@@ -1,6 +1,5 @@
 """The compiled co-simulation kernel against the Python master: the same bits, the same errors."""
 
-import importlib
 import math
 import shutil
 import subprocess
@@ -16,10 +15,10 @@ from designer.cosim import binding, kernel, prepare
 from designer.cosim.master import Master
 from designer.cosim.references import Chirp, Sine, Step, Trajectory
 from designer.cosim.robot import Robot, SpringDamper, load_spec
-from designer.cosim.scenario import load
+from designer.cosim.robot_scenario import robot_reference
+from designer.cosim.scenario_file import load
 from designer.errors import DesignerError
 
-cosim_run = importlib.import_module("designer.cosim.run")
 EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "two_link_arm.toml"
 REFERENCES = [
     '{ type = "sine", amplitude = 0.5, frequency = 0.7, offset = 0.1, phase = 0.3 }',
@@ -231,7 +230,7 @@ def test_auto_falls_back_to_python_without_a_compiler(tmp_path, monkeypatch):
 def test_in_engine_reference_bit_identical():
     sc = load(EXAMPLE)
     laws = {j: {"k": 0.333, "c": 8.3e-4, "offset": 0.01} for j in sc.joints}
-    ker = cosim_run.robot_reference(sc, laws, 1e-3, 2.0, "rk4")
+    ker = robot_reference(sc, laws, 1e-3, 2.0, "rk4")
     py = _reference_master(sc, laws).run(2.0, 1e-3)
     assert_same(py, ker)
 
@@ -298,7 +297,7 @@ def asking_fmus(monkeypatch, every=250, fail_at=None):
         fake = asking(self.fmu)
         keep.append(fake)
         fakes[id(self.fmu)] = ctypes.cast(fake, ctypes.c_void_p).value
-        self.needs_completed_step = True
+        self.mode.completed = True  # a ModelExchange mode: CompletedIntegratorStep after each step
 
         def python_completed():
             enter, stop = ctypes.c_int(0), ctypes.c_int(0)
@@ -308,8 +307,8 @@ def asking_fmus(monkeypatch, every=250, fail_at=None):
             return bool(enter.value), bool(stop.value)
 
         self.fmu.completedIntegratorStep = python_completed
-        iteration = self._event_iteration
-        self._event_iteration = lambda: (events.append((self.fmu.instanceName, self._steps)), iteration())
+        iteration = self.event_iteration
+        self.event_iteration = lambda: (events.append((self.fmu.instanceName, self.steps)), iteration())
 
     def function(fmu, name):
         return fakes[id(fmu)] if name.endswith("CompletedIntegratorStep") else real_function(fmu, name)

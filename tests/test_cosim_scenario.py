@@ -11,6 +11,7 @@ import typer
 from typer.testing import CliRunner
 
 from designer.cosim import load, prepare, run, write_outputs
+from designer.cosim.robot_scenario import robot_reference
 from designer.errors import DesignerError
 
 # the module, not the function `designer.cosim.run` that shadows it as an attribute of the package
@@ -63,7 +64,7 @@ def test_two_link_arm_through_fmus_matches_in_engine_reference(tmp_path):
     with prepare(sc) as session:
         laws = session.laws(session.parameters(None))
         res = session.trace()
-    ref = cosim_run.robot_reference(sc, laws, sc.step, sc.duration, "euler")
+    ref = robot_reference(sc, laws, sc.step, sc.duration, "euler")
     assert laws["j1"]["k"] == pytest.approx(0.33) and laws["j1"]["c"] == pytest.approx(8.3e-4)
     for j in sc.joints:
         assert np.abs(res.column(f"robot.{j}.q") - ref.column(f"robot.{j}.q")).max() <= 1e-6

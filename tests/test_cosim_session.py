@@ -163,7 +163,7 @@ def test_prepare_reads_each_file_once_and_unpacks_only_what_loads(tmp_path, scra
     modelDescription.xml), no sources."""
     import fmpy
 
-    from designer.cosim import robot, session
+    from designer.cosim import robot, robot_scenario
     from designer.export.fmu import export_fmu
 
     sc = short()
@@ -172,7 +172,7 @@ def test_prepare_reads_each_file_once_and_unpacks_only_what_loads(tmp_path, scra
     reads, parses = [], []
     real_read, real_spec = fmpy.read_model_description, robot.load_spec
     monkeypatch.setattr(fmpy, "read_model_description", lambda *a, **k: reads.append(a) or real_read(*a, **k))
-    monkeypatch.setattr(session, "load_spec", lambda *a: parses.append(a) or real_spec(*a))
+    monkeypatch.setattr(robot_scenario, "load_spec", lambda *a: parses.append(a) or real_spec(*a))
     monkeypatch.setattr(robot, "load_spec", lambda *a: parses.append(a) or real_spec(*a))
     with prepare(sc) as s:
         (folder,) = scratch.iterdir()
@@ -308,8 +308,7 @@ def test_in_engine_law_is_the_one_definition():
     from designer.cosim import kernel
     from designer.cosim.master import Master
     from designer.cosim.robot import SpringDamper
-    from designer.cosim.run import robot_reference
-    from designer.cosim.session import robot_system
+    from designer.cosim.robot_scenario import robot_reference, robot_system
     from designer.sweep.cases import Case
     from designer.sweep.engine import rollout_traces
 

@@ -10,9 +10,13 @@ designer.cosim.write_outputs(result, "results/")          # time series, metrics
 
 from .master import Master, Trace
 from .references import Chirp, Sine, Step, Trajectory
+from .result import Result
+from .rig_scenario import RigScenario
 from .robot import Robot, SpringDamper, load_spec, planar_arm_xml
-from .run import Result, plot_result, run, write_outputs
-from .scenario import JointSource, Scenario, load
+from .robot_scenario import RobotScenario
+from .run import plot_result, run, write_outputs
+from .scenario import JointSource, Scenario
+from .scenario_file import load
 from .session import Session, prepare
 
 __all__ = [
@@ -20,7 +24,9 @@ __all__ = [
     "JointSource",
     "Master",
     "Result",
+    "RigScenario",
     "Robot",
+    "RobotScenario",
     "Scenario",
     "Session",
     "Sine",

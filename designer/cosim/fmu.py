@@ -21,6 +21,7 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import functools
+import importlib
 import itertools
 import shutil
 from collections import deque
@@ -161,12 +162,87 @@ def _same_instant_capable(md) -> bool:
     )
 
 
+class FmiMode:
+    """How an FMU is driven (the master's view of one FMI interface): `name`, `feedthrough`, its
+    model description element (`element`) and fmpy's class (FMU2<fmpy>, FMU3<fmpy>)."""
+
+    name: str
+    feedthrough: bool
+    element: str
+    fmpy: str
+
+    def interface(self, md):
+        """The model description's element of this interface."""
+        return getattr(md, self.element)
+
+    def fmpy_class(self, version: int) -> type:
+        """fmpy's class for an instance of this interface in FMI `version`."""
+        return getattr(importlib.import_module(f"fmpy.fmi{version}"), f"FMU{version}{self.fmpy}")
+
+    def initialized(self, system: FmuSystem) -> None:
+        """What follows Initialization Mode."""
+        raise NotImplementedError
+
+    def step(self, system: FmuSystem, h: float) -> None:
+        """One macro step of `h` s."""
+        raise NotImplementedError
+
+    def kernel_calls(self) -> list[str]:
+        """The FMI calls the compiled kernel makes per step besides set and get (binding.CALLS)."""
+        raise NotImplementedError
+
+
+class CoSimulation(FmiMode):
+    """Driving an FMU through its Co-Simulation interface: a step is DoStep(n h, h); its outputs are
+    those of its last step (not feedthrough)."""
+
+    name, feedthrough, element, fmpy = "co-simulation", False, "coSimulation", "Slave"
+
+    def initialized(self, system: FmuSystem) -> None:
+        """Nothing to do: the instance is in Step Mode."""
+
+    def step(self, system: FmuSystem, h: float) -> None:
+        """DoStep(n h, h)."""
+        system.fmu.doStep(system.steps * h, h)
+        system.steps += 1
+
+    def kernel_calls(self) -> list[str]:
+        return ["step"]
+
+
+class ModelExchange(FmiMode):
+    """Driving an FMU without states through its Model Exchange interface, so that its outputs follow
+    inputs set at the same instant (feedthrough): a step is SetTime((n + 1) h), then
+    CompletedIntegratorStep when the FMU needs it (`completed`), and an event iteration if it asks."""
+
+    name, feedthrough, element, fmpy = "model-exchange", True, "modelExchange", "Model"
+
+    def __init__(self, completed: bool) -> None:
+        self.completed = completed
+
+    def initialized(self, system: FmuSystem) -> None:
+        """The event iteration after Initialization Mode, into Continuous-Time Mode."""
+        system.event_iteration()
+
+    def step(self, system: FmuSystem, h: float) -> None:
+        """SetTime((n + 1) h), then CompletedIntegratorStep if the FMU needs it."""
+        system.steps += 1
+        system.fmu.setTime(system.steps * h)
+        if self.completed:
+            system.completed(*system.fmu.completedIntegratorStep())
+
+    def kernel_calls(self) -> list[str]:
+        return ["time", "completed"] if self.completed else ["time"]
+
+
 class FmuSystem:
     """One FMU instance driven by the master; exposes only the variables of the chosen axes.
 
-    Attributes: `inputs`, `outputs` (variable names), `feedthrough` (outputs follow inputs at the same
-    instant: a force element run as Model Exchange), `kind` ("model-exchange" or "co-simulation"),
-    `delay` (None, or a sentence saying which outputs lag their inputs by one step and why).
+    Attributes: `inputs`, `outputs` (variable names), `mode` (how it is driven: `ModelExchange` for a
+    force element whose Model Exchange interface needs no integration, else `CoSimulation`),
+    `feedthrough` (outputs follow inputs at the same instant), `kind` (the mode's name,
+    "model-exchange" or "co-simulation"), `delay` (None, or a sentence saying which outputs lag
+    their inputs by one step and why), `steps` (macro steps since t = 0).
     """
 
     def __init__(
@@ -190,14 +266,16 @@ class FmuSystem:
         md = fmu if isinstance(fmu, FmuDescription) else FmuDescription(fmu, axes)
         self.description, self.name = md, name
         self.interface, self.version = md.interface, md.version
-        me = self.interface == "force" and _same_instant_capable(md.md)
-        self.kind = "model-exchange" if me else "co-simulation"
-        self.feedthrough = me
+        if self.interface == "force" and _same_instant_capable(md.md):
+            self.mode: FmiMode = ModelExchange(bool(md.md.modelExchange.needsCompletedIntegratorStep))
+        else:
+            self.mode = CoSimulation()
+        self.kind, self.feedthrough = self.mode.name, self.mode.feedthrough
         self.delay = None
         if self.interface == "force":
             self.inputs = [f"{a}.{v}" for a in axes for v in ("s", "v")]
             self.outputs = [f"{a}.f" for a in axes]
-            if not me:
+            if not self.feedthrough:
                 self.delay = (
                     f"{name}: {', '.join(self.outputs)} lag(s) the inputs by one step: the FMU offers "
                     "co-simulation only, which defines no output for inputs set since its last step"
@@ -205,7 +283,6 @@ class FmuSystem:
         else:
             self.inputs = [f"{a}.f" for a in axes]
             self.outputs = [f"{a}.{v}" for a in axes for v in ("s", "v", "a")]
-        self.needs_completed_step = bool(me and md.md.modelExchange.needsCompletedIntegratorStep)
         self.parameters = dict(parameters or {})
         unpacked = md.path.is_dir()
         self._owned = folder is None and not unpacked
@@ -217,7 +294,7 @@ class FmuSystem:
         try:
             if not unpacked:
                 unpack(md.path, self._dir)
-            self.fmu = self._instantiate(md.md, name, me)
+            self.fmu = self._instantiate(md.md, name)
             self._start(self.parameters)
             self._bind(md.refs)
         except BaseException as exc:  # a half-built instance frees what it holds, then reports
@@ -234,7 +311,7 @@ class FmuSystem:
                     f"FMU {self.description.path} has no parameter '{key}'", "use names such as theta.k"
                 )
             self._set_scalar(refs[key], float(value))
-        self._initialize(self.kind == "model-exchange")
+        self._initialize()
 
     def reset(self, parameters: Mapping[str, float] | None = None) -> None:
         """Back to t = 0 for a new run: FMI Reset, the constructor's parameters updated with
@@ -245,7 +322,7 @@ class FmuSystem:
         """
         given = self.parameters | dict(parameters or {})
         self.log.clear()
-        self._steps, self._h = 0, 0.0
+        self.steps, self._h = 0, 0.0
         try:
             self.fmu.reset()
             self._start(given)
@@ -276,27 +353,19 @@ class FmuSystem:
         if self._owned:
             shutil.rmtree(self._dir, ignore_errors=True)
 
-    def _instantiate(self, md, name: str, me: bool):
-        """An fmpy FMU2/FMU3 Model (me) or Slave, instantiated."""
-        iface = md.modelExchange if me else md.coSimulation
-        kwargs = dict(
+    def _instantiate(self, md, name: str):
+        """An fmpy FMU2/FMU3 Model or Slave (as the mode drives it), instantiated."""
+        iface = self.mode.interface(md)
+        fmu = self.mode.fmpy_class(self.version)(
             guid=md.guid, unzipDirectory=self._dir, modelIdentifier=iface.modelIdentifier, instanceName=name
         )
-        if self.version == 3:
-            from fmpy.fmi3 import FMU3Model, FMU3Slave
-
-            fmu = (FMU3Model if me else FMU3Slave)(**kwargs)
-        else:
-            from fmpy.fmi2 import FMU2Model, FMU2Slave
-
-            fmu = (FMU2Model if me else FMU2Slave)(**kwargs)
         self._instantiate_logging(fmu)
         problems = [c.name for c in md.logCategories if c.name in PROBLEM_CATEGORIES]
         if problems:  # only problems: an FMU logging every call would slow each step
             fmu.setDebugLogging(True, problems)
         return fmu
 
-    def _initialize(self, me: bool) -> None:
+    def _initialize(self) -> None:
         """Initialization Mode at t = 0, then Step Mode (CS) or Continuous-Time Mode (ME)."""
         if self.version == 3:
             self.fmu.enterInitializationMode(startTime=0.0)
@@ -304,10 +373,9 @@ class FmuSystem:
             self.fmu.setupExperiment(startTime=0.0)
             self.fmu.enterInitializationMode()
         self.fmu.exitInitializationMode()
-        if me:
-            self._event_iteration()
+        self.mode.initialized(self)
 
-    def _event_iteration(self) -> None:
+    def event_iteration(self) -> None:
         """In Event Mode: update discrete states until settled, then enter Continuous-Time Mode."""
         update = self.fmu.updateDiscreteStates if self.version == 3 else self.fmu.newDiscreteStates
         for _ in range(1000):
@@ -332,7 +400,7 @@ class FmuSystem:
         self._out = np.zeros(len(self.outputs))
         self._in_ptr = self._in.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         self._out_ptr = self._out.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
-        self._steps = 0
+        self.steps = 0
         self._h = 0.0  # the last macro step, s (0 before the first)
         f, ni, no = self.fmu, len(self.inputs), len(self.outputs)
         if self.version == 3:
@@ -387,18 +455,10 @@ class FmuSystem:
             self._surface(exc)
 
     def do_step(self, h: float) -> None:
-        """Co-simulation: DoStep(n h, h). Model Exchange (no states): SetTime((n + 1) h), then
-        CompletedIntegratorStep if the FMU needs it, and an event iteration if it asks for one."""
+        """One macro step of `h` s, as the mode drives it (`CoSimulation.step`, `ModelExchange.step`)."""
         self._h = h
         try:
-            if self.kind == "co-simulation":
-                self.fmu.doStep(self._steps * h, h)
-                self._steps += 1
-                return
-            self._steps += 1
-            self.fmu.setTime(self._steps * h)
-            if self.needs_completed_step:
-                self.completed(*self.fmu.completedIntegratorStep())
+            self.mode.step(self, h)
         except Exception as exc:
             self._surface(exc)
 
@@ -408,7 +468,7 @@ class FmuSystem:
         from fmpy.fmi1 import FMICallException
 
         if isinstance(exc, FMICallException):
-            raise self.status_error(exc.function, exc.status, self._steps * self._h) from None
+            raise self.status_error(exc.function, exc.status, self.steps * self._h) from None
         raise  # the exception being handled
 
     def status_error(self, call: str, status: int, t: float) -> DesignerError:
@@ -432,7 +492,7 @@ class FmuSystem:
         if enter:
             try:
                 self.fmu.enterEventMode()
-                self._event_iteration()
+                self.event_iteration()
             except Exception as exc:
                 self._surface(exc)
 
@@ -448,18 +508,14 @@ class FmuSystem:
             "time": "SetTime",
             "completed": "CompletedIntegratorStep",
         }
-        wanted = ["set", "get"]
-        if self.kind == "co-simulation":
-            wanted.append("step")
-        else:
-            wanted += ["time", "completed"] if self.needs_completed_step else ["time"]
+        wanted = ["set", "get", *self.mode.kernel_calls()]
 
         def start(step: float) -> int:
             self._h = step  # the macro step the kernel runs, for the time in error messages
-            return self._steps
+            return self.steps
 
         def finish(steps: int) -> None:
-            self._steps = steps
+            self.steps = steps
 
         def error(call: int, status: int, t: float) -> DesignerError:
             return self.status_error(f"fmi{v}{names[kb.CALLS[call]]}", status, t)

@@ -16,7 +16,8 @@ from pathlib import Path
 
 from ..errors import DesignerError
 from ..export.build import FLAGS as BUILD_FLAGS
-from ..export.build import cache_dir, compile_c, find_compiler, source_dir
+from ..export.build import cache_dir, compile_c, find_compiler
+from ..export.layout import source_dir
 from ..files import cache_entry
 
 #: the FMU binary's flags, plus -ffp-contract=off and no sin/cos builtins: the arithmetic of the

@@ -45,6 +45,15 @@ class System(Protocol):
     def reset(self) -> None: ...
 
 
+class Series(Protocol):
+    """A run's time series as its readers use it: `time` (s) and `column(name)`. A `Trace` is one, and
+    so is a `designer.cosim.Result`."""
+
+    time: np.ndarray
+
+    def column(self, name: str) -> np.ndarray: ...
+
+
 @dataclass(frozen=True)
 class Trace:
     """Time series of every output, columns named `system.variable`, rows at t = 0, h, ..., N h.

@@ -19,6 +19,7 @@ import numpy as np
 from ..errors import DesignerError
 from . import binding as kb
 from .references import Reference
+from .twin import Twin
 
 INTEGRATORS = ("euler", "implicitfast", "implicit", "rk4")
 
@@ -293,18 +294,15 @@ class Robot:
         self._motor(self.time)
 
     def binding(self) -> kb.Binding:
-        """The robot for the compiled kernel (see designer.cosim.binding): MuJoCo's mjModel/mjData
-        pointers, its joints and motors, the spring-dampers MuJoCo computes itself.
+        """The robot for the compiled kernel (see designer.cosim.binding): a copy of its MuJoCo model
+        and data that the kernel steps, synchronised with this robot's before and after each run
+        (designer.cosim.twin), its joints and motors, the spring-dampers MuJoCo computes itself.
 
         Raises:
-            DesignerError: mujoco's bindings too old to give raw pointers, or a motor reference the
+            DesignerError: a mujoco too old to load a model from memory, or a motor reference the
                 kernel does not know.
         """
-        if not hasattr(self.model, "_address"):  # the raw pointers came with mujoco's 3.x bindings
-            raise DesignerError(
-                "this mujoco's Python bindings give no raw model pointers",
-                "update mujoco, or use engine='python'",
-            )
+        twin = Twin(self.model, self.data)  # the kernel steps its own copy (see twin.py)
         keep: list = []
         refs = (kb.Reference * len(self.motors))(*[kb.reference(r, keep) for r in self.motors])
         qposadr, dofadr, inputs = kb.ints(self.qpos), kb.ints(self.dof), kb.ints(self._input_dof)
@@ -312,8 +310,8 @@ class Robot:
         engine_joint = kb.ints([self.joints.index(j) for j in self.in_engine])
         engine_law = np.array([(v.k, v.c, v.offset) for v in self.in_engine.values()], float).reshape(-1, 3)
         struct = RobotStruct(
-            model=self.model._address,
-            data=self.data._address,
+            model=twin.model,
+            data=twin.data,
             n_joints=len(self.joints),
             n_inputs=len(inputs),
             qposadr=kb.pointer(qposadr, kb.P_INT),
@@ -327,15 +325,17 @@ class Robot:
             engine_joint=kb.pointer(engine_joint, kb.P_INT),
             engine_law=kb.pointer(engine_law),
         )
-        keep += [refs, qposadr, dofadr, inputs, engine_act, engine_joint, engine_law, struct]
+        keep += [refs, qposadr, dofadr, inputs, engine_act, engine_joint, engine_law, struct, twin]
 
         def start(step: float) -> int:
+            twin.load()
             struct.steps, struct.time = self._steps, self.time
             for ref in refs:
                 ref.cursor = 0
             return self._steps
 
         def finish(steps: int) -> None:
+            twin.store()
             self._steps, self.time = struct.steps, struct.time
 
         return kb.Binding(

@@ -19,44 +19,16 @@ from __future__ import annotations
 
 import contextlib
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
 
 from ..errors import DesignerError, check_type
 from ..files import temporary_folder
 from .fmu import FmuDescription, FmuSystem, unpack
 from .kernel import ENGINES, Bound, bind, run_master
 from .master import Master, Trace
-from .rig import HubServo
-from .robot import Robot, SpringDamper, free_host_joints, load_spec
-from .scenario import PARAMETER_FIELDS, JointSource, Scenario
-
-if TYPE_CHECKING:
-    from .run import Result
-
-Progress = Callable[[float], None] | None
-
-
-def robot_system(
-    sc: Scenario,
-    step: float,
-    *,
-    integrator: str | None = None,
-    in_engine: Mapping[str, SpringDamper] | None = None,
-) -> Robot:
-    """The robot of a (checked) robot scenario at physics step `step` (s): the one place a scenario's
-    MuJoCo model is built. `in_engine` computes those joints' spring-dampers inside MuJoCo. Each
-    flexible joint's own stiffness, damping and armature in the host model are zeroed unless its
-    source says `keep_host` (`Robot.notes` says what changed), for the run and its reference alike."""
-    spec = load_spec(sc.model, sc.lengths, sc.masses)
-    notes = free_host_joints(spec, [j for j, src in sc.joints.items() if not src.keep_host])
-    return Robot(spec, sc.motors, step, integrator or sc.integrator, in_engine=in_engine, notes=notes)
-
-
-def sources(sc: Scenario) -> dict[str, JointSource]:
-    """The joint sources of a scenario by system name ("rig" for the virtual rig's joint)."""
-    return {"rig": sc.rig_joint} if sc.kind == "rig" else dict(sc.joints)
+from .result import Result
+from .scenario import PARAMETER_FIELDS, JointSource, Progress, Scenario
 
 
 def _unpacked(src: JointSource, interface: str, folder: Path) -> Path:
@@ -115,8 +87,8 @@ class Session:
     def _load(self) -> None:
         """Unpack (or write) each joint FMU, read its description, instantiate it; wire the master."""
         sc = self.scenario
-        interface = "body" if sc.kind == "rig" else "force"
-        for name, src in sources(sc).items():
+        interface = sc.interface
+        for name, src in sc.sources().items():
             unpacked = _unpacked(src, interface, self._folder / name)
             md = FmuDescription(src.fmu or unpacked, [src.axis])
             if md.interface != interface:
@@ -132,24 +104,7 @@ class Session:
 
     def _master(self, step: float) -> Master:
         """The session's FMU systems wired to a robot (or the rig's hub) stepping at `step` (s)."""
-        sc = self.scenario
-        systems: dict[str, Any] = {}
-        connections = []
-        if sc.kind == "rig":
-            a = sc.rig_joint.axis
-            systems = {"joint": self.systems["rig"], "hub": HubServo(sc.hub, 0.0, 0.0)}
-            connections = [(f"joint.{a}.s", "hub.s"), (f"joint.{a}.v", "hub.v"), ("hub.f", f"joint.{a}.f")]
-        else:
-            systems["robot"] = robot_system(sc, step)
-            for name, src in sc.joints.items():
-                a = src.axis
-                systems[name] = self.systems[name]
-                connections += [
-                    (f"robot.{name}.s", f"{name}.{a}.s"),
-                    (f"robot.{name}.v", f"{name}.{a}.v"),
-                    (f"{name}.{a}.f", f"robot.{name}.tau"),
-                ]
-        return Master(systems, connections, sc.algorithm)
+        return self.scenario.wire(self.systems, step)
 
     # ------------------------------------------------------------------ one run
 
@@ -166,7 +121,7 @@ class Session:
                     f"parameters name '{name}', which is not a joint of the scenario",
                     f"its joints: {', '.join(self.systems)}",
                 )
-            axis = sources(self.scenario)[name].axis
+            axis = self.scenario.sources()[name].axis
             for key, value in values.items():
                 field = str(key).partition(".")[2]
                 if not str(key).startswith(f"{axis}.") or field not in PARAMETER_FIELDS:
@@ -186,7 +141,7 @@ class Session:
         """The SI m, c, k, offset each joint FMU runs with: start values, the scenario's overrides,
         then the case's (`case` as `parameters` returns it)."""
         out = {}
-        for name, src in sources(self.scenario).items():
+        for name, src in self.scenario.sources().items():
             law = self.descriptions[name].parameters(src.axis)
             for key, value in (dict(src.parameters) | case[name]).items():
                 axis, _, field = key.partition(".")
@@ -221,12 +176,7 @@ class Session:
         master = self._masters[step]
         for name, system in self.systems.items():
             system.reset(case[name])
-        for system in master.systems.values():
-            if isinstance(system, FmuSystem):
-                continue
-            system.reset()
-            if isinstance(system, HubServo):  # the rig's servo loop is tuned to the case's joint
-                system.tune(self.laws(case)["rig"], step)
+        sc.reset(master, lambda: self.laws(case), step)
         bound = self._kernel(step, master, engine)
         if bound is None and engine == "auto":
             engine = "python"
@@ -271,9 +221,21 @@ class Session:
             DesignerError: bad parameters, an FMU that refuses them or fails during the run (with its
                 log line), a co-simulation that diverges, a closed session.
         """
-        from .run import result
+        share = 0.5 if validate else 1.0
 
-        return result(self, self.parameters(parameters), duration, engine, validate, progress)
+        def part(offset: float, scale: float) -> Progress:
+            return None if progress is None else (lambda f: progress(offset + scale * f))
+
+        sc = self.scenario
+        case = self.parameters(parameters)
+        laws = self.laws(case)
+        trace = self.trace(case, duration=duration, progress=part(0.0, share), engine=engine)
+        metrics = sc.metrics(trace, laws)
+        validation = sc.validate(self.trace, case, laws, part(share, 1.0 - share)) if validate else None
+        notes = (*trace.delays, *sc.notes(self.master))
+        return Result(
+            sc, trace.time, trace.columns, trace.values, metrics, laws, validation, notes, trace.engine
+        )
 
     # ------------------------------------------------------------------ life cycle
 

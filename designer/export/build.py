@@ -24,11 +24,11 @@ import shutil
 import subprocess
 import sys
 from collections.abc import Sequence
-from importlib import resources
 from pathlib import Path
 
 from ..errors import DesignerError, check_type
 from ..files import cache_entry, temporary_folder
+from .layout import layout, source_dir
 
 #: no fused multiply-add contraction: aarch64 would fuse a*b+c where x86_64 cannot, and a joint's
 #: numbers would then differ by platform (1e-12 after 300 steps, measured under qemu-user)
@@ -60,11 +60,6 @@ _FMI_HEADERS = {
     2: ("include/fmi2Functions.h", "include/fmi2FunctionTypes.h", "include/fmi2TypesPlatform.h"),
     3: ("include/fmi3Functions.h", "include/fmi3FunctionTypes.h", "include/fmi3PlatformTypes.h"),
 }
-
-
-def source_dir() -> Path:
-    """The folder holding the C runtime (`fmus/` in the checkout, `designer/fmus` when installed)."""
-    return Path(str(resources.files("designer.fmus")))
 
 
 def c_sources(fmi_version: int) -> list[str]:
@@ -105,8 +100,6 @@ def platform_folder(fmi_version: int, platform: str | None = None) -> str:
 
 def library_name(platform: str | None = None) -> str:
     """FlexJoint.so, .dll or .dylib for `platform` (default: this machine)."""
-    from .layout import layout
-
     system = (platform or host_platform()).split("-", 1)[1]
     return layout().model_identifier + {"windows": ".dll", "darwin": ".dylib"}.get(system, ".so")
 
@@ -173,7 +166,7 @@ def zig_flags(platform: str) -> list[str]:
     return extra
 
 
-def _compiler(platform: str, *, zig: bool = False) -> tuple[list[str], list[str]]:
+def platform_compiler(platform: str, *, zig: bool = False) -> tuple[list[str], list[str]]:
     """The compiler command and its extra flags for `platform`: the system one for the host (Zig if
     there is none and $CC names none, or if `zig`), Zig for the others.
 
@@ -261,7 +254,7 @@ def build_binary(
     shipped = None if rebuild else shipped_binary(fmi_version, platform)
     if shipped is not None:
         return shipped
-    compiler, extra = _compiler(platform, zig=zig)
+    compiler, extra = platform_compiler(platform, zig=zig)
     key = _build_key(fmi_version, compiler, extra, platform)
     target = cache_dir() / f"fmi{fmi_version}-{platform}-{key}" / library_name(platform)
     if target.is_file():

@@ -27,12 +27,12 @@ from .layout import layout
 INTERFACES = ("force", "body")
 FMI_VERSIONS = (2, 3)
 GENERATOR = f"flexjoint designer {__version__}"
-_ZIP_DATE = (1980, 1, 1, 0, 0, 0)
+ZIP_DATE = (1980, 1, 1, 0, 0, 0)
 _TOKEN = "@TOKEN@"
 
 
 # SI units and their base-unit exponents, for UnitDefinitions
-_BASE_UNITS: dict[str, dict[str, int]] = {
+BASE_UNITS: dict[str, dict[str, int]] = {
     "s": {"s": 1},
     "m": {"m": 1},
     "rad": {"rad": 1},
@@ -49,7 +49,7 @@ _BASE_UNITS: dict[str, dict[str, int]] = {
     "kg": {"kg": 1},
     "kg.m^2": {"kg": 1, "m": 2},
 }
-_BASE_ORDER = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
+BASE_ORDER = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
 
 
 def value_reference(axis: str, field: str) -> int:
@@ -58,12 +58,32 @@ def value_reference(axis: str, field: str) -> int:
 
 
 @dataclass(frozen=True)
+class ValueType:
+    """A variable's type as each format names it and writes its values: `fmi2` (the ScalarVariable's
+    element), `fmi3` (the variable's element), `ssc` (SSP's connector type), `text` (a value as the
+    model description and the binary's start values write it)."""
+
+    fmi2: str
+    fmi3: str
+    ssc: str
+    text: Callable[[float | bool], str]
+
+    def connector(self, unit: str | None) -> str:
+        """The SSP connector type, `<ssc:Real unit="N.m"/>` (`unit` None: none declared)."""
+        return f"<ssc:{self.ssc}/>" if unit is None else f"<ssc:{self.ssc} unit={quoteattr(unit)}/>"
+
+
+REAL = ValueType("Real", "Float64", "Real", lambda v: repr(float(v)))
+BOOLEAN = ValueType("Boolean", "Boolean", "Boolean", lambda v: "true" if v else "false")
+
+
+@dataclass(frozen=True)
 class Variable:
-    """One model variable as both FMI versions declare it."""
+    """One model variable as both FMI versions declare it (a Boolean has no unit and no derivative)."""
 
     name: str
     vr: int
-    kind: str  # "Real" or "Boolean"
+    type: ValueType
     causality: str
     variability: str
     description: str
@@ -105,10 +125,10 @@ def _parameter_variables(a: str, ac: AxisCoefficients) -> list[Variable]:
     }
     for q, text in what.items():
         if si[q] is not None:
-            out.append(var(q, "Real", "parameter", "tunable", text, si[q], units.si_unit(q, a)))
+            out.append(var(q, REAL, "parameter", "tunable", text, si[q], units.si_unit(q, a)))
     r = units.si_unit("r", a)
-    out.append(var("offset", "Real", "parameter", "tunable", f"rest position on {a}", 0.0, r))
-    out.append(var("enabled", "Boolean", "parameter", "tunable", f"spring-damper on {a} active", True))
+    out.append(var("offset", REAL, "parameter", "tunable", f"rest position on {a}", 0.0, r))
+    out.append(var("enabled", BOOLEAN, "parameter", "tunable", f"spring-damper on {a} active", True))
     return out
 
 
@@ -126,7 +146,7 @@ def _io_variables(a: str, interface: str) -> list[Variable]:
         out.append(
             var(
                 "s",
-                "Real",
+                REAL,
                 "input",
                 "continuous",
                 f"relative {'angle' if rot else 'displacement'}",
@@ -134,11 +154,11 @@ def _io_variables(a: str, interface: str) -> list[Variable]:
                 r,
             )
         )
-        out.append(var("v", "Real", "input", "continuous", "relative velocity", 0.0, f"{r}/s"))
+        out.append(var("v", REAL, "input", "continuous", "relative velocity", 0.0, f"{r}/s"))
         out.append(
             var(
                 "f",
-                "Real",
+                REAL,
                 "output",
                 "continuous",
                 f"{what} of the joint, -(k (s - offset) + c v)",
@@ -151,7 +171,7 @@ def _io_variables(a: str, interface: str) -> list[Variable]:
         out.append(
             var(
                 "s",
-                "Real",
+                REAL,
                 "output",
                 "continuous",
                 f"{'angle' if rot else 'displacement'} (state)",
@@ -164,7 +184,7 @@ def _io_variables(a: str, interface: str) -> list[Variable]:
         out.append(
             var(
                 "v",
-                "Real",
+                REAL,
                 "output",
                 "continuous",
                 "velocity (state), der(s)",
@@ -175,11 +195,11 @@ def _io_variables(a: str, interface: str) -> list[Variable]:
                 depends_on=(f"{a}.v",),
             )
         )
-        out.append(var("f", "Real", "input", "continuous", f"load {what} on the body", 0.0, f))
+        out.append(var("f", REAL, "input", "continuous", f"load {what} on the body", 0.0, f))
         out.append(
             var(
                 "a",
-                "Real",
+                REAL,
                 "output",
                 "continuous",
                 "acceleration, der(v)",
@@ -192,31 +212,25 @@ def _io_variables(a: str, interface: str) -> list[Variable]:
     return out
 
 
-def _variables(joint: Joint, interface: str) -> list[Variable]:
+def variables(joint: Joint, interface: str) -> list[Variable]:
     """Every model variable of the joint: time, then per declared axis its parameters and I/O."""
-    out = [Variable("time", 0, "Real", "independent", "continuous", "simulation time", unit="s")]
+    out = [Variable("time", 0, REAL, "independent", "continuous", "simulation time", unit="s")]
     for a in units.AXES:
         if a in joint.axes:
             out += _parameter_variables(a, joint.axes[a]) + _io_variables(a, interface)
     return out
 
 
-def _num(v: float) -> str:
-    return repr(float(v))
-
-
 def _start(v: Variable) -> str:
     if v.start is None:
         return ""
-    return (
-        f' start="{"true" if v.start else "false"}"' if v.kind == "Boolean" else f' start="{_num(v.start)}"'
-    )
+    return f' start="{v.type.text(v.start)}"'
 
 
 def _unit_definitions(variables: list[Variable]) -> list[str]:
     lines = ["  <UnitDefinitions>"]
     for u in sorted({v.unit for v in variables if v.unit}):
-        base = " ".join(f'{k}="{_BASE_UNITS[u][k]}"' for k in _BASE_ORDER if k in _BASE_UNITS[u])
+        base = " ".join(f'{k}="{BASE_UNITS[u][k]}"' for k in BASE_ORDER if k in BASE_UNITS[u])
         lines += [f"    <Unit name={quoteattr(u)}>", f"      <BaseUnit {base}/>", "    </Unit>"]
     return lines + ["  </UnitDefinitions>"]
 
@@ -245,7 +259,7 @@ def _default_experiment(joint: Joint, interface: str) -> str:
             period.append(2 * math.pi / wn)
         stop = float(f"{max(settle):.1g}")
         step = float(f"{min(period) / 100:.1g}")
-    return f'  <DefaultExperiment startTime="0.0" stopTime="{_num(stop)}" stepSize="{_num(step)}"/>'
+    return f'  <DefaultExperiment startTime="0.0" stopTime="{REAL.text(stop)}" stepSize="{REAL.text(step)}"/>'
 
 
 def _description(joint: Joint, interface: str) -> str:
@@ -304,14 +318,13 @@ def _fmi2_description(joint: Joint, interface: str, variables: list[Variable]) -
         if v.initial:
             attrs.append(f'initial="{v.initial}"')
         inner = [_start(v).strip()] if v.start is not None else []
-        if v.kind == "Real":
-            if v.unit:
-                inner.insert(0, f"unit={quoteattr(v.unit)}")
-            if v.derivative_of:
-                inner.append(f'derivative="{index[v.derivative_of]}"')
+        if v.unit:
+            inner.insert(0, f"unit={quoteattr(v.unit)}")
+        if v.derivative_of:
+            inner.append(f'derivative="{index[v.derivative_of]}"')
         lines.append(f"    <!-- index {i} -->")
         lines.append(f"    <ScalarVariable {' '.join(attrs)}>")
-        lines.append(f"      <{v.kind} {' '.join(inner)}/>".replace(" />", "/>"))
+        lines.append(f"      <{v.type.fmi2} {' '.join(inner)}/>".replace(" />", "/>"))
         lines.append("    </ScalarVariable>")
     lines += ["  </ModelVariables>", "  <ModelStructure>"]
 
@@ -378,7 +391,7 @@ def _fmi3_description(joint: Joint, interface: str, variables: list[Variable]) -
             attrs.append(f"unit={quoteattr(v.unit)}")
         if v.derivative_of:
             attrs.append(f'derivative="{vr[v.derivative_of]}"')
-        lines.append(f"    <{'Float64' if v.kind == 'Real' else 'Boolean'} {' '.join(attrs)}/>")
+        lines.append(f"    <{v.type.fmi3} {' '.join(attrs)}/>")
     lines += ["  </ModelVariables>", "  <ModelStructure>"]
 
     def unknown(tag: str, v: Variable, deps: bool = True) -> str:
@@ -427,7 +440,7 @@ def _start_values(joint: Joint, interface: str, variables: list[Variable]) -> st
     for v in variables:
         if v.start is None or v.causality == "independent":
             continue
-        lines.append(f"{v.name} {('true' if v.start else 'false') if v.kind == 'Boolean' else _num(v.start)}")
+        lines.append(f"{v.name} {v.type.text(v.start)}")
     return "\n".join(lines) + "\n"
 
 
@@ -458,16 +471,16 @@ def archive_entries(
     `build.resolve_platforms`: "all", "host" or FMI 3 platform tuples) unless `source_only`, the
     shipped ones unless the sources changed or `rebuild` (see `build.build_binary`)."""
     _check(joint, fmi_version, interface)
-    variables = _variables(joint, interface)
+    model_variables = variables(joint, interface)
     describe = _fmi2_description if fmi_version == 2 else _fmi3_description
-    description = describe(joint, interface, variables)
-    start = _start_values(joint, interface, variables)
+    description = describe(joint, interface, model_variables)
+    start = _start_values(joint, interface, model_variables)
     provenance = {
         "generator": GENERATOR,
         "fmi_version": f"{fmi_version}.0",
         "interface": interface,
         "joint": joint.to_dict(),
-        "value_references": {v.name: v.vr for v in variables},
+        "value_references": {v.name: v.vr for v in model_variables},
     }
     info = json.dumps(provenance, indent=2, sort_keys=True, default=str) + "\n"
     digest = hashlib.sha256("\0".join((description, start, info)).encode()).digest()
@@ -519,7 +532,7 @@ def export_fmu(
         progress(0.5)
     with atomic_path(path) as tmp, zipfile.ZipFile(tmp, "w") as z:
         for name in sorted(entries):
-            info = zipfile.ZipInfo(name, date_time=_ZIP_DATE)
+            info = zipfile.ZipInfo(name, date_time=ZIP_DATE)
             info.compress_type = zipfile.ZIP_DEFLATED
             info.external_attr = (0o755 if name.startswith("binaries/") else 0o644) << 16
             info.create_system = 3

@@ -1,5 +1,6 @@
-"""The FlexJoint model's layout and capabilities, read from the one place they are declared:
-`fmus/FlexJoint/config.h` (as the Modelica Reference FMUs keep them in the model's config.h).
+"""Where the FlexJoint C runtime is, and the model's layout and capabilities, read from the one place
+they are declared: `fmus/FlexJoint/config.h` (as the Modelica Reference FMUs keep them in the model's
+config.h).
 
 The C runtime compiles the same file, so the value references and capability flags written into a
 modelDescription.xml are those the binary implements.
@@ -10,9 +11,16 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from functools import cache
+from importlib import resources
+from pathlib import Path
 
 from ..errors import DesignerError
-from . import build
+
+
+def source_dir() -> Path:
+    """The folder holding the C runtime (`fmus/` in the checkout, `designer/fmus` when installed)."""
+    return Path(str(resources.files("designer.fmus")))
+
 
 CAPABILITIES = (
     "HAS_EVENT_MODE",
@@ -66,7 +74,7 @@ def layout() -> Layout:
     Raises:
         DesignerError: if the header lacks a declaration or disagrees with itself.
     """
-    text = (build.source_dir() / "FlexJoint" / "config.h").read_text()
+    text = (source_dir() / "FlexJoint" / "config.h").read_text()
     axes, fields = _names(text, "AXIS_NAMES"), _names(text, "FIELD_NAMES")
     enum = re.search(r"enum \{ (F_\w+(?:, F_\w+)*), N_FIELDS \};", text)
     if enum is None or [f.strip()[2:].lower() for f in enum.group(1).split(",")] != list(fields):

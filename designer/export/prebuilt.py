@@ -35,7 +35,7 @@ def build_all(folder: str | Path | None = None, *, progress: Callable[[str], Non
         for platform in build.PLATFORMS:
             if progress:
                 progress(f"FMI {fmi_version} {platform}")
-            compiler, extra = build._compiler(platform, zig=True)
+            compiler, extra = build.platform_compiler(platform, zig=True)
             out = folder / f"fmi{fmi_version}" / platform / build.library_name(platform)
             out.parent.mkdir(parents=True, exist_ok=True)
             with atomic_path(out) as tmp:

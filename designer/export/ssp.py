@@ -43,8 +43,8 @@ def _units(names: set[str]) -> list[str]:
     """`ssc:Unit` elements with their SI base-unit exponents (the FMU's table)."""
     lines = []
     for u in sorted(names):
-        exps = fmu._BASE_UNITS[u]
-        base = " ".join(f'{k}="{exps[k]}"' for k in fmu._BASE_ORDER if k in exps)
+        exps = fmu.BASE_UNITS[u]
+        base = " ".join(f'{k}="{exps[k]}"' for k in fmu.BASE_ORDER if k in exps)
         lines.append(f"    <ssc:Unit name={quoteattr(u)}><ssc:BaseUnit {base}/></ssc:Unit>")
     return lines
 
@@ -82,18 +82,24 @@ def ssv_text(joint: Joint, name: str) -> str:
 def _connectors(joint: Joint, interface: str, pad: str) -> tuple[list[str], list[tuple[str, str]], set[str]]:
     """The FMU's inputs, outputs and parameters as SSD connectors; (name, kind) of the wired ones; units."""
     lines, wired, used = [], [], set()
-    for v in fmu._variables(joint, interface):
+    for v in fmu.variables(joint, interface):
         if v.causality not in ("input", "output", "parameter"):
             continue
-        typ = "<ssc:Boolean/>" if v.kind == "Boolean" else f"<ssc:Real unit={quoteattr(v.unit)}/>"
-        if v.unit and v.unit in fmu._BASE_UNITS:
-            used.add(v.unit)
-        elif v.kind != "Boolean":
-            typ = "<ssc:Real/>"
+        unit = v.unit if v.unit in fmu.BASE_UNITS else None  # an undefined unit is left out
+        if unit is not None:
+            used.add(unit)
+        typ = v.type.connector(unit)
         lines.append(f'{pad}<ssd:Connector name="{v.name}" kind="{v.causality}">{typ}</ssd:Connector>')
         if v.causality != "parameter":
             wired.append((v.name, v.causality, typ))
     return lines, wired, used
+
+
+#: the ends of a connection between a component's connector and its system connector, by causality
+SYSTEM_ENDS = {
+    "input": 'startConnector="{joint}_{var}" endElement="{joint}" endConnector="{var}"',
+    "output": 'startElement="{joint}" startConnector="{var}" endConnector="{joint}_{var}"',
+}
 
 
 def ssd_text(joints: list[Joint], interface: str, *, system_connectors: bool = False) -> str:
@@ -109,13 +115,10 @@ def ssd_text(joints: list[Joint], interface: str, *, system_connectors: bool = F
     for j in joints:
         inner, wired, u = _connectors(j, interface, "          ")
         used |= u
-        for var, kind, typ in wired if system_connectors else ():
-            outer.append(f'      <ssd:Connector name="{j.name}_{var}" kind="{kind}">{typ}</ssd:Connector>')
-            ends = (
-                f'startConnector="{j.name}_{var}" endElement="{j.name}" endConnector="{var}"'
-                if kind == "input"
-                else f'startElement="{j.name}" startConnector="{var}" endConnector="{j.name}_{var}"'
-            )
+        for var, causality, typ in wired if system_connectors else ():
+            connector = f'name="{j.name}_{var}" kind="{causality}"'
+            outer.append(f"      <ssd:Connector {connector}>{typ}</ssd:Connector>")
+            ends = SYSTEM_ENDS[causality].format(joint=j.name, var=var)
             connections.append(f"      <ssd:Connection {ends}/>")
         elements += [
             f'      <ssd:Component name="{j.name}" type="application/x-fmu-sharedlibrary" '
@@ -206,7 +209,7 @@ def export_ssp(
         entries[f"resources/{j.name}.fmu"] = _fmu_bytes(j, interface)
     with atomic_path(path) as tmp, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
         for name in sorted(entries):  # fixed dates: the same joints give the same bytes
-            z.writestr(zipfile.ZipInfo(name, date_time=fmu._ZIP_DATE), entries[name], zipfile.ZIP_DEFLATED)
+            z.writestr(zipfile.ZipInfo(name, date_time=fmu.ZIP_DATE), entries[name], zipfile.ZIP_DEFLATED)
     return path
 
 
@@ -285,7 +288,7 @@ def _si_value(name: str, value: float, unit: str | None, base: dict | None, path
     if axis not in units.AXES or field not in _CHECKED or unit is None:
         return value
     si = units.si_unit(_CHECKED[field], axis)
-    want = {k: float(v) for k, v in fmu._BASE_UNITS[si].items()}
+    want = {k: float(v) for k, v in fmu.BASE_UNITS[si].items()}
     exps = dict(base) if base is not None else (want if unit == si else None)
     factor, offset = (exps.pop("factor", 1.0), exps.pop("offset", 0.0)) if exps is not None else (1.0, 0.0)
     if exps != want:

@@ -138,10 +138,10 @@ def _statement(m: ResponseSurface, calibrated: ResponseSurface) -> str:
         return "no measured value: the study's prediction"
     if m.predictable:
         return (
-            f"{m.response}: the study's {m.form} form times your printer's factor, corrected near the "
-            "designs you and the study printed (correlation length "
-            f"{calibrated.length:g} of a factor's half-range); far from them the interval stays as "
-            "wide as the study's plus the factor's uncertainty"
+            f"{m.response}: the study's {m.form} form through your printer's departure (its factor, "
+            "width and height offsets, infill, layer and raster adhesion, and a smooth rest), corrected "
+            f"near the designs you and the study printed (correlation length {calibrated.length:g} of a "
+            "factor's half-range); far from your prints the interval keeps what they leave open"
         )
     return (
         f"{m.response} is not predictable from the six factors (the study's nested Q2 "
@@ -152,7 +152,9 @@ def _statement(m: ResponseSurface, calibrated: ResponseSurface) -> str:
 
 def report(surrogate: Surrogate) -> dict[str, Any]:
     """What a calibration found, as plain data: per response the user's run count, the printer
-    factor with its 95 % interval, and the nested leave-one-out over the user's runs.
+    factor with its 95 % interval, what the runs say of each mechanism of the printer's departure
+    (`designer.model.mechanisms`: posterior value and 95 % interval beside the prior sd), and the
+    nested leave-one-out over the user's runs.
 
     Raises:
         DesignerError: `surrogate` is not calibrated.
@@ -175,6 +177,7 @@ def report(surrogate: Surrogate) -> dict[str, Any]:
             "unit": m.unit,
             "n_runs": int(m.own.sum()) if cal else 0,
             "printer_factor": m.printer_factor().to_dict() if cal else None,
+            "mechanisms": m.mechanisms() if cal else None,
             "settings": m.settings() if cal else None,
             "loo_user": _user_loo(surrogate, r) if cal else None,
             "predictable": base.predictable,

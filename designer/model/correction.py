@@ -30,7 +30,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol, TypeVar
 
 import casadi as ca
 import numpy as np
@@ -41,8 +41,19 @@ from . import mechanisms
 from .forms import as_printed
 from .prediction import Prediction, ResponseSurface
 
-if TYPE_CHECKING:  # for annotations only: the surrogate module imports this one
-    from .surrogate import Surrogate
+
+class Study(Protocol):
+    """What the correction reads of a study surrogate (`designer.model.surrogate.Surrogate`, which
+    imports this module to load a calibrated file: so the correction names no class of it)."""
+
+    models: dict[str, ResponseSurface]
+    training: dict[str, list[float]]
+
+    @property
+    def responses(self) -> list[str]: ...
+
+
+S = TypeVar("S", bound=Study)
 
 #: prior standard deviation of log(printer factor): filaments of one grade and printers differ
 PRINTER_SD = 0.3
@@ -188,7 +199,7 @@ def fit_amplitude(base: ResponseSurface, X: Mapping[str, Any], y: np.ndarray, no
     return float(brentq(excess, 1.0, MAX_AMPLITUDE, xtol=1e-6))
 
 
-def settings_of(prior: Surrogate, response: str) -> tuple[float, float, float]:
+def settings_of(prior: Study, response: str) -> tuple[float, float, float]:
     """(length, amplitude, noise) of `response`'s correction, computed once per study surface (the
     design loop recalibrates many times)."""
     base = prior.models[response]
@@ -362,7 +373,7 @@ class CalibratedSurface(ResponseSurface):
         }
 
 
-def runs_table(runs: Any, surrogate: Surrogate) -> Any:
+def runs_table(runs: Any, surrogate: Study) -> Any:
     """The user's runs through `load_table` (factors checked, printable), restricted to responses
     the surrogate has; raise for a table that shares no response or no factor with it."""
     import pandas as pd
@@ -388,12 +399,12 @@ def runs_table(runs: Any, surrogate: Surrogate) -> Any:
     return table
 
 
-def study_runs(prior: Surrogate, response: str) -> tuple[dict[str, np.ndarray], np.ndarray]:
+def study_runs(prior: Study, response: str) -> tuple[dict[str, np.ndarray], np.ndarray]:
     X = {n: np.asarray(prior.training[n], dtype=float) for n in space.FACTOR_NAMES}
     return X, np.asarray(prior.training[response], dtype=float)
 
 
-def _study_evidence(prior: Surrogate, response: str) -> tuple[np.ndarray, np.ndarray]:
+def _study_evidence(prior: Study, response: str) -> tuple[np.ndarray, np.ndarray]:
     """The study's runs of `response` as printed, (n, 6) in factor order, and their values (n,):
     computed once per study surface (the design loop recalibrates many times)."""
     base = prior.models[response]
@@ -407,7 +418,7 @@ def _study_evidence(prior: Surrogate, response: str) -> tuple[np.ndarray, np.nda
 
 
 def evidence(
-    prior: Surrogate, response: str, user: Mapping[str, np.ndarray], observed: np.ndarray
+    prior: Study, response: str, user: Mapping[str, np.ndarray], observed: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(designs (n, 6) as printed, measured values (n,), own (n,)): the study's runs (own 0: the
     study's printer, the reference) and the user's (own 1), where the correction is observed.
@@ -421,7 +432,7 @@ def evidence(
     return np.vstack([study, mine]), np.concatenate([values, observed]), own
 
 
-def calibrated(prior: Surrogate, runs: Any, printer_sd: float) -> Surrogate:
+def calibrated(prior: S, runs: Any, printer_sd: float) -> S:
     """`calibrate`'s work once its arguments are checked: `prior` uncalibrated, `runs` the user's
     runs as columns (a DataFrame or a mapping of equal-length arrays, load_table's names; NaN where a
     response was not measured)."""

@@ -335,25 +335,75 @@ def series_motion(spec: Spectra, pass_edge: float) -> tuple[np.ndarray, np.ndarr
     return r, v
 
 
-def nonlinear_columns(spec: Spectra, pass_edge: float) -> tuple[np.ndarray, np.ndarray]:
-    """Coulomb friction's sign(r') and the cubic spring's (r - mean r)^3, formed at the series rate
-    from the band-limited motion and then filtered exactly as the load is (so their harmonics above
-    the pass edge go where the load's go), on the grid of `filtered(spec, pass_edge)`.
+def _interval_sign(v: np.ndarray) -> np.ndarray:
+    """The mean of sign(v) over each sample's interval with v linear in it, so a zero crossing
+    between samples counts by where it falls."""
+    step = np.abs(np.gradient(v))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(step > 0, np.clip(2 * v / step, -1.0, 1.0), np.sign(v))
 
-    The sign is the mean of sign(r') over each sample's interval with r' linear in it, so a
-    reversal between samples counts by where it falls. Scaled units (r in units of `scale_r`).
+
+def nonlinear_columns(spec: Spectra, pass_edge: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Coulomb friction's sign(r'), the cubic spring's (r - mean r)^3 and a dead band's
+    sign(r - mean r), formed at the series rate from the band-limited motion and then filtered
+    exactly as the load is (so their harmonics above the pass edge go where the load's go), on the
+    grid of `filtered(spec, pass_edge)`. Scaled units (r in units of `scale_r`).
     """
     bins, nd = _grid(spec, pass_edge)
     r, v = series_motion(spec, pass_edge)
     a, b = spec.r_line
     deflection = r + a + (b - a) * np.linspace(0.0, 1.0, spec.samples)
     deflection -= deflection.mean()
-    step = np.abs(np.gradient(v))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        sign = np.where(step > 0, np.clip(2 * v / step, -1.0, 1.0), np.sign(v))
-    cols = np.fft.rfft(np.stack([sign, deflection**3]), n=spec.n, axis=1)[:, :bins]
+    rows = np.stack([_interval_sign(v), deflection**3, _interval_sign(deflection)])
+    cols = np.fft.rfft(rows, n=spec.n, axis=1)[:, :bins]
     out = np.fft.irfft(cols * lowpass(spec.freqs[:bins], pass_edge), n=nd, axis=1) * (nd / spec.n)
-    return out[0], out[1]
+    return out[0], out[1], out[2]
+
+
+def dead_band_motion(spec: Spectra, pass_edge: float, half_play: float) -> np.ndarray:
+    """r'', r', r of the specimen behind a dead band of +/- `half_play` (scaled units) about the
+    motion's centre, the position sensor before it: sign(d) max(|d| - half_play, 0) of the
+    band-limited deflection d, formed at the series rate, then filtered and differentiated as the
+    position is (`filtered`); (grid rows, 3), the columns of `Channels.x`."""
+    bins, nd = _grid(spec, pass_edge)
+    r, _ = series_motion(spec, pass_edge)
+    a, b = spec.r_line
+    deflection = r + a + (b - a) * np.linspace(0.0, 1.0, spec.samples)
+    deflection -= deflection.mean()
+    specimen = np.sign(deflection) * np.maximum(np.abs(deflection) - half_play, 0.0)
+    freqs = spec.freqs[:bins]
+    w = 2 * np.pi * freqs
+    pos = np.fft.rfft(specimen, n=spec.n)[:bins] * lowpass(freqs, pass_edge)
+    return (np.fft.irfft(np.stack([-(w**2) * pos, 1j * w * pos, pos]), n=nd, axis=1) * (nd / spec.n)).T
+
+
+def another_load(
+    spec: Spectra,
+    values: np.ndarray,
+    bad: np.ndarray,
+    factor: int,
+    pass_edge: float,
+    correct: Callable[[np.ndarray], np.ndarray] | None = None,
+) -> tuple[np.ndarray, float]:
+    """Another channel of the log (another axis's load) through exactly what the load of `spec`
+    went through: block means over the same blocks, the fill, the end line, the low-pass at
+    `pass_edge` and `correct`, on the grid of `filtered(spec, pass_edge)`; in units of its peak.
+
+    bad: the samples to leave out (this axis's dropouts and the channel's own); factor: the block
+    length of `spec`'s block means. Returns the column and the peak it is in units of.
+    """
+    series, lost = block_means(values, bad, factor)
+    series = series[: spec.samples]
+    fill(series, lost[: spec.samples])
+    peak = float(np.max(np.abs(series))) or 1.0
+    series /= peak
+    _ends_line(series)
+    bins, nd = _grid(spec, pass_edge)
+    w = 2 * np.pi * spec.freqs[:bins]
+    spectrum = np.fft.rfft(series, n=spec.n)[:bins] * lowpass(spec.freqs[:bins], pass_edge)
+    if correct is not None:
+        spectrum = spectrum * correct(w)
+    return np.fft.irfft(spectrum, n=nd) * (nd / spec.n), peak
 
 
 def filtered(

@@ -25,7 +25,7 @@ from ..files import atomic_path, atomic_write
 from ..keys import check_keys
 from ..study import space
 from ..study.data import is_parquet
-from . import channel
+from . import channel, saturation
 
 #: the load column of each axis
 LOAD: dict[str, str] = {
@@ -80,6 +80,11 @@ class RigLog:
     load_filter: str | None = None
     #: per axis column, the fraction of samples the sensor did not deliver (NaN or stuck at zero)
     missing_fraction: dict[str, float] = field(default_factory=dict)
+    #: per axis column, the rails it sits on (`saturation.Rail`) when the sensor saturated; those
+    #: samples are flagged as dropouts
+    rails: dict[str, list[saturation.Rail]] = field(default_factory=dict)
+    #: what reading changed in the log, for people (e.g. coarse timestamps rebuilt)
+    notes: list[str] = field(default_factory=list)
 
     @property
     def duration(self) -> float:
@@ -212,15 +217,20 @@ def validate_frame(
     """Check a log's columns, time and units, flag dropouts; raise DesignerError naming column and row."""
     df, axes = _columns(raw, source)
     cols = _numbers(df, source)
-    t = cols["t"]
-    step, gaps = _time_step(t, source)
-    gap_rows = np.zeros(len(t), dtype=bool)
+    notes: list[str] = []
+    step, gaps = _time_step(cols, source, notes)
+    gap_rows = np.zeros(len(cols["t"]), dtype=bool)
     gap_rows[1:] |= gaps
     gap_rows[:-1] |= gaps
     _check_magnitudes(cols, axes, source)
-    dropouts, fractions = {}, {}
+    dropouts, fractions, rails = {}, {}, {}
     for a in axes:
         dropouts[a] = _dropouts(cols, a, gap_rows, fractions, source)
+        for col in (a, LOAD[a]):
+            found = saturation.rails(cols[col])
+            if found:
+                rails[col] = found
+                dropouts[a] |= saturation.on_rails(cols[col], found)
     order = ["t"] + [c for a in axes for c in (a, LOAD[a])] + (["hub"] if "hub" in cols else [])
     return RigLog(
         # one block per column, sharing the arrays: no consolidating copy of a long log
@@ -231,6 +241,8 @@ def validate_frame(
         axes=axes,
         dropouts=dropouts,
         missing_fraction=fractions,
+        rails=rails,
+        notes=notes,
     )
 
 
@@ -303,8 +315,13 @@ def _numbers(df: pd.DataFrame, source: str) -> dict[str, np.ndarray]:
     return cols
 
 
-def _time_step(t: np.ndarray, source: str) -> tuple[float, np.ndarray]:
-    """The sample interval (median) and the gaps; time must be finite, increasing and regular."""
+def _time_step(cols: dict[str, np.ndarray], source: str, notes: list[str]) -> tuple[float, np.ndarray]:
+    """The sample interval (median) and the gaps; time must be finite, increasing and regular.
+
+    Timestamps from a clock coarser than the sampling (repeated or uneven only by their rounding)
+    are rebuilt from the sample index, in place in `cols`, and a note says so.
+    """
+    t = cols["t"]
     if not np.isfinite(t).all():
         raise DesignerError(
             f"{source}: column 't' row {_first_bad_row(~np.isfinite(t))} is empty or not finite",
@@ -312,6 +329,10 @@ def _time_step(t: np.ndarray, source: str) -> tuple[float, np.ndarray]:
         )
     dt = np.diff(t)
     if (dt <= 0).any():
+        rebuilt = _rebuilt_time(t, notes)
+        if rebuilt is not None:
+            cols["t"] = rebuilt
+            return _time_step(cols, source, notes)
         row = int(np.flatnonzero(dt <= 0)[0]) + 2
         what = "repeated" if dt[row - 2] == 0 else "going backwards"
         backwards = int(np.count_nonzero(dt < 0))
@@ -331,6 +352,11 @@ def _time_step(t: np.ndarray, source: str) -> tuple[float, np.ndarray]:
     gaps = dt > GAP_FACTOR * step
     regular = dt[~gaps]
     jitter = float(np.max(np.abs(regular - step)) / step) if regular.size else 0.0
+    if jitter > JITTER_LIMIT or gaps.any():
+        rebuilt = _rebuilt_time(t, notes)
+        if rebuilt is not None:
+            cols["t"] = rebuilt
+            return _time_step(cols, source, notes)
     if jitter > JITTER_LIMIT:
         row = int(np.flatnonzero(~gaps & (np.abs(dt - step) > JITTER_LIMIT * step))[0]) + 2
         raise DesignerError(
@@ -339,6 +365,48 @@ def _time_step(t: np.ndarray, source: str) -> tuple[float, np.ndarray]:
             "resample the log to a constant rate",
         )
     return step, gaps
+
+
+#: timestamps count as a coarse clock's when they spread at most this many resolutions about a
+#: constant rate (rounding or truncation spread one, plus the fit's own error) ...
+COARSE_CLOCK_SPREAD = 1.02
+#: ... and the resolution differs from the sampling interval by at least this fraction (a repeated
+#: or missing row of a log on a fine clock spreads one interval too)
+COARSE_CLOCK_MARGIN = 0.05
+
+
+def _rebuilt_time(t: np.ndarray, notes: list[str]) -> np.ndarray | None:
+    """t rebuilt from the sample index at a constant rate, when the log's clock was only coarse.
+
+    That is: t never decreases, every interval is a whole number of one resolution (the smallest
+    interval), the resolution is not the sampling interval itself, and the timestamps spread at
+    most one resolution about the straight line through them (what rounding or truncation leave;
+    a repeated row, a gap or real jitter spread further). None when t is not such a log; else the
+    rebuilt t, with a note appended to `notes`.
+    """
+    dt = np.diff(t)
+    positive = dt[dt > 0]
+    if (dt < 0).any() or positive.size == 0:
+        return None
+    resolution = float(positive.min())
+    steps = dt / resolution
+    if np.max(np.abs(steps - np.round(steps))) > 1e-6:
+        return None
+    index = np.arange(t.size, dtype=np.float64)
+    centred = index - index.mean()
+    interval = float(centred @ (t - t.mean()) / (centred @ centred))
+    line = t.mean() + interval * centred
+    spread = float(np.ptp(t - line)) / resolution
+    if interval <= 0 or abs(resolution / interval - 1) < COARSE_CLOCK_MARGIN or spread > COARSE_CLOCK_SPREAD:
+        return None
+    repeated = int(np.count_nonzero(dt == 0))
+    notes.append(
+        f"t is on a {resolution:.3g} s clock"
+        + (f" ({repeated} repeated timestamps)" if repeated else "")
+        + f": rebuilt from the sample index at {1.0 / interval:.6g} Hz (the logged times lie in a band "
+        f"{spread:.2g} clock steps wide about it)"
+    )
+    return line
 
 
 def _dropouts(

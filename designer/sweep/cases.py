@@ -21,7 +21,7 @@ from ..errors import DesignerError
 from ..model.surrogate import Surrogate
 from ..study import space
 from .draws import joint_draws, on_axis, source_axis
-from .spec import Spec, sources
+from .spec import Spec
 
 
 @dataclass(frozen=True)
@@ -46,7 +46,7 @@ def finish(cases: list[Case], spec: Spec) -> list[Case]:
     """The cases with k and c for every scenario joint (the scenario's own where a case leaves a joint
     alone) and their keys: a hash of the coefficients and of the spec's context."""
     context = context_key(spec)
-    base = {j: base_coefficients(src) for j, src in sources(spec.scenario).items()}
+    base = {j: base_coefficients(src) for j, src in spec.scenario.sources().items()}
     out = []
     for case in cases:
         coefficients = {j: case.coefficients.get(j, base[j]) for j in base}
@@ -55,6 +55,11 @@ def finish(cases: list[Case], spec: Spec) -> list[Case]:
             replace(case, coefficients=coefficients, key=hashlib.sha256(payload.encode()).hexdigest()[:20])
         )
     return out
+
+
+def si_law(src: JointSource, coefficients: dict[str, float]) -> dict[str, float]:
+    """The SI k and c of a case's joint (rig units in, on the joint's axis)."""
+    return {q: units.to_si(q, src.axis, coefficients[q]) for q in ("k", "c")}
 
 
 def base_coefficients(src: JointSource) -> dict[str, float]:
@@ -77,9 +82,9 @@ def design_of(spec: Spec, joint: str) -> dict[str, float]:
     """The print settings of a joint: given in the sweep, or those its scenario joint was built from."""
     if joint in spec.cases.designs:
         return space.check_design(spec.cases.designs[joint])
-    src = sources(spec.scenario)[joint]
+    src = spec.scenario.sources()[joint]
     params = None if src.joint is None else src.joint.provenance.get("params")
-    params = params or (spec.scenario.factors if joint == "rig" else None)
+    params = params or spec.scenario.factors_of(joint)
     if params is None:
         raise DesignerError(
             f"joint {joint} has no print settings to vary or draw around",
@@ -124,10 +129,10 @@ def grid(spec: Spec) -> list[Case]:
         for j, values in chosen.items():
             inputs.update({f"{j}.{q}": v for q, v in values.items()})
             if set(values) <= {"k", "c"}:
-                coefficients[j] = base_coefficients(sources(spec.scenario)[j]) | values
+                coefficients[j] = base_coefficients(spec.scenario.sources()[j]) | values
             else:
                 design = space.check_design(design_of(spec, j) | values)
-                coefficients[j] = _predicted(surrogate, design, sources(spec.scenario)[j].axis)
+                coefficients[j] = _predicted(surrogate, design, spec.scenario.sources()[j].axis)
         cases.append(Case(i, coefficients, inputs))
     return cases
 
@@ -146,7 +151,7 @@ def suggestion(spec: Spec) -> list[Case]:
     for i, combo in enumerate(itertools.product(numbers, repeat=len(joints))):
         coefficients, inputs = {}, {}
         for j, cand in zip(joints, combo, strict=True):
-            src = sources(spec.scenario)[j]
+            src = spec.scenario.sources()[j]
             joint = Joint.from_suggestion(path, candidate=cand, axes=[src.axis], name=f"joint_{j}")
             ac = joint.axis(src.axis)
             coefficients[j] = {"k": ac.k, "c": ac.c}
@@ -164,7 +169,7 @@ def montecarlo(spec: Spec) -> list[Case]:
     draws = {}
     for j in spec.cases.joints:
         draws[j] = joint_draws(
-            surrogate, design=design_of(spec, j), axis=sources(spec.scenario)[j].axis, n=n, rng=rng
+            surrogate, design=design_of(spec, j), axis=spec.scenario.sources()[j].axis, n=n, rng=rng
         )
     cases = []
     for i in range(n):

@@ -16,18 +16,16 @@ import numpy as np
 
 from ..cosim.master import Trace
 from ..cosim.robot import SpringDamper
-from ..cosim.scenario import Scenario
-from ..cosim.session import robot_system
+from ..cosim.robot_scenario import RobotScenario, robot_system
 from ..errors import DesignerError
-from .cases import Case
-from .evaluate import si_law
+from .cases import Case, si_law
 
 
-def _offsets(sc: Scenario) -> dict[str, float]:
+def _offsets(sc: RobotScenario) -> dict[str, float]:
     return {j: float(src.parameters.get(f"{src.axis}.offset", 0.0)) for j, src in sc.joints.items()}
 
 
-def _motors(sc: Scenario, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _motors(sc: RobotScenario, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Time (n + 1), motor angles and rates (n + 1, joints) at t = 0, h, ..., n h."""
     t = np.arange(n + 1) * sc.step
     mq = np.empty((n + 1, len(sc.joints)))
@@ -38,7 +36,7 @@ def _motors(sc: Scenario, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return t, mq, mv
 
 
-def rollout_traces(sc: Scenario, cases: Sequence[Case]) -> list[Trace | Exception]:
+def rollout_traces(sc: RobotScenario, cases: Sequence[Case]) -> list[Trace | Exception]:
     """The trace of each case (columns `robot.J.q|motor|v` as in a co-simulation's result, rows at
     t = 0, h, ...), or a DesignerError for a case whose model diverged (MuJoCo reset it)."""
     import mujoco

@@ -17,12 +17,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import units
 from ..cosim.master import Trace
-from ..cosim.scenario import JointSource, Scenario
-from ..cosim.session import Session, sources
+from ..cosim.result import Result
+from ..cosim.rig_scenario import RigScenario
+from ..cosim.robot_scenario import RobotScenario
+from ..cosim.scenario import Scenario
+from ..cosim.session import Session
 from ..errors import DesignerError
-from .cases import Case
+from .cases import Case, si_law
+from .engine import rollout_traces
 
 
 @dataclass(frozen=True)
@@ -91,29 +94,22 @@ def holding() -> Iterator[None]:
             release()
 
 
-def si_law(src: JointSource, coefficients: dict[str, float]) -> dict[str, float]:
-    """The SI k and c of a case's joint (rig units in, on the joint's axis)."""
-    return {q: units.to_si(q, src.axis, coefficients[q]) for q in ("k", "c")}
-
-
-def metrics(sc: Scenario, *, trace: Trace, case: Case) -> dict[str, dict]:
-    """Per-joint metrics of an in-engine trace, as `designer cosim` computes them (its robot_metrics)."""
-    from ..cosim.run import robot_metrics
-
+def metrics(sc: RobotScenario, *, trace: Trace, case: Case) -> dict[str, dict]:
+    """Per-joint metrics of an in-engine trace, as `designer cosim` computes them (RobotScenario.metrics)."""
     laws = {j: si_law(src, case.coefficients[j]) for j, src in sc.joints.items()}
-    return robot_metrics(sc, trace, laws)
+    return sc.metrics(trace, laws)
 
 
 def case_parameters(sc: Scenario, case: Case) -> dict[str, dict[str, float]]:
     """A case's k and c as the FMU parameters `Session.run` takes: {joint: {"axis.k", "axis.c"}}, SI."""
-    srcs = sources(sc)
+    srcs = sc.sources()
     return {
         j: {f"{src.axis}.{q}": v for q, v in si_law(src, case.coefficients[j]).items()}
         for j, src in srcs.items()
     }
 
 
-def fmu_result(session: Session, *, case: Case):
+def fmu_result(session: Session, *, case: Case) -> Result:
     """Co-simulate one case in a prepared session: the case's k and c set as FMU parameters (SI).
     Returns the cosim `Result` (time series and per-joint metrics)."""
     return session.run(case_parameters(session.scenario, case))
@@ -126,21 +122,30 @@ RIG_METRICS = ("k_identified", "c_identified", "k_error_pct", "c_error_pct", "r2
 def rig_identification(session: Session, *, case: Case) -> dict[str, dict]:
     """Run the virtual rig on one case's joint, identify its log, and compare with the case's k and c.
 
-    The log is the one `designer cosim` writes for the rig (designer.cosim.run.rig_log), read
-    through the rig-log validation and identified as a measured log would be.
+    The log is the one `designer cosim` writes for the rig (RigScenario.log), read through the
+    rig-log validation and identified as a measured log would be.
     """
-    from ..cosim.run import rig_log
     from ..rig.identify import identify
     from ..rig.logs import validate_frame
 
-    src, true = session.scenario.rig_joint, case.coefficients["rig"]
-    log = validate_frame(rig_log(fmu_result(session, case=case)), f"virtual rig log of case {case.index}")
+    sc, true = session.scenario, case.coefficients["rig"]
+    src = sc.rig_joint
+    log = validate_frame(sc.log(fmu_result(session, case=case)), f"virtual rig log of case {case.index}")
     res = identify(log)[0]
     if src.axis in res.failures:
         raise DesignerError(f"case {case.index}: the rig log failed identification: {res.failures[src.axis]}")
     fit = res.axes[src.axis]
     values = (fit.k, fit.c, 100 * (fit.k / true["k"] - 1), 100 * (fit.c / true["c"] - 1), fit.r2)
     return {"rig": dict(zip(RIG_METRICS, map(float, values), strict=True))}
+
+
+def robot_outcome(session: Session, *, case: Case) -> dict[str, dict]:
+    """Co-simulate a robot case and return its per-joint metrics."""
+    return fmu_result(session, case=case).metrics
+
+
+#: what a sweep computes for one case of each scenario type through the FMU path
+OUTCOMES = {RobotScenario: robot_outcome, RigScenario: rig_identification}
 
 
 def case_row(case: Case, *, outcome: dict | Exception, wall: float) -> dict:
@@ -167,6 +172,7 @@ def _fmu_batch(task: Task) -> list[dict]:
     After a failed case the session is closed and the next case prepares a fresh one."""
     from ..cosim import prepare
 
+    outcome_of = OUTCOMES[type(task.scenario)]
     rows = []
     with contextlib.ExitStack() as stack:
         session: Session | None = None
@@ -177,10 +183,7 @@ def _fmu_batch(task: Task) -> list[dict]:
                     session = (
                         held(task.scenario) if task.hold else stack.enter_context(prepare(task.scenario))
                     )
-                if task.scenario.kind == "rig":
-                    outcome: dict | Exception = rig_identification(session, case=case)
-                else:
-                    outcome = fmu_result(session, case=case).metrics
+                outcome: dict | Exception = outcome_of(session, case=case)
             except Exception as exc:  # a failed case is recorded, never fatal to the sweep
                 outcome = _failure(exc)
                 if session is not None:
@@ -191,8 +194,6 @@ def _fmu_batch(task: Task) -> list[dict]:
 
 
 def _engine_batch(task: Task) -> list[dict]:
-    from .engine import rollout_traces
-
     start = time.perf_counter()
     try:
         outcomes = rollout_traces(task.scenario, task.cases)

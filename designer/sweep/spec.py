@@ -8,14 +8,16 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ..cosim.rig_scenario import RigScenario
+from ..cosim.robot_scenario import RobotScenario
 from ..cosim.scenario import Scenario
-from ..cosim.session import sources  # noqa: F401  (the joints a sweep can vary, by name)
 from ..errors import DesignerError, check_type
 from ..keys import check_keys, read_toml
 from .limits import Limit, parse_limit
@@ -112,7 +114,7 @@ def _cases(doc: dict, path: Path, scenario: Scenario) -> Cases:
         raise DesignerError(
             f"{path.name} needs a [cases] table with a type", f"type = one of {', '.join(CASE_TYPES)}"
         )
-    kind = table["type"]
+    kind = table["type"]  # CASE_TYPES are READERS' keys
     for key in table:
         if key != "type" and key not in CASE_KEYS[kind]:
             owners = " or ".join(f'"{t}"' for t in CASE_TYPES if key in CASE_KEYS[t])
@@ -125,40 +127,58 @@ def _cases(doc: dict, path: Path, scenario: Scenario) -> Cases:
         raise DesignerError(
             f"{_where(path, 'cases.designs')} must map joints to print settings", "see the README"
         )
-    designs = {j: dict(d) for j, d in designs.items()}
-    joints = table.get("joints", list(sources(scenario)) if kind != "grid" else None)
-    if kind == "grid":
-        if not isinstance(joints, dict) or not joints:
+    return READERS[kind](table, path, scenario, {j: dict(d) for j, d in designs.items()})
+
+
+def _grid(table: dict, path: Path, scenario: Scenario, designs: dict) -> Cases:
+    joints = table.get("joints")
+    if not isinstance(joints, dict) or not joints:
+        raise DesignerError(f"{_where(path, 'cases.joints')} must map joints to grid axes", "see the README")
+    grid = {}
+    for j, axes in joints.items():
+        if not isinstance(axes, dict) or not axes:
             raise DesignerError(
-                f"{_where(path, 'cases.joints')} must map joints to grid axes", "see the README"
+                f"{_where(path, 'cases.joints.' + j)} must be a table of axes", "e.g. {k = [..]}"
             )
-        grid = {}
-        for j, axes in joints.items():
-            if not isinstance(axes, dict) or not axes:
-                raise DesignerError(
-                    f"{_where(path, 'cases.joints.' + j)} must be a table of axes", "e.g. {k = [..]}"
-                )
-            grid[j] = {q: _values(v, f"cases.joints.{j}.{q}", path) for q, v in axes.items()}
-        return Cases(type=kind, joints=grid, designs=designs)
+        grid[j] = {q: _values(v, f"cases.joints.{j}.{q}", path) for q, v in axes.items()}
+    return Cases(type="grid", joints=grid, designs=designs)
+
+
+def _joint_names(table: dict, path: Path, scenario: Scenario) -> dict[str, None]:
+    """The joints a suggestion or Monte Carlo sweep varies (default: every joint of the scenario)."""
+    joints = table.get("joints", list(scenario.sources()))
     if not isinstance(joints, list) or not all(isinstance(j, str) for j in joints):
         raise DesignerError(f"{_where(path, 'cases.joints')} must list joint names", 'e.g. ["j1", "j2"]')
-    if kind == "suggestion":
-        if not isinstance(table.get("file"), str):
-            raise DesignerError(f"{_where(path, 'cases.file')} is missing", 'give file = "suggestion.json"')
-        file = (path.parent / table["file"]).resolve()
-        cands = table.get("candidates", [])
-        if not isinstance(cands, list) or not all(isinstance(c, int) and c >= 1 for c in cands):
-            raise DesignerError(
-                f"{_where(path, 'cases.candidates')} must list numbers >= 1", "e.g. [1, 2, 3]"
-            )
-        return Cases(type=kind, joints={j: None for j in joints}, file=file, candidates=tuple(cands))
+    return dict.fromkeys(joints)
+
+
+def _suggestion(table: dict, path: Path, scenario: Scenario, designs: dict) -> Cases:
+    joints = _joint_names(table, path, scenario)
+    if not isinstance(table.get("file"), str):
+        raise DesignerError(f"{_where(path, 'cases.file')} is missing", 'give file = "suggestion.json"')
+    file = (path.parent / table["file"]).resolve()
+    cands = table.get("candidates", [])
+    if not isinstance(cands, list) or not all(isinstance(c, int) and c >= 1 for c in cands):
+        raise DesignerError(f"{_where(path, 'cases.candidates')} must list numbers >= 1", "e.g. [1, 2, 3]")
+    return Cases(type="suggestion", joints=joints, file=file, candidates=tuple(cands))
+
+
+def _montecarlo(table: dict, path: Path, scenario: Scenario, designs: dict) -> Cases:
     return Cases(
-        type=kind,
-        joints={j: None for j in joints},
+        type="montecarlo",
+        joints=_joint_names(table, path, scenario),
         n=_count(table, "n", path, None),
         seed=_count(table, "seed", path, 0, minimum=0),
         designs=designs,
     )
+
+
+#: the reader of each type of [cases] table (what it holds besides `type` and `designs`: CASE_KEYS)
+READERS: dict[str, Callable[[dict, Path, Scenario, dict], Cases]] = {
+    "grid": _grid,
+    "suggestion": _suggestion,
+    "montecarlo": _montecarlo,
+}
 
 
 def _cluster(doc: dict, path: Path) -> dict[str, Any]:
@@ -237,6 +257,26 @@ def with_duration(scenario: Scenario, duration: Any) -> Scenario:
     return dataclasses.replace(scenario, duration=float(duration))
 
 
+def _rig_sweep(spec: Spec) -> None:
+    """A rig sweep identifies each case's virtual rig log through the FMU: no engine path, no limits.
+
+    Raises:
+        DesignerError: the engine path or limits.
+    """
+    if spec.path != "fmu" or spec.limits:
+        raise DesignerError(
+            "a rig sweep identifies each case's virtual rig log through the FMU",
+            "use path='fmu' and no limits with a rig scenario",
+        )
+
+
+#: the checks a sweep of each scenario type adds (a robot sweep takes either path and any limits)
+TYPE_RULES: dict[type[Scenario], tuple[Callable[[Spec], None], ...]] = {
+    RobotScenario: (),
+    RigScenario: (_rig_sweep,),
+}
+
+
 def check(spec: Spec) -> Spec:
     """Check a spec built in code as `load` checks a file; returns it (a Monte Carlo or suggestion sweep
     without joints varies them all).
@@ -249,27 +289,41 @@ def check(spec: Spec) -> Spec:
     check_type(spec, Spec, "spec", expected="a sweep Spec", fix="read one with designer.sweep.load(path)")
     sc = spec.scenario if spec.scenario.checked else spec.scenario.check()
     spec = dataclasses.replace(spec, scenario=sc)
-    if sc.kind == "rig" and (spec.path != "fmu" or spec.limits):
-        raise DesignerError(
-            "a rig sweep identifies each case's virtual rig log through the FMU",
-            "use path='fmu' and no limits with a rig scenario",
-        )
+    for rule in TYPE_RULES[type(sc)]:
+        rule(spec)
     if spec.path not in PATHS:
         raise DesignerError(f"path={spec.path!r} is not allowed", "use path='fmu' or path='engine'")
     if spec.cases.type not in CASE_TYPES:
         raise DesignerError(
             f"cases type {spec.cases.type!r} is unknown", f"use one of {', '.join(CASE_TYPES)}"
         )
-    names = sources(sc)
+    names = sc.sources()
+    for rule in CASE_RULES[spec.cases.type]:
+        rule(spec.cases)
     if not spec.cases.joints:
-        if spec.cases.type == "grid":
-            raise DesignerError("a grid sweep needs its axes", "give joints={'j1': {'k': [100, 200]}}")
         spec = dataclasses.replace(spec, cases=dataclasses.replace(spec.cases, joints=dict.fromkeys(names)))
     for j in spec.cases.joints:
         if j not in names:
             raise DesignerError(
                 f"the sweep varies joint '{j}' the scenario lacks", f"it has {', '.join(names)}"
             )
-    if spec.cases.type == "montecarlo" and not spec.cases.n:
-        raise DesignerError("a Monte Carlo sweep needs a number of draws", "give n (e.g. n = 200)")
     return spec
+
+
+def _grid_axes(cases: Cases) -> None:
+    if not cases.joints:
+        raise DesignerError("a grid sweep needs its axes", "give joints={'j1': {'k': [100, 200]}}")
+
+
+def _draw_count(cases: Cases) -> None:
+    if not cases.n:
+        raise DesignerError("a Monte Carlo sweep needs a number of draws", "give n (e.g. n = 200)")
+
+
+#: what `Cases` built in code must hold, by type, beyond the common checks (a suggestion sweep
+#: without joints varies them all)
+CASE_RULES: dict[str, tuple[Callable[[Cases], None], ...]] = {
+    "grid": (_grid_axes,),
+    "suggestion": (),
+    "montecarlo": (_draw_count,),
+}

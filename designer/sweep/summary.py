@@ -10,12 +10,15 @@ import numpy as np
 import pandas as pd
 
 from .. import units
+from ..cosim.rig_scenario import RigScenario
+from ..cosim.robot_scenario import RobotScenario
 from ..files import atomic_folder, atomic_path, atomic_write
 from ..study import space
 from .cases import Case
-from .evaluate import RIG_METRICS
+from .engine import rollout_traces
+from .evaluate import RIG_METRICS, fmu_result, metrics
 from .limits import METRICS, applies
-from .spec import Spec, sources
+from .spec import Spec
 
 PERCENTILES = (5, 50, 95)
 
@@ -24,7 +27,7 @@ def column_units(spec: Spec, frame: pd.DataFrame) -> dict[str, str]:
     """The unit of every numeric column of a sweep table (rig units for coefficients)."""
     out = {}
     metric_units = dict(METRICS.values()) | {"k_error_pct": "%", "c_error_pct": "%", "r2": "1"}
-    joints = sources(spec.scenario)
+    joints = spec.scenario.sources()
     for col in frame.columns:
         joint, _, name = col.partition(".")
         if not name:
@@ -41,11 +44,8 @@ def column_units(spec: Spec, frame: pd.DataFrame) -> dict[str, str]:
     return out
 
 
-def metric_columns(spec: Spec, frame: pd.DataFrame) -> list[str]:
-    """The metric columns of a sweep table, joint by joint (step metrics for stepped joints only)."""
-    sc = spec.scenario
-    if sc.kind == "rig":
-        return [f"rig.{m}" for m in RIG_METRICS if f"rig.{m}" in frame.columns]
+def robot_columns(sc: RobotScenario, frame: pd.DataFrame) -> list[str]:
+    """A robot sweep's metric columns, joint by joint (step metrics for stepped joints only)."""
     names = [c for c, _ in METRICS.values()]
     return [
         f"{j}.{m}"
@@ -53,6 +53,20 @@ def metric_columns(spec: Spec, frame: pd.DataFrame) -> list[str]:
         for m in names
         if f"{j}.{m}" in frame.columns and applies(m, sc.motors[j])
     ]
+
+
+def rig_columns(sc: RigScenario, frame: pd.DataFrame) -> list[str]:
+    """A rig sweep's metric columns: the identification of the rig joint."""
+    return [f"rig.{m}" for m in RIG_METRICS if f"rig.{m}" in frame.columns]
+
+
+#: the metric columns of a sweep table, by scenario type
+COLUMNS = {RobotScenario: robot_columns, RigScenario: rig_columns}
+
+
+def metric_columns(spec: Spec, frame: pd.DataFrame) -> list[str]:
+    """The metric columns of a sweep table."""
+    return COLUMNS[type(spec.scenario)](spec.scenario, frame)
 
 
 def percentiles(frame: pd.DataFrame, columns: Sequence[str]) -> dict[str, dict]:
@@ -94,8 +108,6 @@ def engine_check(spec: Spec, *, cases: Sequence[Case], frame: pd.DataFrame) -> d
     if spec.path != "engine" or spec.check == 0:
         return None
     from ..cosim import prepare
-    from .engine import rollout_traces
-    from .evaluate import fmu_result, metrics
 
     ok = set(frame.loc[frame["status"] == "ok", "key"])
     finished = [c for c in cases if c.key in ok]

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..cosim.robot_scenario import RobotScenario
 from ..cosim.scenario import Scenario
 from ..errors import DesignerError
 from ..model.surrogate import Surrogate
@@ -97,7 +98,7 @@ def reachable(surrogate: Surrogate, axis: str) -> dict[str, tuple[float, float]]
     return out
 
 
-def score(row: Mapping, *, sc: Scenario, objective: str, limits: Sequence[Limit]) -> float:
+def score(row: Mapping, *, sc: RobotScenario, objective: str, limits: Sequence[Limit]) -> float:
     """The minimised score of one evaluated case (see the module's docstring); step metrics count
     at the joints with a step reference only."""
     if row.get("status") != "ok":
@@ -121,7 +122,10 @@ def _value(row: Mapping, column: str) -> float | None:
 
 
 def _bounds(
-    sc: Scenario, joints: Sequence[str], given: Mapping[str, tuple[float, float]], surrogate: Surrogate | None
+    sc: RobotScenario,
+    joints: Sequence[str],
+    given: Mapping[str, tuple[float, float]],
+    surrogate: Surrogate | None,
 ) -> dict[str, dict[str, tuple[float, float]]]:
     out = {}
     for j in joints:
@@ -184,7 +188,7 @@ def tune(
     objective = metric(objective)
     if path not in PATHS:
         raise DesignerError(f"path={path!r} is not allowed", "use path='engine' or path='fmu'")
-    if scenario.kind != "robot":
+    if not isinstance(scenario, RobotScenario):
         raise DesignerError("tune needs a robot scenario", "give a scenario with [robot] and [joints]")
     if not any(applies(objective, ref) for ref in scenario.motors.values()):
         raise DesignerError(f"no joint of the scenario has {objective}", "give a joint a step reference")
@@ -333,7 +337,7 @@ def _designs(
     tuned.robustness["designs"] = chosen
 
 
-def _length(sc: Scenario, joint: str) -> float:
+def _length(sc: RobotScenario, joint: str) -> float:
     """The joint's printed length (mm): its design's, else the middle of the tested range."""
     src = sc.joints[joint]
     params = None if src.joint is None else src.joint.provenance.get("params")

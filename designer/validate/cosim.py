@@ -19,7 +19,8 @@ COSIM_ORDER = 0.8
 def check_cosim(ctx: Context) -> CheckResult:
     """The arm co-simulated with two joint FMUs converges to the in-engine reference with the macro step."""
     from ..cosim.references import Sine, Step
-    from ..cosim.run import robot_reference, run
+    from ..cosim.robot_scenario import robot_reference
+    from ..cosim.run import run
     from ..cosim.scenario import JointSource, Scenario
     from ..joint import Joint
     from ..plots.checks import plot_convergence
