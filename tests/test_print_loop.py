@@ -139,10 +139,18 @@ def test_a_load_logged_in_kn_is_refused_naming_the_unit(tmp_path, capsys):
     runs = _template(tmp_path, capsys)
     design = dict(zip(FACTORS, [60.0, 24.0, 4.5, 9.0, 0.16, 0.0], strict=True))
     log = rig_log(tmp_path, "P1", design, 0.9, 2.2e-3, load_scale=1e-3)
-    code, _, err = run_inprocess(["identify", log, "--runs", runs], capsys)
+    # identify itself fails such a log (exit 1, the reason printed) and fills nothing
+    code, out, err = run_inprocess(["identify", log, "--runs", runs], capsys)
+    assert_clean_failure(code, err, allowed=(1,))
+    assert "in kN" in " ".join(out.split()), out
+    assert pd.read_csv(runs)["k_x [N/mm]"].isna().all()
+    # the same k typed into the table by hand: calibrate refuses it, naming the unit
+    table = pd.read_csv(runs)
+    table.loc[0, "k_x [N/mm]"], table.loc[0, "c_x [N.s/mm]"] = 0.0009, 2.2e-6
+    table.to_csv(runs, index=False)
+    code, _, err = run_inprocess(["calibrate", runs], capsys)
     assert_clean_failure(code, err, allowed=(2,))
     assert "k_x of print P1 is 0.0009" in err and "load logged in kN" in err, err
-    assert pd.read_csv(runs)["k_x [N/mm]"].isna().all()  # nothing written
 
 
 @pytest.mark.parametrize(
