@@ -41,7 +41,8 @@ def designs_from(doc: Mapping[str, Any], candidate: int | None = None) -> list[d
     """
     if not isinstance(doc, Mapping):
         raise DesignerError(
-            "the file is not a designer next or suggest JSON output", "give designer next --json's output"
+            "the file is not a designer next or suggest JSON output",
+            "give what designer next or designer suggest writes as JSON",
         )
     if "prints" in doc and "recommendation" in doc:
         if candidate is not None:
@@ -58,7 +59,7 @@ def designs_from(doc: Mapping[str, Any], candidate: int | None = None) -> list[d
         return [dict(doc["candidates"][n - 1]["params"])]
     raise DesignerError(
         "the file is neither a designer next nor a designer suggest JSON output",
-        "give the output of designer next --json or designer suggest --json",
+        "give what designer next or designer suggest writes as JSON",
     )
 
 

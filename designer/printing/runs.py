@@ -94,7 +94,7 @@ def measured(table: Any, source: str = "runs") -> tuple[pd.DataFrame, list[str]]
         raise DesignerError(
             f"{source}: row {i + 1}{label} has {', '.join(c for c in measured_cols if c not in missing)} "
             f"but no {', '.join(missing)}",
-            "fill both k and c of the axis (designer identify --runs writes both) or leave the row empty",
+            "fill both k and c of the axis (designer identify writes both) or leave the row empty",
         )
     notes = []
     if empty.any():
