@@ -42,6 +42,13 @@ SurrogateOpt = Annotated[
     Path | None,
     typer.Option("--surrogate", help="Surrogate JSON from `designer fit` (default: the shipped one)."),
 ]
+AcceptImplausibleOpt = Annotated[
+    bool,
+    typer.Option(
+        "--accept-implausible",
+        help="Keep a measured k or c no printer can give (refused by default: a unit slip).",
+    ),
+]
 FixOpt = Annotated[
     list[str] | None,
     typer.Option("--fix", help="Hold a factor, NAME=VALUE in rig units, e.g. --fix width=4.5 (repeatable)."),

@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from .common import (
+    AcceptImplausibleOpt,
     AxisOpt,
     FixOpt,
     JsonOpt,
@@ -36,10 +37,7 @@ def calibrate(
     ],
     out: Annotated[Path | None, output_option("Where to write the calibrated surrogate JSON.")] = None,
     surrogate: SurrogateOpt = None,
-    accept_implausible: Annotated[
-        bool,
-        typer.Option(help="Keep a measured k or c no printer can give (refused by default: a unit slip)."),
-    ] = False,
+    accept_implausible: AcceptImplausibleOpt = False,
     as_json: JsonOpt = False,
 ) -> None:
     """Calibrate the study's surrogate to your printer with your own measured runs.

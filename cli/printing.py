@@ -67,26 +67,8 @@ def print_(
     check_output_folder(output)
     if runs is not None:
         check_output(runs, suffixes=(".csv", ".parquet", ".pq"))
-    given = {
-        "density": density,
-        "length": length,
-        "width": width,
-        "height": height,
-        "layer": layer,
-        "raster": raster,
-    }
-    one = {n: v for n, v in given.items() if v is not None}
-    if from_ is not None and one:
-        raise DesignerError(
-            "both --from and design settings are given", "give --from FILE or the six settings"
-        )
-    if from_ is None:
-        if len(one) < 6:
-            missing = ", ".join(f"--{n}" for n, v in given.items() if v is None)
-            raise DesignerError(f"missing {missing}", "give all six settings, or --from next.json")
-        designs = [one]
-    else:
-        designs = batch.designs_from(_read_json(from_), candidate)
+    given = dict(density=density, length=length, width=width, height=height, layer=layer, raster=raster)
+    designs = _designs(from_, candidate, given)
     existing = runs_table.read_runs(runs) if runs is not None and runs.exists() else None
     names = list(ids) if ids else runs_table.next_ids(existing, len(designs))
     clamp = Clamp(length=block_length, width=block_width, height=block_height)
@@ -100,15 +82,37 @@ def print_(
     }
     if as_json:
         print_json(data)
-        return
-    for p in made.prints:
-        v = p.params
+    else:
+        _print_batch(data)
+
+
+def _designs(from_: Path | None, candidate: int | None, given: dict) -> list[dict]:
+    """The designs to print: those of --from, or the one design of the six settings."""
+    from designer.printing import batch
+
+    one = {n: v for n, v in given.items() if v is not None}
+    if from_ is not None and one:
+        raise DesignerError(
+            "both --from and design settings are given", "give --from FILE or the six settings"
+        )
+    if from_ is not None:
+        return batch.designs_from(_read_json(from_), candidate)
+    if len(one) < 6:
+        missing = ", ".join(f"--{n}" for n, v in given.items() if v is None)
+        raise DesignerError(f"missing {missing}", "give all six settings, or --from next.json")
+    return [one]
+
+
+def _print_batch(data: dict) -> None:
+    for p in data["prints"]:
+        v = p["params"]
         console.print(
-            f"{p.print_id}: infill {v['density']:g} %, l {v['length']:g} mm, b {v['width']:g} mm, "
+            f"{p['print']}: infill {v['density']:g} %, l {v['length']:g} mm, b {v['width']:g} mm, "
             f"h {v['height']:g} mm, layer {v['layer']:g} mm, raster {v['raster']:g} deg"
         )
-    for note in made.notes:
+    for note in data["notes"]:
         console.print(f"- {note}")
+    files = data["files"]
     console.print(
         f"plate: {files['plate']} (PrusaSlicer, OrcaSlicer or Bambu Studio: each object carries its settings)"
     )

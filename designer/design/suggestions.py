@@ -96,8 +96,7 @@ def suggest(
     Args:
         surrogate: the fitted surrogate (`Surrogate.load()` for the shipped one).
         k, c: a target value, "min" or "max"; None leaves that response free.
-        axis: the surrogate's axis the goals are on; a rotational axis it lacks (theta: N.mm/rad)
-            is derived from x through the pseudo-rigid-body relation (`designer.model.rotational`).
+        axis: the goals' axis; a rotational one the surrogate lacks comes from x (model.rotational).
         fixed: factors held at a value, e.g. {"width": 4.5}.
         top: how many distinct candidates to return (fewer are explained in `statements`).
         importance, bounds, weight: per response, the composite's importance, the desirability's
@@ -152,7 +151,6 @@ def suggest(
             picked.append(cand)
     sug = Suggestion(axis, targets, picked, True, [], info, surrogate.id, fixed, tolerance)
     assess(sug, surrogate, problem, box, ranked)
-    sug.statements += [printer_statement(surrogate), *derived_statement(surrogate, axis)]
     if len(picked) < top:
         sug.statements.append(
             f"{len(picked)} distinct design(s) instead of the {top} asked for: every start of the search "
@@ -365,6 +363,7 @@ def assess(
             f"+-{100 * tol:.0f} % together with probability {every:.2f} (the product: given the model, "
             "the responses scatter independently)"
         )
+    sug.statements += [printer_statement(surrogate), *derived_statement(surrogate, sug.axis)]
 
 
 def unpredictable_statement(sug: Suggestion, q: str, t: Target, p: Prediction, unit: str) -> str:
