@@ -6,12 +6,13 @@ through the study's runs (the smoothest surface through them, calmer between the
 one); `--truth drawn` (default): each printer's log k adds its own draw of a smooth departure field,
 about zero at the study's runs and, between them, as large as the study surrogate's nested
 cross-validation says it errs there (`--scale` times that of a Gaussian process fitted to the study;
-default printers.DEPARTURE_SCALE). `--truth extrusion|adhesion|infill|combined`: the spline's
-physics through a printer mechanism (width and height offsets, layer and raster dependent bonds,
-another infill's density law, or all three; printers.MECHANISMS). Per printer and target (targets
-log-spaced across the study's measured k; every third run also has a c goal, every third holds raster
-at 0 deg), three policies, each printing the tool's recommended design and counting prints until one
-lands within +-10 % of every predictable target (k; c is not predictable from the factors):
+default printers.DEPARTURE_SCALE). `--truth extrusion|adhesion|infill|combined`: a drawn truth (the
+study's physics, as rough between the runs as its cross-validation measures) through a printer
+mechanism (width and height offsets, layer and raster dependent bonds, another infill's density law,
+or all three; printers.MECHANISMS); with `--smooth`, the mechanism on the spline instead. Per
+printer and target (targets log-spaced across the study's measured k; every third run also has a c
+goal, every third holds raster at 0 deg), these policies, each counting prints until one lands within
++-10 % of every predictable target (k; c is not predictable from the factors):
 
 - `loop`: calibrate to the runs so far (`designer.calibrate`), `designer.next_prints(n=1)`: print
   the recommendation when its P >= 0.9, else the print it proposes; every print is measured, so the
@@ -239,9 +240,9 @@ def paired(loop_prints: list[int], baseline_prints: list[int]) -> dict:
     }
 
 
-def make_printer(seed: int, kind: str, scale: float) -> truth.Printer:
+def make_printer(seed: int, kind: str, scale: float, smooth: bool) -> truth.Printer:
     if kind in truth.MECHANISMS:
-        return truth.Printer(seed, mechanism=kind)
+        return truth.Printer(seed, mechanism=kind, drawn=not smooth, scale=scale)
     return truth.Printer(seed, drawn=kind == "drawn", scale=scale)
 
 
@@ -273,6 +274,9 @@ def main() -> None:
         default=truth.DEPARTURE_SCALE,
         help="a drawn departure's size, relative to the process fitted to the study",
     )
+    parser.add_argument(
+        "--smooth", action="store_true", help="mechanism printers on the spline instead of a drawn truth"
+    )
     args = parser.parse_args()
     if args.quick:
         args.printers, args.targets, args.augment = 3, 3, 0
@@ -286,7 +290,7 @@ def main() -> None:
     unreachable = 0
     t0 = time.perf_counter()
     for p in range(args.printers):
-        printer = make_printer(args.seed + p, args.truth, args.scale)
+        printer = make_printer(args.seed + p, args.truth, args.scale, args.smooth)
         for i, k in enumerate(targets):
             goals, fixed = _goals(i, float(k))
             if not printer.best(k=k, fixed=fixed, tolerance=TOLERANCE)[1]:
@@ -303,7 +307,8 @@ def main() -> None:
                 results["augment"].append(augment(study, table, printer, goals, fixed, rng, args.max_prints))
     out = {
         "truth": args.truth,
-        "scale": args.scale if args.truth == "drawn" else None,
+        "scale": args.scale if args.truth == "drawn" or not args.smooth else None,
+        "smooth": args.smooth,
         "printers": args.printers,
         "targets_per_printer": args.targets,
         "unreachable_skipped": unreachable,

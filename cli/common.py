@@ -197,6 +197,9 @@ FLAGS: tuple[tuple[str, str], ...] = (
     (r"\brest=(?=\S+ is for exports into)", "--rest "),
     (r"\bmotor_inertia=", "--motor-inertia "),
     (r"\bmotor_bandwidth=", "--motor-bandwidth "),
+    (r"\brest=(?=\S+ (rad|m) is outside the range)", "--rest "),
+    (r"\bpackage_paths=\{'([^']+)': 'DIR'\}", r"--package-path \1=DIR"),
+    (r"\bpackage_paths\['([^']+)'\]=", r"--package-path \1="),
 )
 
 

@@ -12,10 +12,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
+from rich.markup import escape
 
 from designer.errors import DesignerError
 
-from .common import console, err_console, finishing, print_json, progress
+from .common import console, err_console, finishing, flag_message, print_json, progress
 
 export_app = typer.Typer(
     help="Export a joint: FMU (FMI 2/3), Modelica, MJCF, URDF, SDF or SSP.", no_args_is_help=True
@@ -175,7 +176,7 @@ def _snippet(
         for n, a in advice.items():
             console.print(f"  {n}: {a.text()}")
         for line in getattr(result, "notes", ()):
-            console.print(f"  {line}")
+            console.print(f"  {escape(flag_message(line))}")
 
     command.__doc__ = (
         f"Write the joint as {title.format(fmi='2|3', interface='force|body')}, SI units, "
@@ -233,11 +234,37 @@ def _mjcf(joint: Joint, output: Path, _from: Source, *, axis_pick: str | None, *
     return export_mjcf(joint, output, axis=axis_pick, **options)
 
 
-def _urdf(joint: Joint, output: Path, _from: Source, *, axis_pick: str | None, **options):
+def package_paths(items: list[str] | None) -> dict[str, Path]:
+    """`--package-path NAME=DIR` options as {NAME: DIR}.
+
+    Raises:
+        DesignerError: an item without NAME=DIR.
+    """
+    out = {}
+    for item in items or []:
+        name, sep, folder = item.partition("=")
+        if not (sep and name.strip() and folder.strip()):
+            raise DesignerError(
+                f"--package-path {item!r} is not NAME=DIR",
+                "give the package's name and its folder, e.g. --package-path example-robot-data=/opt/erd",
+            )
+        out[name.strip()] = Path(folder.strip())
+    return out
+
+
+def _urdf(
+    joint: Joint,
+    output: Path,
+    _from: Source,
+    *,
+    axis_pick: str | None,
+    package_path: list[str] | None,
+    **options,
+):
     """URDF standalone or --into a robot; the CLI's --use-axis is the writer's `axis`."""
     from designer.export.urdf import export_urdf
 
-    return export_urdf(joint, output, axis=axis_pick, **options)
+    return export_urdf(joint, output, axis=axis_pick, package_paths=package_paths(package_path), **options)
 
 
 def _sdf(joint: Joint, output: Path, _from: Source):
@@ -345,6 +372,22 @@ def _ssp(joint: Joint, output: Path, suggestion: Source, *, interface: str, syst
     )
 
 
+OUTSIDE_RANGE = _option(
+    "allow_outside_range",
+    Annotated[bool, typer.Option(help="accept a --rest outside the robot joint's range")],
+    False,
+)
+PACKAGE_PATH = _option(
+    "package_path",
+    Annotated[
+        list[str] | None,  # noqa: UP007
+        typer.Option(
+            "--package-path",
+            help="NAME=DIR: the folder of a package the robot's package://NAME/ file names use (repeat)",
+        ),
+    ],
+    None,
+)
 #: the options of `export mjcf` beyond the joint's: where it goes in a robot and how
 MJCF_OPTIONS = (
     INTO,
@@ -354,11 +397,7 @@ MJCF_OPTIONS = (
     _option("form", Annotated[str, typer.Option(help="parallel or series (motor -> flexure)")], "parallel"),
     _option("motor_inertia", Annotated[float | None, typer.Option(help="series: SI")], None),  # noqa: UP007
     _option("motor_bandwidth", Annotated[float | None, typer.Option(help="series: servo Hz")], None),  # noqa: UP007
-    _option(
-        "allow_outside_range",
-        Annotated[bool, typer.Option(help="accept a --rest outside the robot joint's range")],
-        False,
-    ),
+    OUTSIDE_RANGE,
 )
 #: the options of `export ssp` beyond the joint's
 SSP_OPTIONS = (
@@ -413,7 +452,7 @@ def _formats(snippet: Callable[..., None]) -> None:
         "a URDF chain (damping; spring in a <gazebo reference> extension)",
         _urdf,
         "designer export urdf --k 50 --c 0.5 --m 1e-5 --axis theta -o joint.urdf",
-        (INTO, ROBOT_JOINT, REST, AXIS_PICK),
+        (INTO, ROBOT_JOINT, REST, AXIS_PICK, OUTSIDE_RANGE, PACKAGE_PATH),
     )
     snippet(
         "sdf",

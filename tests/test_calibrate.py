@@ -395,3 +395,31 @@ def test_next_is_never_out_of_reach_where_a_printable_design_is_predicted_within
         if not sug.reachable:
             lo, hi = sug.ranges["k"]["predicted"]
             assert lo <= sug.candidates[0].predicted["k"].value <= hi
+
+
+def test_the_stated_spread_holds_at_the_recommendation_on_mechanism_printers(study):
+    """Where the user acts on it: on printers that depart from the study through a mechanism
+    (tests/printers.py: a drawn truth, as rough between the study's runs as its cross-validation
+    measures, with offsets, layer- and raster-dependent bonds and another infill together),
+    after one print of `next`'s first recommendation, a print of the next recommendation (what P is
+    about: the printer's truth with its print scatter) has a log k standardized error against the
+    calibrated model's predictive t with an sd near 1, and the 95 % intervals cover."""
+    z, inside = [], []
+    for seed in range(24):
+        printer = printers.Printer(500 + seed, mechanism="combined", drawn=True)
+        k = float(np.geomspace(0.35, 1.3, 6)[seed % 6])
+        first = designer.next_prints(study, k=k, n=1).recommendation.params
+        runs = printer.prints(pd.DataFrame([first]), np.random.default_rng(seed))
+        cal = designer.calibrate(study, runs)
+        rec = designer.suggest(cal, k=k, top=1).candidates[0].params
+        model = cal.model("k_x")
+        p = cal.predict(pd.DataFrame([rec])[FACTORS])["k_x"].at(0)
+        mu, s = math.log(p.value), (math.log(p.high) - math.log(p.value)) / model.t95
+        measured = float(
+            printer.prints(pd.DataFrame([rec]), np.random.default_rng(100 + seed))["k_x_N_per_mm"][0]
+        )
+        z.append((math.log(measured) - mu) / s)
+        inside.append(p.low <= measured <= p.high)
+    z = np.array(z)
+    assert 0.6 < z.std() < 1.45 and abs(z.mean()) < 0.6, (z.std(), z.mean())
+    assert np.mean(inside) >= 0.85, np.mean(inside)

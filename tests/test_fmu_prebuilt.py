@@ -337,3 +337,41 @@ def test_two_joints_built_from_source_link_into_one_program(tmp_path):
     )
     out = subprocess.run([str(exe), *args], capture_output=True, text=True, check=True).stdout
     assert [float(v) for v in out.split()] == [800.0, 1600.0]
+
+
+# --- designer cosim picks the platform's own binary ----------------------------------------------------
+
+
+def test_cosim_names_the_platforms_own_fmi2_binary(hosts, unpacked, monkeypatch, tmp_path):
+    """FMPy 0.3.32 looks for an FMI 2 binary in linux64 (64-bit x86) on aarch64 Linux too, and in
+    darwin64 on Apple Silicon; FMI 2.0.4 has no aarch64 folder, so the exports put it in aarch64-linux.
+    `designer cosim` names the binary of its own platform, as FMI 3 does; under qemu that binary runs
+    the joint as the native one does."""
+    from designer import cosim
+    from designer.cosim.fmu import library_path
+
+    folder, token = unpacked[2]
+    assert library_path(folder, 2, "FlexJoint") == str(folder / "binaries" / "linux64" / "FlexJoint.so")
+    for platform in ("aarch64-linux", "aarch64-darwin"):
+        name = "FlexJoint.so" if platform.endswith("linux") else "FlexJoint.dylib"
+        assert library_path(folder, 2, "FlexJoint", platform) == str(folder / "binaries" / platform / name)
+    assert library_path(folder, 2, "Other") is None  # not in the FMU: FMPy chooses and says what it missed
+    # on an aarch64 Linux machine (platform.machine() says so) a run loads binaries/aarch64-linux
+    monkeypatch.setattr(build._platform, "machine", lambda: "aarch64")
+    aarch64 = str(folder / "binaries" / "aarch64-linux" / "FlexJoint.so")
+    assert library_path(folder, 2, "FlexJoint") == aarch64
+    scenario = tmp_path / "arm.toml"
+    scenario.write_text(
+        '[simulation]\nduration = 0.01\nstep = 1e-3\n[robot]\nmodel = "arm"\n[joints.j1]\n'
+        "coefficients = { k = 330, c = 0.83 }\n"
+    )
+    with pytest.raises(Exception, match=r"binaries/aarch64-linux/FlexJoint\.so"):  # an x86_64 machine
+        cosim.run(cosim.load(scenario))
+    monkeypatch.undo()
+    found, missing, _ = hosts
+    if "qemu" not in found or "native" not in found:
+        pytest.skip(missing.get("qemu") or missing["native"])
+    location = next(iter(_locations(2, folder / "resources", "posix").values()))
+    native = _run(found["native"], folder, 2, "me", token, location, STEPS)
+    emulated = _run(found["qemu"], folder, 2, "me", token, location, STEPS)
+    assert np.all(np.abs(emulated - native) <= 1e-12 * np.max(np.abs(native)))

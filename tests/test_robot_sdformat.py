@@ -66,10 +66,10 @@ def test_urdf_into_a_robot_reaches_gazebo_with_the_spring(probe, tmp_path):
     joint = Joint.from_coefficients({"theta": {"k": 50.0, "c": 0.5, "m": 1e-5}})
     before = gazebo_reads(probe, folder / "panda.urdf")
     out = export_urdf(
-        joint, folder / "flex.urdf", into=folder / "panda.urdf", joint_name="panda_joint4", rest=0.1
+        joint, folder / "flex.urdf", into=folder / "panda.urdf", joint_name="panda_joint4", rest=-0.1
     )
     after = gazebo_reads(probe, out.path)
     assert (after["links"], after["joint_count"]) == (before["links"], before["joint_count"]) > (0, 0)
-    assert after["joints"]["panda_joint4"] == (0.05, 0.1, 5e-4)
+    assert after["joints"]["panda_joint4"] == (0.05, -0.1, 5e-4)
     others = {n: v for n, v in after["joints"].items() if n != "panda_joint4"}
     assert others == {n: v for n, v in before["joints"].items() if n != "panda_joint4"}

@@ -139,6 +139,29 @@ def check_fmu(path: str | Path, axes: Sequence[str]) -> str:
     return FmuDescription(path, axes).interface
 
 
+def library_path(
+    folder: Path, fmi_version: int, model_identifier: str, platform: str | None = None
+) -> str | None:
+    """The binary of `platform` (an FMI 3 tuple; default this machine) in an unpacked FMU `folder`.
+
+    FMI 3 names binaries/ folders by the tuple; FMI 2.0.4 names only 64-bit x86 (linux64, win64,
+    darwin64), so other platforms use the FMI 3 tuple there too (aarch64-linux, aarch64-darwin, as
+    designer's exports do). FMPy 0.3.32 looks for an FMI 2 binary in linux64 or darwin64 on any 64-bit
+    machine, an x86_64 binary on aarch64 Linux and Apple Silicon: so the binary is named for it.
+    None when the FMU has no such file (or the platform is not one designer knows): FMPy then chooses,
+    and its error names what it missed.
+    """
+    from ..export.build import host_platform, platform_folder
+
+    try:
+        platform = platform or host_platform()
+    except DesignerError:
+        return None
+    extension = {"windows": ".dll", "darwin": ".dylib"}.get(platform.split("-", 1)[1], ".so")
+    path = folder / "binaries" / platform_folder(fmi_version, platform) / (model_identifier + extension)
+    return str(path) if path.is_file() else None
+
+
 def unpack(path: str | Path, folder: str | Path) -> Path:
     """Extract what an importer loads from an FMU (binaries/ and resources/, as FMPy's simulate_fmu
     does) into `folder`: not the sources or documentation."""
@@ -354,10 +377,15 @@ class FmuSystem:
             shutil.rmtree(self._dir, ignore_errors=True)
 
     def _instantiate(self, md, name: str):
-        """An fmpy FMU2/FMU3 Model or Slave (as the mode drives it), instantiated."""
+        """An fmpy FMU2/FMU3 Model or Slave (as the mode drives it), instantiated from this machine's
+        own binary (`library_path`)."""
         iface = self.mode.interface(md)
         fmu = self.mode.fmpy_class(self.version)(
-            guid=md.guid, unzipDirectory=self._dir, modelIdentifier=iface.modelIdentifier, instanceName=name
+            guid=md.guid,
+            unzipDirectory=self._dir,
+            modelIdentifier=iface.modelIdentifier,
+            instanceName=name,
+            libraryPath=library_path(Path(self._dir), self.version, iface.modelIdentifier),
         )
         self._instantiate_logging(fmu)
         problems = [c.name for c in md.logCategories if c.name in PROBLEM_CATEGORIES]

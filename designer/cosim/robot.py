@@ -53,8 +53,35 @@ def planar_arm_xml(lengths: Sequence[float] = ARM_LENGTHS, masses: Sequence[floa
     return f'<mujoco model="planar_arm"><option gravity="0 0 -9.81"/><worldbody>{body}</worldbody></mujoco>'
 
 
-def load_spec(path: str | Path | None = None, lengths=ARM_LENGTHS, masses=ARM_MASSES):
-    """A MuJoCo spec from an MJCF or URDF file, or the built-in planar arm when `path` is None."""
+def _urdf_text(path: Path, package_paths: Mapping[str, str | Path] | None) -> str:
+    """A URDF's text with its file names resolved (see `designer.export.urdf_packages`).
+
+    Raises:
+        DesignerError: a package the URDF names that `package_paths` does not.
+    """
+    from ..export.urdf_packages import packages_named, resolved_urdf
+
+    missing = sorted(packages_named(path.read_text(errors="replace")) - set(package_paths or {}))
+    if missing:
+        raise DesignerError(
+            f"robot model {path.name} names files by package://{missing[0]}/..., which MuJoCo cannot resolve",
+            f'give the package\'s folder: [robot] package_paths = {{ {missing[0]} = "DIR" }} in a scenario '
+            "file (package_paths= in Python), as ROS's package path would",
+        )
+    return resolved_urdf(path, package_paths)
+
+
+def load_spec(
+    path: str | Path | None = None,
+    lengths=ARM_LENGTHS,
+    masses=ARM_MASSES,
+    package_paths: Mapping[str, str | Path] | None = None,
+):
+    """A MuJoCo spec from an MJCF or URDF file, or the built-in planar arm when `path` is None.
+
+    A URDF's `package://NAME/` file names resolve against `package_paths[NAME]` (a folder), as ROS's
+    package path would (see `designer.export.urdf_packages`); MuJoCo knows no packages.
+    """
     import mujoco
 
     if path is None:
@@ -63,7 +90,11 @@ def load_spec(path: str | Path | None = None, lengths=ARM_LENGTHS, masses=ARM_MA
     if not path.is_file():
         raise DesignerError(f"robot model {path} does not exist", "give the path of an MJCF or URDF file")
     try:
+        if path.suffix.lower() == ".urdf":
+            return mujoco.MjSpec.from_string(_urdf_text(path, package_paths))
         return mujoco.MjSpec.from_file(str(path))
+    except DesignerError:
+        raise
     except Exception as exc:  # mujoco raises a bare ValueError with its parser message
         raise DesignerError(
             f"MuJoCo cannot load {path}: {exc}", "give an MJCF or URDF file MuJoCo reads"
@@ -148,11 +179,17 @@ class SpringDamper:
     actuator with affine bias (gain 1, bias -k q - c q') driven by `control`; the compiled kernel
     (fmus/kernel/systems.c) and the sweeps' rollout (designer/sweep/engine.py) compute `control` too,
     and tests/test_cosim.py checks each against `torque`.
+
+    `explicit`: MuJoCo's implicit integrators (implicitfast, implicit) take an actuator's
+    velocity-dependent bias implicitly, while a co-simulated torque is a force set for the step; an
+    explicit law is a plain force actuator (gain 1, no bias) whose control is `torque` at the start of
+    each step, the co-simulation's own exchange, so a same-step comparison is like with like.
     """
 
     k: float
     c: float
     offset: float = 0.0
+    explicit: bool = False
 
     def torque(self, s, v):
         """The torque (N.m, or N on a slide) at deflection `s` and rate `v` (arrays broadcast)."""
@@ -172,11 +209,12 @@ class SpringDamper:
             target=joint,
             trntype=mujoco.mjtTrn.mjTRN_JOINT,
             gaintype=mujoco.mjtGain.mjGAIN_FIXED,
-            biastype=mujoco.mjtBias.mjBIAS_AFFINE,
+            biastype=mujoco.mjtBias.mjBIAS_NONE if self.explicit else mujoco.mjtBias.mjBIAS_AFFINE,
         )
         act.gainprm[0] = 1.0
-        act.biasprm[1] = -self.k
-        act.biasprm[2] = -self.c
+        if not self.explicit:
+            act.biasprm[1] = -self.k
+            act.biasprm[2] = -self.c
         act.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
         return act
 
@@ -285,7 +323,12 @@ class Robot:
         """Advance one physics step (h must be the model's timestep), then move the motors to t + h."""
         for i, (j, law) in enumerate(self.in_engine.items()):
             k = self.joints.index(j)
-            self.data.ctrl[self.actuators[i]] = law.control(self.motor_q[k], self.motor_v[k])
+            if law.explicit:  # the torque at the step's start, as the co-simulation exchanges it
+                s = self.data.qpos[self.qpos[k]] - self.motor_q[k]
+                v = self.data.qvel[self.dof[k]] - self.motor_v[k]
+                self.data.ctrl[self.actuators[i]] = law.torque(s, v)
+            else:
+                self.data.ctrl[self.actuators[i]] = law.control(self.motor_q[k], self.motor_v[k])
         self._mj_step(self.model, self.data)
         if self._bad.number:
             raise diverged(self.time)
@@ -302,6 +345,11 @@ class Robot:
             DesignerError: a mujoco too old to load a model from memory, or a motor reference the
                 kernel does not know.
         """
+        if any(law.explicit for law in self.in_engine.values()):
+            raise DesignerError(
+                "the compiled kernel computes in-engine spring-dampers in their implicit form only",
+                "run this robot with engine='python'",
+            )
         twin = Twin(self.model, self.data)  # the kernel steps its own copy (see twin.py)
         keep: list = []
         refs = (kb.Reference * len(self.motors))(*[kb.reference(r, keep) for r in self.motors])

@@ -4,19 +4,24 @@ motor reference; its metrics, and its validation against the same spring-dampers
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
 
 from ..errors import DesignerError
+from ..export.urdf_packages import check_package_paths
+from .host import host_integrator, integrator_name, take_host_actuators
 from .kernel import run_master
 from .master import Master, Series, System, Trace
 from .metrics import joint_metrics
 from .references import Chirp, Reference, Sine, Step, Trajectory
 from .robot import ARM_LENGTHS, ARM_MASSES, Robot, SpringDamper, check_joints, free_host_joints, load_spec
 from .scenario import JointSource, Laws, Progress, Scenario, Tracer, positive
+
+#: MuJoCo's integrators that take an actuator's velocity-dependent force implicitly
+IMPLICIT = ("implicit", "implicitfast")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -33,10 +38,16 @@ class RobotScenario(Scenario):
     model: Path | None = None
     lengths: tuple[float, ...] = ARM_LENGTHS
     masses: tuple[float, ...] = ARM_MASSES
+    #: a URDF's package://NAME/ folders {NAME: folder}, as ROS's package path
+    package_paths: Mapping[str, Path] = field(default_factory=dict)
 
     kind: ClassVar[str] = "robot"
     keyword: ClassVar[str] = "joints"
     interface: ClassVar[str] = "force"
+
+    def model_spec(self):
+        """The robot model's MuJoCo spec, as the scenario names it (see `robot.load_spec`)."""
+        return load_spec(self.model, self.lengths, self.masses, self.package_paths)
 
     def own_fields(self) -> dict[str, Any]:
         out: dict[str, Any] = {}
@@ -51,7 +62,13 @@ class RobotScenario(Scenario):
                     "give one length and one mass per link",
                 )
             out |= {"lengths": lengths, "masses": masses}
-        spec = load_spec(out.get("model"), out.get("lengths", self.lengths), out.get("masses", self.masses))
+        out["package_paths"] = check_package_paths(self.package_paths)
+        spec = load_spec(
+            out.get("model"),
+            out.get("lengths", self.lengths),
+            out.get("masses", self.masses),
+            out["package_paths"],
+        )
         check_joints(spec, list(self.joints))
         for name, src in self.joints.items():
             if not isinstance(src, JointSource):
@@ -116,6 +133,10 @@ class RobotScenario(Scenario):
         ref_fine = _angles(robot_reference(self, laws, fine, duration, "rk4"), joints)
         same = _angles(trace(case, duration=duration), joints)
         same_ref = _angles(robot_reference(self, laws, self.step, duration, self.integrator), joints)
+        integrator = self.integrator or integrator_name(self.model_spec())
+        explicit = (
+            f" (under {integrator}: a force set each step, as co-simulated)" if integrator in IMPLICIT else ""
+        )
         rows = []
         for i, h in enumerate(steps):
             ratio = int(round(h / fine))
@@ -136,7 +157,7 @@ class RobotScenario(Scenario):
             if progress is not None:
                 progress((i + 1) / len(steps))
         return {
-            "reference": f"in-engine MuJoCo general actuator; steps against RK4 at {fine:g} s",
+            "reference": f"in-engine MuJoCo general actuator{explicit}; steps against RK4 at {fine:g} s",
             "max_error": float(np.max(np.abs(same - same_ref))),
             "steps": rows,
         }
@@ -161,18 +182,30 @@ def robot_system(
     *,
     integrator: str | None = None,
     in_engine: Mapping[str, SpringDamper] | None = None,
+    as_cosimulated: bool = False,
 ) -> Robot:
     """The robot of a (checked) robot scenario at physics step `step` (s): the one place a scenario's
     MuJoCo model is built. `in_engine` computes those joints' spring-dampers inside MuJoCo. Each
     flexible joint's own stiffness, damping and armature in the host model are zeroed unless its
-    source says `keep_host` (`Robot.notes` says what changed), for the run and its reference alike."""
-    spec = load_spec(sc.model, sc.lengths, sc.masses)
+    source says `keep_host`, and the host's actuators on it are taken out (see `host`); `integrator`
+    (default the scenario's, else the model's own) is MuJoCo's. `Robot.notes` says what changed, for
+    the run and its reference alike. `as_cosimulated`: under an implicit integrator the in-engine laws
+    are explicit, as the co-simulation exchanges its torques (see `SpringDamper`); the sweeps'
+    open-loop rollout needs them implicit."""
+    spec = sc.model_spec()
     notes = free_host_joints(spec, [j for j, src in sc.joints.items() if not src.keep_host])
-    return Robot(spec, sc.motors, step, integrator or sc.integrator, in_engine=in_engine, notes=notes)
+    notes += take_host_actuators(spec, list(sc.joints))
+    name, said = host_integrator(spec, integrator or sc.integrator)
+    if in_engine and as_cosimulated and name in IMPLICIT:  # the co-simulated torque is explicit
+        in_engine = {j: replace(law, explicit=True) for j, law in in_engine.items()}
+    return Robot(spec, sc.motors, step, name, in_engine=in_engine, notes=notes + said)
 
 
-def robot_reference(sc: RobotScenario, laws: Mapping, step: float, duration: float, integrator: str) -> Trace:
-    """The same robot with every joint's spring-damper computed inside MuJoCo."""
+def robot_reference(
+    sc: RobotScenario, laws: Mapping, step: float, duration: float, integrator: str | None
+) -> Trace:
+    """The same robot with every joint's spring-damper computed inside MuJoCo, as the co-simulation
+    exchanges it (explicitly under an implicit integrator; `integrator` None: the scenario's)."""
     springs = {j: SpringDamper(p["k"], p["c"], p["offset"]) for j, p in laws.items()}
-    robot = robot_system(sc, step, integrator=integrator, in_engine=springs)
+    robot = robot_system(sc, step, integrator=integrator, in_engine=springs, as_cosimulated=True)
     return run_master(Master({"robot": robot}, []), duration, step)

@@ -114,7 +114,7 @@ class Scenario:
     duration: float
     step: float
     algorithm: str = "gauss-seidel"
-    integrator: str = "euler"
+    integrator: str | None = None
     outputs: Mapping[str, bool] = field(default_factory=dict)
     validation_steps: tuple[float, ...] = ()
     validation_duration: float | None = None
@@ -151,7 +151,8 @@ class Scenario:
         if duration < step:
             raise DesignerError(f"duration = {duration:g} s is shorter than step = {step:g} s", "lengthen it")
         one_of(self.algorithm, ALGORITHMS, "algorithm")
-        one_of(self.integrator, INTEGRATORS, "integrator")
+        if self.integrator is not None:  # None: the robot model's own
+            one_of(self.integrator, INTEGRATORS, "integrator")
         if not self.sources():
             raise DesignerError(*NEITHER)
         unknown = set(self.outputs) - set(OUTPUTS)

@@ -8,6 +8,7 @@ README documents every key. This is the one place that decides a file's scenario
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -25,7 +26,7 @@ from .scenario import OUTPUTS, JointSource, Scenario
 KEYS = {
     "": ("simulation", "robot", "joints", "rig", "outputs", "validation"),
     "simulation": ("duration", "step", "algorithm", "integrator"),
-    "robot": ("model", "lengths", "masses"),
+    "robot": ("model", "lengths", "masses", "package_paths"),
     "joint": (
         "fmu",
         "coefficients",
@@ -115,7 +116,7 @@ def load(path: str | Path) -> Scenario:
         duration=d.required(sim, "duration", "simulation."),
         step=d.required(sim, "step", "simulation."),
         algorithm=sim.get("algorithm", "gauss-seidel"),
-        integrator=sim.get("integrator", "euler"),
+        integrator=sim.get("integrator"),
         outputs=outputs,
         validation_steps=tuple(d.number({"steps": s}, "steps", "validation.") for s in steps),
         validation_duration=d.number(val, "duration", "validation."),
@@ -151,7 +152,8 @@ def _robot(doc: Mapping, d: _Doc, common: dict) -> RobotScenario:
     joints, motors = {}, {}
     for name, spec in joints_doc.items():
         key = f"joints.{name}"
-        joints[name] = _joint_source(spec, key, d, f"joint_{name}")
+        # the FMU's model name: robot joint names may hold what an identifier cannot ('robot:joint4')
+        joints[name] = _joint_source(spec, key, d, "joint_" + re.sub(r"\W", "_", name))
         motors[name] = _reference(
             spec.get("reference", {"type": "step", "amplitude": 0.0}), f"{key}.reference", d
         )
@@ -160,8 +162,17 @@ def _robot(doc: Mapping, d: _Doc, common: dict) -> RobotScenario:
     for key, value in (("lengths", lengths), ("masses", masses)):
         if not isinstance(value, list):
             raise DesignerError(f"{d.where('robot.' + key)} must be a list of numbers", "e.g. [0.08, 0.06]")
+    packages = robot.get("package_paths", {})
+    if not isinstance(packages, dict):
+        raise DesignerError(
+            f"{d.where('robot.package_paths')} must be a table",
+            'e.g. package_paths = { my_robot = "../my_robot" }',
+        )
     return RobotScenario(
         model=None if model == "arm" else d.file(model, "robot.model"),
+        package_paths={
+            name: d.file(folder, f"robot.package_paths.{name}") for name, folder in packages.items()
+        },
         lengths=tuple(d.number({"lengths": x}, "lengths", "robot.") for x in lengths),
         masses=tuple(d.number({"masses": x}, "masses", "robot.") for x in masses),
         joints=joints,

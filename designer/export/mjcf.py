@@ -2,7 +2,8 @@
 
 The snippet declares no `<compiler>`, `<option>` or `<default>`: `<include>`-ing it changes nothing
 global in the host. Every value it writes is angle-unit free (stiffness, damping and inertia are per
-radian whatever the compiler's angle; springref is 0). Into a robot: see `mjcf_into`.
+radian whatever the compiler's angle; springref is 0). Into a robot: see `mjcf_into` (parallel) and
+`mjcf_series`.
 """
 
 from __future__ import annotations
@@ -15,7 +16,8 @@ from ..errors import DesignerError, check_type
 from ..files import atomic_write, check_suffix
 from ..joint import Joint, check_joint
 from . import robot
-from .mjcf_into import into_parallel, into_series
+from .mjcf_into import into_parallel
+from .mjcf_series import into_series
 from .stability import StepAdvice, step_advice
 
 FORMS = ("parallel", "series")
@@ -188,7 +190,7 @@ def export_mjcf(
     Standalone (`into` None): form "parallel" is a chain of links, one per axis, each on a spring-damper
     joint; form "series" is motor -> flexure -> link on one axis (see `series_text`). With `into` (an
     MJCF file) and `joint_name`, a copy of that robot with the joint made flexible, in parallel or in
-    series (see `mjcf_into.into_parallel`, `mjcf_into.into_series`). `rest` (rad or m, the joint's
+    series (see `mjcf_into.into_parallel`, `mjcf_series.into_series`). `rest` (rad or m, the joint's
     qpos): in parallel None keeps the host's springref; a rest outside a limited joint's range is
     refused unless `allow_outside_range`. Masses come from the joint, or from the design's geometry.
 

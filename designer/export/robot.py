@@ -132,6 +132,54 @@ class Servo:
         return cls(motor_inertia, bandwidth, kp, 2 * math.sqrt(kp * total))
 
 
+def check_rest(
+    rest: float, span: tuple[float, float] | None, joint_name: str, unit: str, allow: bool
+) -> None:
+    """Refuse a given spring rest outside the robot joint's range `span` (None: unlimited), unless `allow`.
+
+    Raises:
+        DesignerError: the rest lies outside the range.
+    """
+    if span is not None and not span[0] <= rest <= span[1] and not allow:
+        raise DesignerError(
+            f"rest={rest:g} {unit} is outside the range [{span[0]:.4g}, {span[1]:.4g}] {unit} of robot joint "
+            f"'{joint_name}'",
+            "give a rest inside the range, or allow_outside_range=True if the spring should preload "
+            "the joint against its limit",
+        )
+
+
+def rest_inside(
+    host_rest: float,
+    span: tuple[float, float] | None,
+    unit: str,
+    what: str,
+    poses: dict[str, float] | None = None,
+) -> tuple[float, str | None]:
+    """The rest an export uses when none is given: the host's `host_rest` (its springref or Gazebo
+    springReference, named `what`) when it lies inside the range `span` (None: unlimited); otherwise
+    the first of the host's named `poses` (keyframes) inside the range, else the range's value nearest
+    to the host's. A spring resting outside the range would hold the joint against its limit, which a
+    host rest of 0 on a joint whose range excludes 0 (MuJoCo's and URDF's default) never meant.
+    Returns the rest and the note saying why it is not the host's (None when it is)."""
+    if span is None or span[0] <= host_rest <= span[1]:
+        return host_rest, None
+    lo, hi = span
+    for name, q in (poses or {}).items():
+        if lo <= q <= hi:
+            where = f"the {name} pose's {q:.4g} {unit}"
+            return q, _outside_note(host_rest, span, unit, what, where)
+    q = min(max(host_rest, lo), hi)
+    return q, _outside_note(host_rest, span, unit, what, f"the range's nearest value {q:.4g} {unit}")
+
+
+def _outside_note(host_rest: float, span: tuple[float, float], unit: str, what: str, where: str) -> str:
+    return (
+        f"{what}: the host's {host_rest:.4g} {unit} lies outside the joint's range [{span[0]:.4g}, "
+        f"{span[1]:.4g}] {unit}, so the spring rests at {where} (give rest to choose another)"
+    )
+
+
 def num(v: float) -> str:
     """A number for XML: the shortest text that reads back as the same float."""
     return repr(float(v))

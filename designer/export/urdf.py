@@ -11,6 +11,7 @@ default of recomputing inertia from collision shapes gives the same number.
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from pathlib import Path
 
 from .. import units
@@ -18,8 +19,10 @@ from ..errors import DesignerError, check_type
 from ..files import atomic_path, atomic_write, check_suffix
 from ..joint import Joint, check_joint
 from . import robot, urdf_drake, xmltext
+from .mjcf_host import compiled_changes
 from .stability import step_advice
 from .urdf_inertia import moved_inertia
+from .urdf_packages import mujoco_urdf, packages_named
 
 #: a prismatic URDF joint needs limits; these (m) are wide enough never to act on a flexure
 PRISMATIC_LIMIT = 1.0
@@ -172,12 +175,30 @@ def _host_values(root, element, joint_name: str) -> dict[str, float]:
     return old
 
 
+def _span(element) -> tuple[float, float] | None:
+    """A revolute or prismatic URDF joint's `<limit lower upper>` (URDF's defaults 0); None for a
+    continuous joint, which has no range."""
+    if element.get("type") == "continuous":
+        return None
+    limit = element.find("limit")
+    get = (lambda n: 0.0) if limit is None else (lambda n: float(limit.get(n, 0)))
+    return get("lower"), get("upper")
+
+
 def _into_urdf(
-    joint: Joint, host: Path, *, joint_name: str, axis: str | None, rest: float | None
+    joint: Joint,
+    host: Path,
+    *,
+    joint_name: str,
+    axis: str | None,
+    rest: float | None,
+    allow_outside_range: bool = False,
 ) -> tuple[bytes, dict[str, robot.StepAdvice], tuple[str, ...]]:
     """The host URDF's bytes with `joint_name`'s damping and Gazebo spring set, the rest as written;
     the joint's step advice (none when the links it moves declare no inertia); one note per host
-    value changed or kept (old -> new, SI). `rest` None keeps the host's springReference (else 0)."""
+    value changed or kept (old -> new, SI). `rest` None keeps the host's springReference (else 0)
+    when it lies inside the joint's limits, else takes the limits' nearest value (stated); a given
+    `rest` outside them is refused unless `allow_outside_range`, as in MJCF."""
     from lxml import etree
 
     if not host.is_file():
@@ -205,10 +226,14 @@ def _into_urdf(
     si = joint.axes[a].si()
     old = _host_values(root, found[0], joint_name)
     notes = []
+    span, unit = _span(found[0]), "rad" if rot else "m"
     if rest is None:
-        rest = old.get("springReference", 0.0)
+        host_rest = old.get("springReference", 0.0)
+        rest, moved = robot.rest_inside(host_rest, span, unit, "springReference")
         how = "kept at the host's" if "springReference" in old else "set to"
-        notes.append(f"springReference {how} {rest:.4g} (give rest to set it)")
+        notes.append(moved or f"springReference {how} {rest:.4g} (give rest to set it)")
+    else:
+        robot.check_rest(rest, span, joint_name, unit, allow_outside_range)
     new = {"damping": si["c"], "springStiffness": si["k"], "springReference": rest}
     notes += [
         f"{tag}: {'none' if tag not in old else format(old[tag], '.4g')} -> {v:.4g} (SI)"
@@ -291,6 +316,33 @@ def _set_spring(text: str, joint_name: str, k: float, rest: float) -> str:
     return f"{text[:end].rstrip()}\n{lines}\n{text[end:]}"
 
 
+def _mujoco_check(
+    host: Path, path: Path, data: bytes, joint_name: str, package_paths: Mapping[str, str | Path] | None
+) -> tuple[str, ...]:
+    """Compile the host URDF and its edited copy (`data`, to be written at `path`) in MuJoCo and raise
+    unless only the joint's damping differs; the note saying so, or why MuJoCo could not check it."""
+    from lxml import etree
+
+    try:
+        before = mujoco_urdf(host, package_paths)
+    except DesignerError as exc:
+        if packages_named(host.read_text(errors="replace")) and "package://" in exc.problem:
+            return (f"not checked in MuJoCo: {exc}",)
+        if "MuJoCo cannot load" in exc.problem:
+            return (f"not checked in MuJoCo: {exc.problem}",)
+        raise
+    encoding = etree.fromstring(data).getroottree().docinfo.encoding or "utf-8"
+    after = mujoco_urdf(path, package_paths, data.decode(encoding))
+    changed = compiled_changes(before, after, joint_name, {"dof_damping": "dof"})
+    if changed:
+        raise RuntimeError(f"MuJoCo reads more than {joint_name}'s damping changed: {', '.join(changed)}")
+    damping = float(after.joint(joint_name).damping[0])
+    return (
+        f"checked in MuJoCo: {joint_name} damping {damping:.4g} (SI), every other compiled value as the "
+        "host's",
+    )
+
+
 def export_urdf(
     joint: Joint,
     path: str | Path,
@@ -299,15 +351,21 @@ def export_urdf(
     joint_name: str | None = None,
     axis: str | None = None,
     rest: float | None = None,
+    allow_outside_range: bool = False,
+    package_paths: Mapping[str, str | Path] | None = None,
 ) -> robot.RobotExport:
     """Write `joint` as URDF at `path` (.urdf) and return the path and the stated step advice.
 
     Standalone: a chain of links with real masses (see `urdf_text`), every spring at `rest`. With
     `into` (a URDF file) and
     `joint_name`: a copy of that robot with the joint's damping set and a Gazebo spring extension
-    (stiffness, and `rest` in rad or m as springReference); its links are left as they are (URDF has
-    no armature, so the flexure's own moving inertia is not added). The advice uses the inertia the
-    joint moves according to the links' `<inertial>` (see `urdf_inertia`).
+    (stiffness, and `rest` in rad or m as springReference: None keeps the host's when it lies inside
+    the joint's limits; outside them a given rest is refused unless `allow_outside_range`); its links
+    are left as they are (URDF has no armature, so the flexure's own moving inertia is not added).
+    The advice uses the inertia the joint moves according to the links' `<inertial>` (see `urdf_inertia`).
+    MuJoCo, which reads URDF damping, then compiles the host and the copy and must see only that
+    damping change; `package_paths` ({package name: folder}) resolves `package://` file names for it
+    (see `urdf_packages`). A host MuJoCo cannot load is written unchecked, and the notes say why.
 
     Raises:
         DesignerError: a wrong suffix, a missing mass, or an `into` problem.
@@ -318,10 +376,18 @@ def export_urdf(
         if joint_name is None:
             raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
         check_type(joint_name, str, "joint_name", expected="a name", fix="give e.g. joint_name='knee'")
-        data, advice, notes = _into_urdf(joint, Path(into), joint_name=joint_name, axis=axis, rest=rest)
+        data, advice, notes = _into_urdf(
+            joint,
+            Path(into),
+            joint_name=joint_name,
+            axis=axis,
+            rest=rest,
+            allow_outside_range=allow_outside_range,
+        )
+        checked = _mujoco_check(Path(into), path, data, joint_name, package_paths)
         with atomic_path(path) as tmp:
             tmp.write_bytes(data)
-        return robot.RobotExport(path, advice, notes + READERS)
+        return robot.RobotExport(path, advice, notes + checked + READERS)
     text, advice = urdf_text(robot.with_masses(joint), rest=rest or 0.0)
     with atomic_write(path) as fh:
         fh.write(text)

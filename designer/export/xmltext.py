@@ -60,3 +60,12 @@ def indent_before(text: str, pos: int) -> str:
     """The indentation of the line holding `pos`."""
     line = text[text.rfind("\n", 0, pos) + 1 : pos]
     return line[: len(line) - len(line.lstrip())]
+
+
+def remove_attributes(start_tag: str, names: tuple[str, ...]) -> str:
+    """`start_tag` without the attributes `names` (those it does not have are ignored)."""
+    for attr in names:
+        start_tag = re.sub(
+            r"\s" + re.escape(attr) + r"\s*=\s*(['\"]).*?\1", "", start_tag, count=1, flags=re.S
+        )
+    return start_tag

@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 
 from .. import units
+from ..cosim.host import integrator_name
 from ..cosim.rig_scenario import RigScenario
 from ..cosim.robot_scenario import RobotScenario
 from ..files import atomic_folder, atomic_path, atomic_write
@@ -134,7 +135,7 @@ def engine_check(spec: Spec, *, cases: Sequence[Case], frame: pd.DataFrame) -> d
         "cases": [c.index for c in picks],
         "max_angle_difference_rad": angle,
         "max_metric_difference": metric_diff,
-        "integrator": sc.integrator,
+        "integrator": sc.integrator or integrator_name(sc.model_spec()),
     }
 
 

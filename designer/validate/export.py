@@ -316,6 +316,23 @@ def other_joint_changes(before, after, name: str) -> list[str]:
     return changed
 
 
+def gain_changes(before, after) -> list[str]:
+    """The named actuators whose compiled gains differ (gain, bias, dynamics parameters, gear), as
+    "name.field old -> new"; MuJoCo resolves a `dampratio` into biasprm[2] from the mass matrix."""
+    changed = []
+    for i in range(before.nu):
+        name = before.actuator(i).name
+        if not name:
+            continue
+        old, new = before.actuator(name), after.actuator(name)
+        for field in ("gainprm", "biasprm", "dynprm", "gear"):
+            a, b = getattr(old, field), getattr(new, field)
+            if not np.array_equal(a, b):
+                k = int(np.flatnonzero(a != b)[0])
+                changed.append(f"{name}.{field}[{k}] {a[k]:.4g} -> {b[k]:.4g}")
+    return changed
+
+
 #: the MJCF check's host: mujoco's own test model (shipped in the mujoco wheel: tendons, a keyframe,
 #: sensors, default classes) and its joint coupled by a fixed tendon
 MJCF_HOST, MJCF_HOST_JOINT = "testdata/model.xml", "hipy_0"
