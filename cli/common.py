@@ -42,6 +42,13 @@ SurrogateOpt = Annotated[
     Path | None,
     typer.Option("--surrogate", help="Surrogate JSON from `designer fit` (default: the shipped one)."),
 ]
+AcceptImplausibleOpt = Annotated[
+    bool,
+    typer.Option(
+        "--accept-implausible",
+        help="Keep a measured k or c no printer can give (refused by default: a unit slip).",
+    ),
+]
 FixOpt = Annotated[
     list[str] | None,
     typer.Option("--fix", help="Hold a factor, NAME=VALUE in rig units, e.g. --fix width=4.5 (repeatable)."),
@@ -205,6 +212,11 @@ FLAGS: tuple[Flag, ...] = (
         r"\ballow_outside_range=True\b", "--allow-outside-range", "or allow_outside_range=True if the spring"
     ),
     Flag(r"\btargets=\{'k': 0\.8\}", "--target k=0.8", "give targets={'k': 0.8}, for k or c"),
+    Flag(
+        r"\baccept_implausible=True\b",
+        "--accept-implausible",
+        "k_x 800 is 1000 times the study's; if the value is right, pass accept_implausible=True",
+    ),
     Flag(r"\bfrom fixed=", "from --fix", "drop width from fixed="),
     # export mjcf/urdf/sdf/modelica/ssp
     Flag(r"\binto=", "--into ", "give the file that defines the joint as into="),

@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from .common import (
+    AcceptImplausibleOpt,
     AxisOpt,
     FixOpt,
     JsonOpt,
@@ -37,6 +38,7 @@ def calibrate(
     ],
     out: Annotated[Path | None, output_option("Where to write the calibrated surrogate JSON.")] = None,
     surrogate: SurrogateOpt = None,
+    accept_implausible: AcceptImplausibleOpt = False,
     as_json: JsonOpt = False,
 ) -> None:
     """Calibrate the study's surrogate to your printer with your own measured runs.
@@ -46,25 +48,34 @@ def calibrate(
     adhesion: those your runs pin down are printed) and a local correction that is strong near the
     designs you printed and fades away from them. The result is a surrogate file every --surrogate
     option accepts. The report gives the nested leave-one-out accuracy over your runs (each predicted
-    from the others).
+    from the others). The runs table designer print writes is read as filled: prints not measured yet
+    are left out. A k or c whose implied printer factor lies far outside its prior (a value in N/m, a
+    load in kN) is refused, naming the likely unit, unless --accept-implausible.
 
     Example: designer calibrate my_runs.csv -o mine.json
     """
     from designer.files import check_output
     from designer.model.calibration import calibrate as run_calibrate
     from designer.model.calibration import report
+    from designer.model.plausibility import check_measured
+    from designer.printing.runs import measured, settings_and_coefficients
 
     if out is not None:
         check_output(out, suffixes=[".json"])
-    calibrated = run_calibrate(load_surrogate(surrogate), runs)
+    table, notes = measured(runs, source=runs.name)
+    prior = load_surrogate(surrogate)
+    check_measured(prior, table, accept_implausible=accept_implausible)  # names each print by its id
+    calibrated = run_calibrate(prior, table[settings_and_coefficients(table)], accept_implausible=True)
     finishing()
     if out is not None:
         calibrated.save(out)
-    data = report(calibrated) | {"out": str(out) if out else None}
+    data = report(calibrated) | {"out": str(out) if out else None, "notes": notes}
     if as_json:
         print_json(data)
         return
     _print_calibration(data)
+    for note in notes:
+        console.print(f"- {note}")
     console.print(
         f"surrogate id {calibrated.id}" + (f", written to {out}" if out else " (not saved: give -o FILE)")
     )

@@ -35,7 +35,7 @@ import typer  # noqa: E402
 
 from designer.errors import DesignerError  # noqa: E402
 
-from . import common, cosim, design, export, loop, plots, rig, sweep  # noqa: E402
+from . import common, cosim, design, export, loop, plots, printing, rig, sweep  # noqa: E402
 from .common import flag_message  # noqa: E402
 
 try:  # typer 0.28 vendors click
@@ -88,6 +88,7 @@ def _options(
 design.register(design_app)
 design.register(app)
 loop.register(app)
+printing.register(app)
 rig.register(app)
 export.register(app)
 cosim.register(app)

@@ -10,11 +10,18 @@ import typer
 
 from designer.errors import DesignerError
 
-from .common import JsonOpt, console, err_console, finishing, print_json, progress
+from .common import AcceptImplausibleOpt, JsonOpt, console, err_console, finishing, print_json, progress
 
 rig_app = typer.Typer(help="The virtual rig: simulate the study's experiment.", no_args_is_help=True)
 
 _FACTOR_HELP = "specimen factor written to the log's sidecar (give all six, or none)"
+#: identify's runs table of the prints (designer print's)
+RunsOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--runs", help="the prints' runs table (designer print's): fill the row of the print a log names"
+    ),
+]
 
 
 def identify(
@@ -38,12 +45,16 @@ def identify(
             "load_filter, else none)"
         ),
     ] = None,
+    runs: RunsOpt = None,
+    accept_implausible: AcceptImplausibleOpt = False,
     json_out: JsonOpt = False,
 ) -> None:
     """Identify m, c, k per axis from rig logs (F = m r'' + c r' + k r); exit 1 if any log fails.
 
     A force sensor's own low-pass lags the load like a delay and biases c (a 2nd-order Butterworth
     at 200 Hz: about -45 % of c at 0.8 N/mm); give it with --load-filter.
+
+    With --runs, each log's k and c go into the row of the print its sidecar names ({"print": "P1"}).
 
     Example: designer identify run1.csv run2.parquet --load-delay 0.002 -o table.csv
     """
@@ -54,6 +65,8 @@ def identify(
 
     if output is not None:
         check_output(output, suffixes=TABLE_SUFFIXES, inputs=logs)
+    if runs is not None:
+        check_output(runs, suffixes=TABLE_SUFFIXES, inputs=logs)
     if load_delay is not None and load_delay != load_delay:
         raise DesignerError("--load-delay is NaN", "give the delay in seconds, e.g. --load-delay 0.002")
     with progress("identifying") as bar:
@@ -65,6 +78,7 @@ def identify(
         from designer.study.data import write_frame
 
         write_frame(results_table(passed), output)
+    filled = _fill_runs(runs, passed, accept_implausible)
     if json_out:
         print_json(
             {
@@ -73,6 +87,7 @@ def identify(
                 "failed": [str(r.path) for r in results if not r.ok],
                 "warnings": [f"{r.path}: {w}" for r in results for w in r.warnings],
                 "table": str(output) if wrote else None,
+                "runs": filled,
             }
         )
     else:
@@ -83,8 +98,24 @@ def identify(
             console.print(f"wrote {output} ({len(passed)} of {len(results)} logs)")
         elif output is not None:
             console.print(f"no log passed: {output} not written")
+        _print_filled(filled, runs)
     if len(passed) < len(results):
         raise typer.Exit(1)
+
+
+def _fill_runs(runs: Path | None, passed: list, accept_implausible: bool) -> dict | None:
+    """Fill the runs table from the logs that passed; None without --runs or a passed log."""
+    if runs is None or not passed:
+        return None
+    from designer.printing.runs import fill_file
+
+    return fill_file(runs, passed, accept_implausible=accept_implausible)
+
+
+def _print_filled(filled: dict | None, runs: Path | None) -> None:
+    if filled is not None:
+        waiting = f"; not measured yet: {', '.join(filled['waiting'])}" if filled["waiting"] else ""
+        console.print(f"filled {', '.join(filled['filled'])} in {runs}{waiting}")
 
 
 def _print_identification(res) -> None:

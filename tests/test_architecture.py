@@ -20,7 +20,7 @@ README = Path(__file__).resolve().parents[1] / "README.md"
 MAX_LINES = 600
 #: packages of designer/ that are layers of their own; joint.py and mass.py form the `joint` layer,
 #: the other top-level modules the `foundation`
-SUBPACKAGES = ("study", "model", "design", "plots", "rig", "export", "cosim", "sweep", "validate")
+SUBPACKAGES = ("study", "model", "design", "plots", "rig", "printing", "export", "cosim", "sweep", "validate")
 
 
 def _modules() -> dict[str, Path]:

@@ -423,3 +423,12 @@ def test_the_stated_spread_holds_at_the_recommendation_on_mechanism_printers(stu
     z = np.array(z)
     assert 0.6 < z.std() < 1.45 and abs(z.mean()) < 0.6, (z.std(), z.mean())
     assert np.mean(inside) >= 0.85, np.mean(inside)
+
+
+def test_calibrate_reads_an_identify_table_with_its_text_columns(study, table, tmp_path):
+    """identify's table carries the log's name beside the coefficients: calibrate uses the settings and
+    the coefficients and leaves the text alone."""
+    runs = _rows(table, [3, 12], scale=0.8).assign(log=["a.csv", "b.csv"])
+    runs.to_csv(tmp_path / "runs.csv", index=False)
+    cal = designer.calibrate(study, tmp_path / "runs.csv")
+    assert cal.model("k_x").printer_factor().low < 0.8 < cal.model("k_x").printer_factor().high

@@ -62,6 +62,9 @@ def test_first_hour_in_a_fresh_venv(tmp_path):
         "results/arm/timeseries.csv",
         "results/arm.png",
         "profile.html",
+        "prints/plate.3mf",
+        "prints/P1.stl",
+        "prints/runs.csv",
     ):
         assert (checkout / made).stat().st_size > 0, made
     where = subprocess.run(

@@ -23,8 +23,9 @@ from typing import Any
 import numpy as np
 
 from ..errors import DesignerError, number_argument
-from ..model.calibration import new_printer, with_runs
+from ..model.calibration import new_printer
 from ..model.prediction import Prediction
+from ..model.rotational import derived_statement, with_axis, with_runs
 from ..model.surrogate import Surrogate, check_surrogate
 from ..study import space
 from .candidates import Candidate
@@ -312,6 +313,8 @@ def next_prints(
             "not calibrated to your printer yet: P counts how an unmeasured printer may depart from "
             "the study's (suggest states P for the study's own printer)"
         )
+    surrogate = with_axis(surrogate, axis)  # a rotational goal through the PRB relation
+    statements += derived_statement(surrogate, axis)
     sug = suggest(surrogate, k=k, c=c, axis=axis, fixed=fixed, top=POOL, tolerance=tolerance)
     targets = _predictable_targets(sug, axis)
     scorer = _Scorer(surrogate, axis, targets, tolerance)
@@ -319,9 +322,9 @@ def next_prints(
     p_now = float(best.p_within or 0.0)
     goals = {q: t.goal for q, t in sug.targets.items()}
     if not sug.reachable:
-        statements += [st for st in sug.statements if "distinct design" not in st] + [
-            "no print is proposed: the target lies outside what the data supports (see above)"
-        ]
+        statements += [
+            st for st in sug.statements if "distinct design" not in st and not st.startswith("printer:")
+        ] + ["no print is proposed: the target lies outside what the data supports (see above)"]
         return NextPrints(axis, goals, tolerance, best, p_now, False, [], p_now, statements, False)
     chance = _chance_text(best, targets, tolerance)
     if p_now >= stop:
@@ -340,7 +343,9 @@ def next_prints(
     statements += [
         f"the best design now: {chance}, {_doubt_text(surrogate)}; after printing and measuring these "
         f"{len(chosen)}, the best is expected to land with {p_after:.2f}",
-        "then: add the measured coefficients to your runs table, designer calibrate, designer next again",
+        "then: designer print makes them (a 3MF plate, each object with its settings, and the runs table); "
+        "measure each, designer identify fills the table from the rig logs, designer calibrate, "
+        "designer next again",
     ]
     if len(chosen) < n:
         statements.append(f"{len(chosen)} distinct design(s) instead of {n}: the search found no more")

@@ -22,6 +22,7 @@ import numpy as np
 from .. import units
 from ..errors import DesignerError, check_type, number_argument
 from ..model.prediction import Prediction
+from ..model.rotational import PRBSurface, derived_statement, with_axis
 from ..model.surrogate import Surrogate, check_surrogate
 from ..study import space
 from .candidates import Candidate, Suggestion
@@ -49,7 +50,20 @@ def predictability(surrogate: Surrogate, axis: str) -> dict[str, dict[str, Any]]
         m = surrogate.model(f"{q}_{axis}")
         q2 = m.accuracy["q2"]
         label = "nested leave-one-out" if m.loo_nested else "leave-one-out"
-        if not m.predictable:
+        own = int(np.sum(getattr(m, "own", 0)))  # the user's runs of a calibrated response
+        if not m.predictable and own:
+            text = (
+                f"{q}_{axis} is not predictable from the six factors on the study's runs ({label} Q2 = "
+                f"{q2:.2f}): your {own} run(s) set its level for your printer and pin it down near the "
+                "designs you printed; elsewhere its interval stays wide"
+            )
+        elif not m.predictable and isinstance(m, PRBSurface):
+            text = (
+                f"{q}_{axis} is not predictable from the six factors ({q}_{m.base.axis}'s {label} Q2 = "
+                f"{q2:.2f}): its prediction is {q}_{m.base.axis}'s mean carried through the relation, so it "
+                "follows the length alone"
+            )
+        elif not m.predictable:
             text = (
                 f"{q}_{axis} is not predictable from the six factors: no form beats the mean of the "
                 f"runs ({label} Q2 = {q2:.2f}); every design gets the same prediction"
@@ -82,7 +96,7 @@ def suggest(
     Args:
         surrogate: the fitted surrogate (`Surrogate.load()` for the shipped one).
         k, c: a target value, "min" or "max"; None leaves that response free.
-        axis: the surrogate's axis the goals are on.
+        axis: the goals' axis; a rotational one the surrogate lacks comes from x (model.rotational).
         fixed: factors held at a value, e.g. {"width": 4.5}.
         top: how many distinct candidates to return (fewer are explained in `statements`).
         importance, bounds, weight: per response, the composite's importance, the desirability's
@@ -100,6 +114,7 @@ def suggest(
             non-positive target, importance or weight, bounds not enclosing a target, top < 1, or
             tolerance not in (0, 1).
     """
+    surrogate = with_axis(surrogate, axis)  # a rotational goal through the PRB relation
     check_request(surrogate, axis, k is None and c is None, top, tolerance)
     for name, value in (("fixed", fixed), ("importance", importance), ("bounds", bounds), ("weight", weight)):
         if value is not None:
@@ -142,6 +157,19 @@ def suggest(
             "ended at one of these" + (" (the fixed factors leave little to choose)" if fixed else "")
         )
     return sug
+
+
+def printer_statement(surrogate: Surrogate) -> str:
+    """Which printer the predictions and P are for: the study's own, or the user's once calibrated."""
+    if surrogate.calibration is None:
+        return (
+            "printer: the study's own (one Ender 3, one spool of TPU); yours departs from it by a factor "
+            "of its own: designer next states P with that unknown, designer calibrate learns it"
+        )
+    n = len(surrogate.calibration["table"])
+    if not n:
+        return "printer: yours, not measured yet: P counts how it may depart from the study's printer"
+    return f"printer: yours, the study calibrated on {n} run(s) of yours"
 
 
 MAPPING_EXAMPLES = {
@@ -335,6 +363,7 @@ def assess(
             f"+-{100 * tol:.0f} % together with probability {every:.2f} (the product: given the model, "
             "the responses scatter independently)"
         )
+    sug.statements += [printer_statement(surrogate), *derived_statement(surrogate, sug.axis)]
 
 
 def unpredictable_statement(sug: Suggestion, q: str, t: Target, p: Prediction, unit: str) -> str:

@@ -14,6 +14,7 @@ import numpy as np
 
 from ..errors import DesignerError
 from ..study import space
+from . import plausibility
 from .correction import (
     PRINTER_SD,
     CalibratedSurface,
@@ -54,7 +55,9 @@ def new_printer(surrogate: Surrogate, *, printer_sd: float = PRINTER_SD) -> Surr
     )
 
 
-def calibrate(surrogate: Surrogate, runs: Any, *, printer_sd: float = PRINTER_SD) -> Surrogate:
+def calibrate(
+    surrogate: Surrogate, runs: Any, *, printer_sd: float = PRINTER_SD, accept_implausible: bool = False
+) -> Surrogate:
     """The study surrogate updated by a user's measured runs: a printer factor and a local correction.
 
     Args:
@@ -64,13 +67,16 @@ def calibrate(surrogate: Surrogate, runs: Any, *, printer_sd: float = PRINTER_SD
             the surrogate's responses, e.g. k_x and c_x; designer identify's output) with 0 or more
             rows. Responses missing from the table stay as in the prior.
         printer_sd: prior standard deviation of log(printer factor).
+        accept_implausible: take measured values whose implied printer factor lies far outside its
+            prior (a unit slip, refused by default) as they are.
 
     Returns:
         A new `Surrogate` whose responses are `CalibratedSurface`s; with no run, `surrogate` itself.
 
     Raises:
         DesignerError: a malformed table, a factor outside what can be printed, no response of the
-            surrogate's axis in the table, a non-positive coefficient, or printer_sd <= 0.
+            surrogate's axis in the table, a non-positive coefficient, a value no printer can give
+            (`designer.model.plausibility`), or printer_sd <= 0.
     """
     if not isinstance(surrogate, Surrogate) or not surrogate.models:
         raise DesignerError(
@@ -80,6 +86,7 @@ def calibrate(surrogate: Surrogate, runs: Any, *, printer_sd: float = PRINTER_SD
     check_printer_sd(printer_sd)
     prior = surrogate.prior if surrogate.calibration else surrogate
     table = runs_table(runs, prior)
+    plausibility.check_measured(prior, table, accept_implausible=accept_implausible)
     if prior is not surrogate and len(surrogate.calibration["table"]):
         import pandas as pd
 

@@ -438,7 +438,8 @@ def calibrated(prior: S, runs: Any, printer_sd: float) -> S:
     response was not measured)."""
     import pandas as pd
 
-    cols = {str(c): np.asarray(runs[c], dtype=float) for c in runs.keys()}
+    wanted = [*space.FACTOR_NAMES, *prior.responses]  # other columns (a log's name, notes) are not data
+    cols = {c: np.asarray(runs[c], dtype=float) for c in wanted if c in runs.keys()}
     if not cols or not len(cols[space.FACTOR_NAMES[0]]):
         return prior
     n = len(cols[space.FACTOR_NAMES[0]])

@@ -326,33 +326,45 @@ def describe(
             f"{k_lin:.4g} {ku})"
         )
     elif found.name == "backlash":
-        k_model = float(found.solution.beta[2]) * scale
-        play = -2 * v / k_model
-        out["play"] = play
-        ru = units.rig_unit("r", axis)
-        if play > 0:
-            text = (
-                f"backlash: the drive has a dead band of {play:.3g} {ru} ({100 * play / spec.scale_r:.2g} % "
-                f"of the motion's peak) between the position sensor and the specimen, which stands still "
-                f"while the drive crosses it (an encoder on the motor); m, c, k are from the model with it "
-                f"(the linear fit gave k = {k_lin:.4g} {ku}); put the encoder at the specimen or take the "
-                "play out of the drive"
-            )
-        else:
-            text = (
-                f"the load steps by {-2 * v:.3g} {fu} where the deflection changes sign (a preload or a "
-                f"snap-through, the opposite of a dead band); m, c, k are from the model with it (the "
-                f"linear fit gave k = {k_lin:.4g} {ku})"
-            )
+        text = _backlash_text(found, scale, spec, axis, k_lin, out)
     else:
-        source, unit = found.detail["from"], found.detail["from_unit"]
-        share = (
-            f"{100 * v:.2g} % (+/- {100 * se:.2g} %)" if unit == fu else f"{v:.3g} +/- {se:.2g} {fu}/{unit}"
-        )
-        text = (
-            f"cross-talk: the load sensor of {axis} reads {share} of {source}, the load of another axis "
-            f"(a departure no material law explains); m, "
-            f"c, k are from the model with it (the linear fit took it for c = {c_lin:.4g} {cu}, k = "
-            f"{k_lin:.4g} {ku}); decouple the load channels (the sensor's cross-talk matrix)"
-        )
+        text = _crosstalk_text(found, axis, c_lin, k_lin)
     return out | {"text": text}
+
+
+def _backlash_text(
+    found: Departure, scale: float, spec: bandlib.Spectra, axis: str, k_lin: float, out: dict
+) -> str:
+    """A dead band in the drive (or its opposite, a step at the sign change), sized; sets out["play"]."""
+    ku, fu, ru = (units.rig_unit(q, axis) for q in ("k", "F", "r"))
+    v = found.value
+    k_model = float(found.solution.beta[2]) * scale
+    play = -2 * v / k_model
+    out["play"] = play
+    if play > 0:
+        return (
+            f"backlash: the drive has a dead band of {play:.3g} {ru} ({100 * play / spec.scale_r:.2g} % "
+            f"of the motion's peak) between the position sensor and the specimen, which stands still "
+            f"while the drive crosses it (an encoder on the motor); m, c, k are from the model with it "
+            f"(the linear fit gave k = {k_lin:.4g} {ku}); put the encoder at the specimen or take the "
+            "play out of the drive"
+        )
+    return (
+        f"the load steps by {-2 * v:.3g} {fu} where the deflection changes sign (a preload or a "
+        f"snap-through, the opposite of a dead band); m, c, k are from the model with it (the "
+        f"linear fit gave k = {k_lin:.4g} {ku})"
+    )
+
+
+def _crosstalk_text(found: Departure, axis: str, c_lin: float, k_lin: float) -> str:
+    """Another axis's load read by this axis's sensor, with its share."""
+    ku, cu, fu = (units.rig_unit(q, axis) for q in ("k", "c", "F"))
+    v, se = found.value, found.se
+    source, unit = found.detail["from"], found.detail["from_unit"]
+    share = f"{100 * v:.2g} % (+/- {100 * se:.2g} %)" if unit == fu else f"{v:.3g} +/- {se:.2g} {fu}/{unit}"
+    return (
+        f"cross-talk: the load sensor of {axis} reads {share} of {source}, the load of another axis "
+        f"(a departure no material law explains); m, "
+        f"c, k are from the model with it (the linear fit took it for c = {c_lin:.4g} {cu}, k = "
+        f"{k_lin:.4g} {ku}); decouple the load channels (the sensor's cross-talk matrix)"
+    )

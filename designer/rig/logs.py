@@ -111,8 +111,9 @@ class RigLog:
         }
 
 
-#: keys a sidecar may hold: the six factors, and the load channel's lag behind the positions (s)
-SIDECAR_KEYS = ("factors", "load_delay_s", "load_filter")
+#: keys a sidecar may hold: the six factors, the load channel's lag behind the positions (s), the
+#: load sensor's filter, and the id of the print logged (`designer print`'s runs table)
+SIDECAR_KEYS = ("factors", "load_delay_s", "load_filter", "print")
 
 
 def sidecar_path(path: str | Path) -> Path:

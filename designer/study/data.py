@@ -3,7 +3,8 @@
 A coefficient table has one row per specimen: the six factors (`density`, `length`, `width`,
 `height`, `layer`, `raster`) and, per identified axis, `c_<axis>`, `k_<axis>` and optionally
 `m_<axis>`, all in rig units (see `designer.units`). Column names may carry the study's unit
-suffixes (`density_pct`, `k_x_N_per_mm`, ...); a suffix naming another unit is rejected.
+suffixes (`density_pct`, `k_x_N_per_mm`, ...) or a unit in brackets (`density [%]`, `k_x [N/mm]`,
+as `designer print`'s runs table names them); a unit other than the table's is rejected.
 """
 
 from __future__ import annotations
@@ -70,12 +71,12 @@ def axes_present(table: pd.DataFrame) -> list[str]:
 
 
 def _canonical_name(col: str, source: str) -> str | None:
-    """Map a column name to its canonical name, checking any unit suffix (`k_x_N/mm`, or in
-    brackets as spreadsheets write it, `k_x [N/mm]`); None if not ours."""
+    """Map a column name to its canonical name, checking any unit suffix (`length_mm`, or in
+    brackets: `length [mm]`, `k_x [N/mm]`); None if not ours."""
     name = col.strip()
-    bracket = re.match(r"^(.*?)\s*\[\s*(.*?)\s*\]$", name)
-    if bracket:
-        name = f"{bracket[1]}_{bracket[2]}"
+    bracketed = re.fullmatch(r"(\S+)\s*\[\s*(.+?)\s*\]", name)
+    if bracketed:
+        name = f"{bracketed[1]}_{bracketed[2]}"
     for fac, suffixes in _FACTOR_SUFFIXES.items():
         if name == fac:
             return fac
@@ -130,6 +131,13 @@ def normalise(raw: pd.DataFrame, source: str = "table") -> pd.DataFrame:
             "a coefficient table needs density, length, width, height, layer, raster",
         )
     if not axes_present(table):
+        alone = [c for c in coefficient_columns(table) if not c.startswith("m_")]
+        if alone:
+            pairs = ", ".join(f"{'c' if c[0] == 'k' else 'k'}{c[1:]}" for c in alone)
+            raise DesignerError(
+                f"{source}: {', '.join(alone)} without {pairs}",
+                "give both k and c of an axis (designer identify writes both)",
+            )
         raise DesignerError(
             f"{source}: no coefficient columns",
             "give c_<axis> and k_<axis> for at least one axis (x y z theta phi psi)",

@@ -1,0 +1,133 @@
+"""A batch of prints from designs: ids, meshes, settings, and the files a printer and a rig need.
+
+`designs_from` reads the designs of a `designer next --json` (its prints, or its recommendation
+once it says to print it) or `designer suggest --json` (one candidate) output; `prepare` makes the
+specimens, each beam's height in whole layers as the slicer prints it; `write_batch` writes the 3MF
+plate, an STL and a PrusaSlicer `.ini` per print, and the runs table.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from ..errors import DesignerError
+from ..study import space
+from . import runs, settings
+from .plate import write_plate
+from .specimen import Clamp, Specimen, specimen
+
+
+@dataclass(frozen=True)
+class Batch:
+    """Specimens ready to print and what changed on the way from the designs (`notes`)."""
+
+    prints: list[Specimen]
+    notes: list[str] = field(default_factory=list)
+
+
+def designs_from(doc: Mapping[str, Any], candidate: int | None = None) -> list[dict[str, float]]:
+    """The designs of a `designer next --json` or `designer suggest --json` output.
+
+    `next`: every proposed print, or its recommendation when it proposes none (it says to print
+    design #1). `suggest`: candidate `candidate` (1 = the best; default 1).
+
+    Raises:
+        DesignerError: neither output, or a candidate it does not hold.
+    """
+    if not isinstance(doc, Mapping):
+        raise DesignerError(
+            "the file is not a designer next or suggest JSON output",
+            "give what designer next or designer suggest writes as JSON",
+        )
+    if "prints" in doc and "recommendation" in doc:
+        if candidate is not None:
+            raise DesignerError("candidate is for a suggest output", "a next output's prints are all printed")
+        chosen = [p["params"] for p in doc["prints"]] or [doc["recommendation"]["params"]]
+        return [dict(p) for p in chosen]
+    if "candidates" in doc:
+        n = 1 if candidate is None else candidate
+        if not 1 <= n <= len(doc["candidates"]):
+            raise DesignerError(
+                f"candidate={n} is not in the suggestion (it holds {len(doc['candidates'])})",
+                f"give candidate 1 to {len(doc['candidates'])}",
+            )
+        return [dict(doc["candidates"][n - 1]["params"])]
+    raise DesignerError(
+        "the file is neither a designer next nor a designer suggest JSON output",
+        "give what designer next or designer suggest writes as JSON",
+    )
+
+
+def prepare(designs: Sequence[Mapping[str, Any]], ids: Sequence[str], clamp: Clamp | None = None) -> Batch:
+    """The specimens of `designs` (the six settings; a density of "any", a solid section, prints
+    at 100 %) with `ids`, each beam's height rounded to whole layers.
+
+    Raises:
+        DesignerError: a design that cannot be printed, an id that cannot be engraved, a beam that
+            does not fit the clamp.
+    """
+    if len(ids) != len(designs):
+        raise DesignerError(f"{len(ids)} ids for {len(designs)} designs", "give one id per design")
+    prints, notes = [], []
+    for print_id, design in zip(ids, designs, strict=True):
+        params = {n: design[n] for n in space.FACTOR_NAMES if n in design}
+        if params.get("density") == "any":
+            params["density"] = 100.0
+        params = space.check_design(params, allow_extrapolation=True)
+        height = settings.printed_height(params["height"], params["layer"])
+        if abs(height - params["height"]) > 1e-9:
+            notes.append(
+                f"{print_id}: height {params['height']:g} -> {height:g} mm, whole {params['layer']:g} mm "
+                f"layers over the {settings.FIRST_LAYER_MM:g} mm first layer (the height the slicer prints)"
+            )
+            params["height"] = height
+        prints.append(specimen(params, print_id, clamp))
+    return Batch(prints=prints, notes=notes)
+
+
+def write_batch(
+    batch: Batch, folder: str | Path, *, runs_path: str | Path | None = None, axis: str = "x"
+) -> dict[str, Any]:
+    """Write the plate, each print's STL and PrusaSlicer `.ini`, and the runs table.
+
+    The files go into `folder` (filled beside it and moved in at the end); the runs table is
+    `folder/runs.csv`, or `runs_path`, to which the batch's rows are appended when it exists.
+
+    Returns:
+        {"plate": path, "stl": [paths], "ini": [paths], "runs": path}.
+    """
+    from ..files import atomic_folder
+    from ..study.data import write_frame
+
+    existing = runs.read_runs(runs_path) if runs_path is not None and Path(runs_path).exists() else None
+    rows = runs.template([(p.print_id, p.params) for p in batch.prints], axis=axis)
+    if existing is not None:
+        clash = sorted(set(existing[runs.PRINT]) & set(rows[runs.PRINT]))
+        if clash:
+            raise DesignerError(
+                f"{runs_path} already holds print(s) {', '.join(clash)}",
+                "give new print ids (or leave them to designer)",
+            )
+        rows = pd.concat([existing, rows], ignore_index=True)
+    folder = Path(folder)
+    table = Path(runs_path) if runs_path is not None else folder / "runs.csv"
+    with atomic_folder(folder) as stage:
+        write_plate(batch.prints, stage / "plate.3mf")
+        for p in batch.prints:
+            p.mesh.export(stage / f"{p.print_id}.stl")
+            (stage / f"{p.print_id}.ini").write_text(settings.prusa_ini(p.params, p.print_id))
+        if runs_path is None:
+            write_frame(rows, stage / "runs.csv")
+    if runs_path is not None:
+        write_frame(rows, table)
+    return {
+        "plate": str(folder / "plate.3mf"),
+        "stl": [str(folder / f"{p.print_id}.stl") for p in batch.prints],
+        "ini": [str(folder / f"{p.print_id}.ini") for p in batch.prints],
+        "runs": str(table),
+    }

@@ -1,0 +1,145 @@
+"""Slicer settings of one print: the study's process (cubic infill, a 0.8 mm shell from a 0.4 mm
+nozzle, TPU at 210 C on a 60 C bed) and the print's own layer height, infill density and angle.
+
+Two dialects: PrusaSlicer's option names (its `.ini` and the 3MF's `Slic3r_PE` configs) and
+OrcaSlicer / Bambu Studio's (the 3MF's `model_settings.config` and `project_settings.config`).
+Per object go the settings a print varies; the plate-wide ones (printer, filament, temperatures)
+are the same for every print of a batch.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+from ..study import space
+
+#: the study's material and process
+MATERIAL = "TPU"
+NOZZLE_C = 210
+BED_C = 60
+INFILL_PATTERN = "cubic"
+FILAMENT_MM = 1.75
+FIRST_LAYER_MM = 0.2
+#: the wall: two 0.4 mm lines, 0.8 mm, on the sides, top and bottom
+PERIMETERS = round(space.WALL_MM / space.NOZZLE_MM)
+#: TPU prints slowly: the volumetric flow PrusaSlicer caps every move at, mm^3/s
+MAX_FLOW = 2.5
+#: the study's printer, an Ender 3: 220 x 220 mm build plate
+BED_MM = 220.0
+
+
+def solid_layers(layer: float) -> int:
+    """Top and bottom solid layers making at least the 0.8 mm shell at this layer height."""
+    return math.ceil(space.WALL_MM / layer - 1e-9)
+
+
+def _number(value: float) -> str:
+    return f"{value:g}"
+
+
+def prusa_object(params: Mapping[str, float]) -> dict[str, str]:
+    """PrusaSlicer's per-object options of one print (what the 3MF's object config holds)."""
+    layers = str(solid_layers(params["layer"]))
+    return {
+        "layer_height": _number(params["layer"]),
+        "fill_density": f"{_number(params['density'])}%",
+        "fill_pattern": INFILL_PATTERN,
+        "fill_angle": _number(params["raster"]),
+        "perimeters": str(PERIMETERS),
+        "top_solid_layers": layers,
+        "bottom_solid_layers": layers,
+        "top_solid_min_thickness": _number(space.WALL_MM),
+        "bottom_solid_min_thickness": _number(space.WALL_MM),
+    }
+
+
+def prusa_plate() -> dict[str, str]:
+    """PrusaSlicer's plate-wide options: printer, TPU filament, line widths, temperatures.
+
+    Every line is one nozzle wide (0.4 mm), so two perimeters make the 0.8 mm wall; sparse infill is
+    never turned solid for being small (`solid_infill_below_area` 0), which would print a narrow
+    beam solid whatever its density; objects are labelled in the G-code.
+    """
+    width = _number(space.NOZZLE_MM)
+    bed = _number(BED_MM)
+    return {
+        "printer_technology": "FFF",
+        "bed_shape": f"0x0,{bed}x0,{bed}x{bed},0x{bed}",
+        "nozzle_diameter": width,
+        "filament_diameter": _number(FILAMENT_MM),
+        "filament_type": "FLEX",
+        "filament_max_volumetric_speed": _number(MAX_FLOW),
+        "temperature": str(NOZZLE_C),
+        "first_layer_temperature": str(NOZZLE_C),
+        "bed_temperature": str(BED_C),
+        "first_layer_bed_temperature": str(BED_C),
+        "first_layer_height": _number(FIRST_LAYER_MM),
+        "extrusion_width": width,
+        "first_layer_extrusion_width": width,
+        "perimeter_extrusion_width": width,
+        "external_perimeter_extrusion_width": width,
+        "infill_extrusion_width": width,
+        "solid_infill_extrusion_width": width,
+        "top_infill_extrusion_width": width,
+        "solid_infill_below_area": "0",
+        "gcode_label_objects": "1",
+    }
+
+
+def prusa_ini(params: Mapping[str, float], print_id: str) -> str:
+    """A PrusaSlicer config (`--load FILE.ini`) slicing one print as the study printed it."""
+    lines = [f"# print {print_id}: PrusaSlicer settings written by flexjoint designer"]
+    options = prusa_plate() | prusa_object(params)
+    lines += [f"{key} = {value}" for key, value in sorted(options.items())]
+    return "\n".join(lines) + "\n"
+
+
+#: OrcaSlicer / Bambu Studio's names of PrusaSlicer's per-object options
+ORCA_NAMES = {
+    "layer_height": "layer_height",
+    "fill_density": "sparse_infill_density",
+    "fill_pattern": "sparse_infill_pattern",
+    "fill_angle": "infill_direction",
+    "perimeters": "wall_loops",
+    "top_solid_layers": "top_shell_layers",
+    "bottom_solid_layers": "bottom_shell_layers",
+    "top_solid_min_thickness": "top_shell_thickness",
+    "bottom_solid_min_thickness": "bottom_shell_thickness",
+}
+
+
+def orca_object(params: Mapping[str, float]) -> dict[str, str]:
+    """OrcaSlicer / Bambu Studio's per-object options of one print (model_settings.config): the
+    PrusaSlicer options under their names, the line widths and no small infill turned solid."""
+    width = _number(space.NOZZLE_MM)
+    options = {ORCA_NAMES[key]: value for key, value in prusa_object(params).items()}
+    return options | {
+        "outer_wall_line_width": width,
+        "inner_wall_line_width": width,
+        "sparse_infill_line_width": width,
+        "minimum_sparse_infill_area": "0",
+    }
+
+
+def orca_plate() -> dict[str, list[str] | str]:
+    """OrcaSlicer / Bambu Studio's plate-wide options (project_settings.config; filament options are
+    lists, one entry per filament)."""
+    return {
+        "nozzle_diameter": [_number(space.NOZZLE_MM)],
+        "filament_type": [MATERIAL],
+        "filament_diameter": [_number(FILAMENT_MM)],
+        "filament_max_volumetric_speed": [_number(MAX_FLOW)],
+        "nozzle_temperature": [str(NOZZLE_C)],
+        "nozzle_temperature_initial_layer": [str(NOZZLE_C)],
+        "hot_plate_temp": [str(BED_C)],
+        "hot_plate_temp_initial_layer": [str(BED_C)],
+        "initial_layer_print_height": _number(FIRST_LAYER_MM),
+    }
+
+
+def printed_height(height: float, layer: float) -> float:
+    """The beam height a slicer prints: the first layer, then whole layers (a slicer cuts each
+    layer at its middle, so a top between layer boundaries goes up or down by up to half a layer)."""
+    n = math.floor((height - FIRST_LAYER_MM) / layer + 0.5)
+    return round(FIRST_LAYER_MM + max(n, 0) * layer, 6)

@@ -1,0 +1,221 @@
+"""designer print: the specimen meshes, the 3MF plate read back by lib3mf (the 3MF Consortium's
+library), and PrusaSlicer's command line slicing the plate and each STL + .ini: the G-code read back
+(tests/gcode.py) has each object's layer height, infill density and angle, perimeters and
+temperatures as asked, and the printed beam's extents equal l, b, h within 0.05 mm."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import gcode
+import numpy as np
+import pandas as pd
+import pytest
+import trimesh
+from clitools import assert_clean_failure, run_inprocess
+from test_cli_campaign import SIX
+
+from designer.printing import batch, plate, settings
+from designer.printing.specimen import Clamp, specimen
+
+#: three prints that differ in every setting the slicer sees: the study's three layers, both rasters
+DESIGNS = [
+    {"density": 60.0, "length": 24.0, "width": 4.5, "height": 9.0, "layer": 0.16, "raster": 0.0},
+    {"density": 30.0, "length": 20.0, "width": 6.0, "height": 5.5, "layer": 0.2, "raster": 45.0},
+    {"density": 85.0, "length": 28.3, "width": 3.2, "height": 12.0, "layer": 0.12, "raster": 0.0},
+]
+SLICER = shutil.which("prusa-slicer")
+needs_slicer = pytest.mark.skipif(
+    SLICER is None, reason="PrusaSlicer's command line (prusa-slicer) is not installed"
+)
+
+
+@pytest.fixture(scope="module")
+def made(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("prints") / "batch"
+    prepared = batch.prepare(DESIGNS, ["P1", "P2", "P3"])
+    files = batch.write_batch(prepared, folder)
+    return prepared, files
+
+
+def slice_(args: list[str], out: Path) -> gcode.Moves:
+    run = subprocess.run(
+        [SLICER, *args, "--export-gcode", "--output", str(out)], capture_output=True, text=True, timeout=300
+    )
+    assert run.returncode == 0 and out.exists(), run.stdout[-2000:] + run.stderr[-2000:]
+    return gcode.read(out)
+
+
+def test_specimen_is_a_closed_solid_with_its_id_engraved():
+    params = DESIGNS[0]
+    s = specimen(params, "P12")
+    clamp = Clamp()
+    mesh = s.mesh
+    assert mesh.is_watertight and mesh.is_winding_consistent
+    length = 2 * clamp.length + params["length"]
+    assert np.allclose(mesh.bounds, [[0, 0, 0], [length, clamp.width, clamp.height]])
+    solid = (
+        2 * clamp.length * clamp.width * clamp.height + params["length"] * params["width"] * params["height"]
+    )
+    engraved = solid - mesh.volume
+    assert 0 < engraved < clamp.depth * (clamp.length - 2 * clamp.margin) * (clamp.width - 2 * clamp.margin)
+    # the engraving: a section just under the top of the first block has holes, the second none
+    section = mesh.section(plane_origin=[0, 0, clamp.height - clamp.depth / 2], plane_normal=[0, 0, 1])
+    loops = [loop[:, 0].mean() for loop in section.discrete]
+    first = sum(x < clamp.length for x in loops)
+    assert len(loops) - first == 1 and first >= 4  # the block's edge and a hole per stroke group of P, 1, 2
+    # the beam: the section at half its height crosses the gap as a b-wide strip
+    mid = mesh.section(plane_origin=[length / 2, 0, 0], plane_normal=[1, 0, 0])
+    lo, hi = mid.bounds
+    assert np.allclose(hi - lo, [0, params["width"], params["height"]], atol=1e-9)
+
+
+def test_writing_a_plate_leaves_the_locale(made, tmp_path):
+    import locale
+
+    before = locale.setlocale(locale.LC_ALL)
+    plate.write_plate(made[0].prints[:1], tmp_path / "one.3mf")
+    assert locale.setlocale(locale.LC_ALL) == before  # lib3mf's writer sets the C locale and leaves it
+
+
+def test_plate_reads_back_in_lib3mf(made):
+    import lib3mf
+
+    prepared, files = made
+    wrapper = lib3mf.get_wrapper()
+    model = wrapper.CreateModel()
+    reader = model.QueryReader("3mf")
+    reader.SetStrictModeActive(True)
+    reader.AddRelationToRead(plate.RELATIONSHIP)
+    reader.ReadFromFile(files["plate"])
+    assert reader.GetWarningCount() == 0
+    objects = model.GetMeshObjects()
+    found = {}
+    while objects.MoveNext():
+        obj = objects.GetCurrentMeshObject()
+        assert obj.IsManifoldAndOriented()
+        found[obj.GetName()] = (obj.GetModelResourceID(), obj.GetVertexCount(), obj.GetTriangleCount())
+    assert {p.print_id: (len(p.mesh.vertices), len(p.mesh.faces)) for p in prepared.prints} == {
+        n: v[1:] for n, v in found.items()
+    }
+    items = model.GetBuildItems()
+    spots = []
+    while items.MoveNext():
+        spots.append(tuple(items.GetCurrent().GetObjectTransform().Fields[3][:2]))
+    assert len(spots) == 3 and len(set(spots)) == 3
+    attachments = {model.GetAttachment(i).GetPath() for i in range(model.GetAttachmentCount())}
+    assert attachments == {plate.PRUSA_PLATE, plate.PRUSA_OBJECTS, plate.ORCA_OBJECTS, plate.ORCA_PLATE}
+    # each dialect's object settings name the 3D model's resource ids
+    for uri, keys in (
+        (plate.PRUSA_OBJECTS, ("layer_height", "fill_density", "fill_angle")),
+        (plate.ORCA_OBJECTS, ("layer_height", "sparse_infill_density", "infill_direction")),
+    ):
+        root = ET.fromstring(bytes(model.FindAttachment(uri).WriteToBuffer()))
+        for obj in root.iter("object"):
+            meta = {m.get("key"): m.get("value") for m in obj.findall("metadata")}
+            rid, *_ = found[meta["name"]]
+            assert int(obj.get("id")) == rid
+            params = next(p.params for p in prepared.prints if p.print_id == meta["name"])
+            assert [meta[k] for k in keys] == [
+                f"{params['layer']:g}",
+                f"{params['density']:g}%",
+                f"{params['raster']:g}",
+            ]
+    project = json.loads(bytes(model.FindAttachment(plate.ORCA_PLATE).WriteToBuffer()))
+    assert project["nozzle_temperature"] == ["210"] and project["hot_plate_temp"] == ["60"]
+
+
+def check_gcode(moves: gcode.Moves, obj: str, params: dict) -> None:
+    """Everything the print asked of the slicer, read back from its G-code."""
+    clamp = Clamp()
+    assert list(gcode.layer_heights(moves, obj)) == [params["layer"]]
+    z = (params["height"] + clamp.height) / 2  # a layer through the blocks only
+    raster = params["raster"]
+    assert gcode.infill_directions(moves, obj, z) == sorted((raster + d) % 180 for d in (0, 60, 120))
+    assert gcode.infill_density(moves, obj, z, raster) == pytest.approx(params["density"], abs=0.5)
+    assert gcode.perimeters(moves, obj, z) == 2
+    length, width, height = gcode.beam(moves, obj, above=z, within=params["height"] / 2)
+    assert abs(length - params["length"]) < 0.05
+    assert abs(width - params["width"]) < 0.05
+    assert abs(height - params["height"]) < 0.05
+
+
+@needs_slicer
+def test_prusaslicer_slices_the_plate_as_asked(made, tmp_path):
+    prepared, files = made
+    moves = slice_([files["plate"]], tmp_path / "plate.gcode")
+    assert set(moves.objects) - {""} == {"P1", "P2", "P3"}
+    assert set(moves.nozzle_c) - {0.0} == {settings.NOZZLE_C} and set(moves.bed_c) == {settings.BED_C}
+    for p in prepared.prints:
+        check_gcode(moves, p.print_id, p.params)
+
+
+@needs_slicer
+@pytest.mark.parametrize("i", [0, 1, 2])
+def test_prusaslicer_slices_each_stl_with_its_ini(made, tmp_path, i):
+    prepared, files = made
+    p = prepared.prints[i]
+    moves = slice_(["--load", files["ini"][i], files["stl"][i]], tmp_path / f"{p.print_id}.gcode")
+    assert set(moves.nozzle_c) - {0.0} == {settings.NOZZLE_C} and set(moves.bed_c) == {settings.BED_C}
+    check_gcode(moves, f"{p.print_id}.stl", p.params)
+
+
+def test_heights_are_whole_layers_and_said_so(made):
+    prepared, _ = made
+    heights = {p.print_id: p.params["height"] for p in prepared.prints}
+    assert heights == {"P1": 9.0, "P2": 5.4, "P3": 11.96}  # 0.2 mm + whole layers, the nearest
+    assert [n.split(":")[0] for n in prepared.notes] == ["P2", "P3"]
+
+
+def test_runs_template(made):
+    _, files = made
+    runs = pd.read_csv(files["runs"])
+    assert list(runs.columns) == [
+        "print",
+        "density [%]",
+        "length [mm]",
+        "width [mm]",
+        "height [mm]",
+        "layer [mm]",
+        "raster [deg]",
+        "k_x [N/mm]",
+        "c_x [N.s/mm]",
+        "log",
+    ]
+    assert (
+        list(runs["print"]) == ["P1", "P2", "P3"] and runs[["k_x [N/mm]", "c_x [N.s/mm]"]].isna().all().all()
+    )
+
+
+def test_print_cli_design_and_bad_input(tmp_path, capsys):
+    out = tmp_path / "one"
+    args = ["print", *SIX]
+    code, text, err = run_inprocess([*args, "-o", out], capsys)
+    assert code == 0, err
+    assert "P1: infill 60 %" in text and sorted(p.name for p in out.iterdir()) == [
+        "P1.ini",
+        "P1.stl",
+        "plate.3mf",
+        "runs.csv",
+    ]
+    assert trimesh.load(out / "P1.stl").is_watertight
+    # a second batch appended to the first one's table continues its ids
+    code, text, err = run_inprocess([*args, "--runs", out / "runs.csv", "-o", tmp_path / "two"], capsys)
+    assert code == 0, err
+    assert (
+        list(pd.read_csv(out / "runs.csv")["print"]) == ["P1", "P2"]
+        and (tmp_path / "two" / "P2.stl").exists()
+    )
+    for bad, words in (
+        (["print", "--density", "60", "-o", tmp_path / "x"], "missing --length"),
+        ([*args, "--id", "Q!", "-o", tmp_path / "x"], "cannot be engraved"),
+        ([*args, "--block-width", "4", "-o", tmp_path / "x"], "does not fit"),
+        (["print", "--from", tmp_path / "none.json", "-o", tmp_path / "x"], "no such file"),
+    ):
+        code, _, err = run_inprocess(bad, capsys)
+        assert_clean_failure(code, err, allowed=(2,))
+        assert words in err, err
