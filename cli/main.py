@@ -149,6 +149,17 @@ def _os_message(exc: OSError) -> tuple[str, str]:
     """An operating-system error as (problem, fix)."""
     where = f" ({exc.filename})" if exc.filename else ""
     if exc.errno in (errno.ENOSPC, errno.EDQUOT):
+        import shutil
+        import tempfile
+
+        tmp = tempfile.gettempdir()
+        inside = str(exc.filename or "").startswith(tmp + os.sep)
+        # no file named (an archive unpacked, a library's own write): the temporary folder, if it is full
+        if inside or (exc.filename is None and shutil.disk_usage(tmp).free < 1 << 20):
+            return (
+                f"the temporary folder is full ({tmp}, TMPDIR)",
+                "free some space there, or point TMPDIR to a folder with room",
+            )
         return f"the disk is full{where}", "free some space or write to another disk"
     if exc.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
         return f"permission denied{where}", "choose a path you can read or write"
@@ -185,8 +196,22 @@ def run(argv: list[str] | None = None) -> int:
         return _run(args, debug)
 
 
+def _check_tmpdir() -> None:
+    """Refuse a TMPDIR that is not a writable folder before any work: Python falls back to /tmp
+    silently, but the co-simulation libraries write there and crash (libcosimpy: SIGSEGV).
+
+    Raises:
+        DesignerError: naming TMPDIR and its value.
+    """
+    folder = os.environ.get("TMPDIR")
+    if folder and not (os.path.isdir(folder) and os.access(folder, os.W_OK | os.X_OK)):
+        why = "is not a writable folder" if os.path.isdir(folder) else "does not exist"
+        raise DesignerError(f"TMPDIR={folder} {why}", "create it, or point TMPDIR to a writable folder")
+
+
 def _run(args: list[str], debug: bool) -> int:
     try:
+        _check_tmpdir()
         chosen = design_app if args[:1] and args[0] in DESIGN_COMMANDS else app
         code = chosen(args=args, prog_name="designer", standalone_mode=False)
         if RECEIVED or code == 130:
