@@ -119,7 +119,7 @@ def derived_statement(surrogate: Surrogate, axis: str) -> list[str]:
 def with_axis(surrogate: Surrogate, axis: str) -> Surrogate:
     """`surrogate` with k and c of rotational `axis` derived from its translational x axis when it
     has no such axis of its own; otherwise `surrogate` unchanged (its checks name what is missing)."""
-    if axis in surrogate.axes or not units.is_rotational(axis) or SOURCE_AXIS not in surrogate.axes:
+    if not units.is_rotational(axis) or axis in surrogate.axes or SOURCE_AXIS not in surrogate.axes:
         return surrogate
     lengths = np.asarray(surrogate.training["length"], dtype=float)
     scale = (PRB_GAMMA * lengths) ** 2
