@@ -11,6 +11,19 @@ sys.path[:] = [p for p in sys.path if os.path.abspath(p or os.curdir) != _root]
 # current directory (often the checkout) off sys.path.
 
 
+_START = os.getcwd()
+
+
+@pytest.fixture(autouse=True)
+def _start_in_the_starting_folder():
+    """Every test starts in the folder pytest started in. A test (or a library it drives) that leaves
+    the process in another folder, or in one since removed, must not break the tests after it: on the
+    whole suite the in-process commands after one such test failed with 'getcwd failed' and
+    FileNotFoundError (sbatch, Drake and fmpy likewise), while every file passed on its own."""
+    os.chdir(_START)
+    yield
+
+
 @pytest.fixture(scope="module")
 def fmu_cache(tmp_path_factory):
     """Build FMU binaries into a throw-away cache, never the user's (one per test module)."""
