@@ -48,7 +48,8 @@ API (designs are mappings or DataFrames with the columns ``FACTORS``, in the stu
 length/width/height mm, layer mm, raster deg):
 - ``Truth(draw=None, scale=DEPARTURE_SCALE)``: ``k(designs)`` N/mm, ``c(designs)`` N.s/mm,
   ``solid_fraction(designs)`` (arrays).
-- ``Printer(seed, drawn=False, scale=DEPARTURE_SCALE, mechanism=None)``: ``factor_k``, ``factor_c``, ``k(designs)``,
+- ``Printer(seed, drawn=False, scale=DEPARTURE_SCALE, mechanism=None)``: ``factor_k``, ``factor_c``,
+  ``k(designs)``,
   ``c(designs)`` (its truth), ``prints(designs, rng)`` -> a coefficient table (``density_pct,
   length_mm, width_mm, height_mm, layer_mm, raster_deg, k_x_N_per_mm, c_x_Ns_per_mm``), one row per
   print.
