@@ -24,6 +24,7 @@ import functools
 import importlib
 import itertools
 import shutil
+from abc import ABC, abstractmethod
 from collections import deque
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -185,7 +186,7 @@ def _same_instant_capable(md) -> bool:
     )
 
 
-class FmiMode:
+class FmiMode(ABC):
     """How an FMU is driven (the master's view of one FMI interface): `name`, `feedthrough`, its
     model description element (`element`) and fmpy's class (FMU2<fmpy>, FMU3<fmpy>)."""
 
@@ -202,17 +203,17 @@ class FmiMode:
         """fmpy's class for an instance of this interface in FMI `version`."""
         return getattr(importlib.import_module(f"fmpy.fmi{version}"), f"FMU{version}{self.fmpy}")
 
+    @abstractmethod
     def initialized(self, system: FmuSystem) -> None:
         """What follows Initialization Mode."""
-        raise NotImplementedError
 
+    @abstractmethod
     def step(self, system: FmuSystem, h: float) -> None:
         """One macro step of `h` s."""
-        raise NotImplementedError
 
+    @abstractmethod
     def kernel_calls(self) -> list[str]:
         """The FMI calls the compiled kernel makes per step besides set and get (binding.CALLS)."""
-        raise NotImplementedError
 
 
 class CoSimulation(FmiMode):

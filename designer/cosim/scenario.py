@@ -14,6 +14,7 @@ decide which type a scenario is. The README documents every key.
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -94,7 +95,7 @@ Laws = Mapping[str, Mapping[str, float]]
 
 
 @dataclass(frozen=True)
-class Scenario:
+class Scenario(ABC):
     """A scenario; times in s, paths absolute. The fields every scenario has are here; the two types
     add theirs (`RobotScenario`: joints, motors, model, lengths, masses; `RigScenario`: rig_joint,
     hub, factors).
@@ -183,48 +184,48 @@ class Scenario:
 
     # ------------------------------------------------------------------ the protocol
 
+    @abstractmethod
     def own_fields(self) -> dict[str, Any]:
         """This type's own fields checked and completed (what `check` replaces them with)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def sources(self) -> dict[str, JointSource]:
         """The joint sources by system name ("rig" for the virtual rig's joint); empty: none given."""
-        raise NotImplementedError
 
+    @abstractmethod
     def signals(self) -> int:
         """How many signals a run records per step (the width of its result)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def wire(self, fmus: Mapping[str, System], step: float) -> Master:
         """The joint FMU systems `fmus` (by system name) wired to the robot or the rig's hub at `step` (s)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def reset(self, master: Master, laws: Callable[[], Laws], step: float) -> None:
         """Bring `master`'s systems other than the joint FMUs back to t = 0 for a case whose joints run
         with `laws()` (SI m, c, k, offset by system) at `step` (s)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def metrics(self, trace: Trace, laws: Laws) -> dict[str, Any]:
         """A run's metrics (see README) from its `trace` and the joints' SI `laws`."""
-        raise NotImplementedError
 
+    @abstractmethod
     def validate(self, trace: Tracer, case: Mapping, laws: Laws, progress: Progress) -> dict[str, Any]:
         """The comparison with this type's reference solution at the validation steps; `trace` runs the
         case at another step (`Session.trace`)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def notes(self, master: Master) -> tuple[str, ...]:
         """What a reader of a run wired by `master` should know (host elements changed, ...)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def write_extra(self, series: Series, folder: Path) -> list[Path]:
         """The files this type writes beside a run's time series and metrics (the rig's log) into
         `folder`; their paths."""
-        raise NotImplementedError
 
+    @abstractmethod
     def factors_of(self, joint: str) -> Mapping[str, float] | None:
         """The print settings the scenario itself states for `joint` (the rig's `factors`), or None."""
-        raise NotImplementedError
 
 
 def check_memory(sc: Scenario, duration: float | None = None) -> None:
