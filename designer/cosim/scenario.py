@@ -14,11 +14,14 @@ decide which type a scenario is. The README documents every key.
 from __future__ import annotations
 
 import math
+import numbers
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, ClassVar
+
+import numpy as np
 
 from .. import units
 from ..errors import DesignerError
@@ -71,7 +74,7 @@ class JointSource:
                     f"parameter '{key}' is not a parameter of axis {self.axis}",
                     f"use {', '.join(f'{self.axis}.{f}' for f in PARAMETER_FIELDS)}",
                 )
-            finite(value, f"parameter '{key}'")
+            parameter_value(name, value, f"parameter '{key}'")
         if self.fmu is None:
             self.joint.axis(self.axis)
             return self
@@ -254,6 +257,23 @@ def finite(value: Any, what: str) -> float:
     """
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise DesignerError(f"{what} = {value!r} is not a finite number", "give a finite number")
+    return float(value)
+
+
+def parameter_value(field: str, value: Any, what: str) -> float | bool:
+    """A joint parameter's value checked: `enabled` a bool (Python's or numpy's), the others a finite
+    number (numpy's float32 and int64 included, a bool not).
+
+    Raises:
+        DesignerError: the value is not of its field's kind, naming `what`.
+    """
+    if field == "enabled":
+        if not isinstance(value, (bool, np.bool_)):
+            raise DesignerError(f"{what} = {value!r} is not true or false", "give True or False")
+        return bool(value)
+    real = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+    if not real or not math.isfinite(value):
+        raise DesignerError(f"{what} = {value!r} is not a finite number", "give its value in SI")
     return float(value)
 
 
