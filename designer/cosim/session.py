@@ -18,12 +18,8 @@ every path, also when `prepare` fails halfway.
 from __future__ import annotations
 
 import contextlib
-import math
-import numbers
 from collections.abc import Mapping
 from pathlib import Path
-
-import numpy as np
 
 from ..errors import DesignerError, check_type, describe
 from ..files import temporary_folder
