@@ -457,3 +457,20 @@ def test_the_reports_leave_one_out_equals_recalibrating_without_each_run(study, 
         errors = np.abs(held.value - y) / y
         assert rep["responses"][r]["loo_user"]["n"] == len(rows)
         assert rep["responses"][r]["loo_user"]["mape"] == pytest.approx(100 * np.median(errors))
+
+
+def test_calibrate_refuses_more_runs_than_it_takes_before_any_work(tmp_path, capsys, table):
+    """Issue 37, cause 6: 10 000 rows reached 7 GB of memory in 20 s with no estimate or limit. Now
+    one line naming the count, the limit and the memory it would need; 2000 rows are calibrated."""
+    from designer.model.calibration import MAX_RUNS
+
+    many = table.sample(MAX_RUNS + 1, replace=True, random_state=0)[FACTORS + ["k_x", "c_x"]]
+    path = tmp_path / "many.csv"
+    many.to_csv(path, index=False)
+    code, _, err = run_inprocess(["calibrate", path, "-o", tmp_path / "o.json"], capsys)
+    assert_clean_failure(code, err, allowed=(2,))
+    assert f"runs has {MAX_RUNS + 1} rows" in err and "designer fit" in err and "about 290 MiB" in err
+    assert not (tmp_path / "o.json").exists()
+    assert (
+        designer.calibrate(Surrogate.load(), many.iloc[:MAX_RUNS]).calibration["table"].shape[0] == MAX_RUNS
+    )
