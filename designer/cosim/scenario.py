@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 import numbers
 from abc import ABC, abstractmethod
+from collections import Counter
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -83,6 +84,9 @@ class JointSource:
         check_fmu(self.fmu, [self.axis])
         return replace(self, fmu=Path(self.fmu))
 
+
+#: the most validation steps a scenario lists: each is a whole run, the order of convergence needs 2
+MAX_VALIDATION_STEPS = 10
 
 #: the one-line refusal of a scenario that is neither (or both) a robot and the rig
 NEITHER = (
@@ -177,6 +181,18 @@ class Scenario(ABC):
         if len(steps) < 2:
             raise DesignerError(
                 f"validation_steps = {list(steps)} lists fewer than two steps", "e.g. [1e-3, 5e-4]"
+            )
+        twice = sorted(s for s, n in Counter(steps).items() if n > 1)
+        if twice:
+            raise DesignerError(
+                f"validation_steps lists {', '.join(f'{s:g}' for s in twice)} more than once",
+                "list each step once, e.g. [1e-3, 5e-4]",
+            )
+        if len(steps) > MAX_VALIDATION_STEPS:
+            raise DesignerError(
+                f"validation_steps lists {len(steps)} steps; a convergence check takes 2 to "
+                f"{MAX_VALIDATION_STEPS}, each run in turn",
+                "list a few steps halving down, e.g. [1e-3, 5e-4, 2.5e-4]",
             )
         span = (
             self.duration
