@@ -33,9 +33,9 @@ def test_the_run_covers_every_row_with_its_rounds_and_load():
 
 def test_the_readme_rewrite_replaces_only_the_table(tmp_path):
     readme = tmp_path / "README.md"
-    readme.write_text(f"before\n{bench_waits.BEGIN}\nold\n{bench_waits.END}\nafter\n")
+    readme.write_text(f"before\n{bench_waits.BEGIN}\nSTALE TABLE\n{bench_waits.END}\nafter\n")
     result = json.loads(bench_waits.RESULTS.read_text())
     bench_waits.write_readme(result, readme)
     text = readme.read_text()
     assert text.startswith(f"before\n{bench_waits.BEGIN}\n") and text.endswith(f"{bench_waits.END}\nafter\n")
-    assert "old" not in text and "\n".join(bench_waits.table_lines(result)) in text
+    assert "STALE TABLE" not in text and "\n".join(bench_waits.table_lines(result)) in text
