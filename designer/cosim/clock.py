@@ -3,9 +3,11 @@
 
 MuJoCo's Python bindings install a clock as the global `mjcb_time`; mj_step reads it around each of
 its stages to fill the profiling timers (`MjData.timer`), nothing else: the physics is the same
-without it, and the engine path's rollouts of 200 example-arm cases take 0.63-0.68x the CPU (issue 38). The compiled kernel
-(fmus/kernel/master.c) does the same around its loops. The clock is given back when the last user in
-the process finishes, so runs in several threads do not lose it.
+without it, and the engine path's rollouts of 200 example-arm cases take 0.63-0.68x the CPU
+(issue 38). The compiled kernel (fmus/kernel/master.c) does the same around its loops. The clock is
+given back when the last user in the process finishes, so runs in several threads do not lose it
+(the kernel keeps its own count: a Python run that ends before an overlapping kernel run in another
+thread of the same process would see the kernel put back the unset clock).
 """
 
 from __future__ import annotations
