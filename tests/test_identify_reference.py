@@ -12,7 +12,6 @@ Regenerate only when a result is meant to change, and say why in the commit:
 """
 
 import json
-import math
 import sys
 from pathlib import Path
 
@@ -21,6 +20,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
 from physics_logs import make_log  # noqa: E402
+from stored_outputs import assert_same  # noqa: E402
 
 from designer.rig.identify import identify  # noqa: E402
 from designer.rig.simulate import simulate  # noqa: E402
@@ -73,25 +73,6 @@ def outcomes(tmp: Path) -> dict:
     return out
 
 
-def _compare(got, want, where: str) -> None:
-    if isinstance(want, dict):
-        assert isinstance(got, dict) and sorted(got) == sorted(want), where
-        for k in want:
-            _compare(got[k], want[k], f"{where}.{k}")
-    elif isinstance(want, list):
-        assert isinstance(got, list) and len(got) == len(want), where
-        for i, (g, w) in enumerate(zip(got, want, strict=True)):
-            _compare(g, w, f"{where}[{i}]")
-    elif isinstance(want, float) and not isinstance(want, bool):
-        assert isinstance(got, (float, int)), where
-        if math.isnan(want):
-            assert math.isnan(got), where
-        else:
-            assert got == pytest.approx(want, rel=1e-12, abs=1e-300), f"{where}: {got!r} != {want!r}"
-    else:
-        assert got == want, f"{where}: {got!r} != {want!r}"
-
-
 @pytest.fixture(scope="module")
 def current(tmp_path_factory):
     return outcomes(tmp_path_factory.mktemp("logs"))
@@ -109,7 +90,7 @@ def test_the_cases_cover_fits_warnings_and_notes():
 @pytest.mark.parametrize("case", [f"{n} [{f}]" for n in CASES for f in FORMATS])
 def test_identify_gives_the_stored_results(current, case):
     want = json.loads(REFERENCE.read_text())[case]
-    _compare(current[case], want, case)
+    assert_same(current[case], want, case)
     for a, fit in want["axes"].items():  # the headline numbers, bit for bit where no reordering happened
         for key in ("k", "c", "k_se", "c_se"):
             if key in fit:

@@ -8,11 +8,12 @@ Regenerate only when a result is meant to change, and say why in the commit:
 """
 
 import json
-import math
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+from stored_outputs import assert_same
 
 import designer
 
@@ -38,30 +39,12 @@ def outputs(folder: Path) -> dict:
     return out
 
 
-def _same(got, want, where: str) -> None:
-    if isinstance(want, dict):
-        assert isinstance(got, dict) and sorted(got) == sorted(want), where
-        for k in want:
-            _same(got[k], want[k], f"{where}.{k}")
-    elif isinstance(want, list):
-        assert isinstance(got, list) and len(got) == len(want), where
-        for i, (g, w) in enumerate(zip(got, want, strict=True)):
-            _same(g, w, f"{where}[{i}]")
-    elif isinstance(want, float) and not isinstance(want, bool):
-        assert isinstance(got, (int, float)), where
-        assert math.isclose(got, want, rel_tol=1e-12, abs_tol=1e-300) or (
-            math.isnan(got) and math.isnan(want)
-        ), f"{where}: {got!r} != {want!r}"
-    else:
-        assert got == want, f"{where}: {got!r} != {want!r}"
-
-
 def test_the_loop_and_suggest_give_the_stored_outputs(tmp_path):
     want = json.loads(REFERENCE.read_text())
     got = outputs(tmp_path)
     assert sorted(got) == sorted(want) == sorted(COMMANDS)
     for name in COMMANDS:
-        _same(got[name], want[name], name)
+        assert_same(got[name], want[name], name)
 
 
 if __name__ == "__main__":

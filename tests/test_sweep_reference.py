@@ -10,9 +10,10 @@ Regenerate only when a result is meant to change, and say why in the commit:
 import ctypes
 import dataclasses
 import json
-import math
 import tempfile
 from pathlib import Path
+
+from stored_outputs import assert_same
 
 from designer import cosim, sweep
 from designer.cosim.kernel_build import mujoco_paths
@@ -46,15 +47,6 @@ def tables(tmp: Path) -> dict[str, list[dict]]:
     return out
 
 
-def _same(got, want, where: str) -> None:
-    if isinstance(want, float) and math.isnan(want):
-        assert isinstance(got, float) and math.isnan(got), f"{where}: {got!r} != nan"
-    elif isinstance(want, float) and isinstance(got, (float, int)):
-        assert math.isclose(got, want, rel_tol=1e-12, abs_tol=1e-300), f"{where}: {got!r} != {want!r}"
-    else:
-        assert got == want, f"{where}: {got!r} != {want!r}"
-
-
 def test_engine_sweep_tables_equal_the_stored_ones_and_mujoco_keeps_its_clock(tmp_path):
     hook = ctypes.c_void_p.in_dll(ctypes.CDLL(str(mujoco_paths()[1])), "mjcb_time")
     before = hook.value
@@ -65,10 +57,7 @@ def test_engine_sweep_tables_equal_the_stored_ones_and_mujoco_keeps_its_clock(tm
     for name, rows in want.items():
         assert [r["status"] for r in rows] == [r["status"] for r in got[name]]
         assert {r["status"] for r in rows} == ({"ok", "failed"} if "grid" in name else {"ok"})
-        for i, (g, w) in enumerate(zip(got[name], rows, strict=True)):
-            assert sorted(g) == sorted(w)
-            for key in w:
-                _same(g[key], w[key], f"{name}[{i}].{key}")
+        assert_same(got[name], rows, name)
 
 
 if __name__ == "__main__":
