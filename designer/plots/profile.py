@@ -58,6 +58,8 @@ _RANGE_POINTS = 5
 PRINT_NOISE: dict[str, float] = {"density": 0.0, "length": 0.1, "width": 0.1, "height": 0.1}
 #: the simulator's Monte Carlo size (draws of the print noise)
 MC_DRAWS = 4000
+#: the page's scripts, in the order the page runs them (each uses what the ones before define)
+SCRIPTS = ("profile_model.js", "profile_search.js", "profile_views.js", "profile_contour.js", "profile_page.js")
 
 
 class _Expr:
@@ -264,10 +266,13 @@ class Profiler:
 
     def to_html(self) -> str:
         """The self-contained page: the template with this data embedded."""
-        template = (resources.files("designer.plots") / "profile.html").read_text(encoding="utf-8")
+        here = resources.files("designer.plots")
+        template = (here / "profile.html").read_text(encoding="utf-8")
+        script = "\n".join((here / name).read_text(encoding="utf-8") for name in SCRIPTS)
         payload = json.dumps(self.data, separators=(",", ":"), allow_nan=False).replace("</", "<\\/")
         title = f"Prediction profiler, axis {self.data['axis']}"
-        return template.replace("__TITLE__", html.escape(title)).replace("__DATA__", payload)
+        page = template.replace("__TITLE__", html.escape(title)).replace("__SCRIPT__", script)
+        return page.replace("__DATA__", payload)
 
 
 def build_profiler(
