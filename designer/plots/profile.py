@@ -59,7 +59,14 @@ PRINT_NOISE: dict[str, float] = {"density": 0.0, "length": 0.1, "width": 0.1, "h
 #: the simulator's Monte Carlo size (draws of the print noise)
 MC_DRAWS = 4000
 #: the page's scripts, in the order the page runs them (each uses what the ones before define)
-SCRIPTS = ("profile_model.js", "profile_search.js", "profile_views.js", "profile_contour.js", "profile_page.js")
+SCRIPTS = (
+    "profile_model.js",
+    "profile_search.js",
+    "profile_views.js",
+    "profile_goals.js",
+    "profile_contour.js",
+    "profile_page.js",
+)
 
 
 class _Expr:
@@ -185,10 +192,8 @@ def _response(surrogate: Surrogate, name: str, statement: str, target: float | s
     }
 
 
-def _suggestions(suggestion: Any) -> list[dict[str, Any]]:
-    """Candidates of a `Suggestion`, of its `to_dict()`, or of a JSON file holding that dict."""
-    if suggestion is None:
-        return []
+def _suggestion_dict(suggestion: Any) -> Any:
+    """A `Suggestion`, its `to_dict()` or the path of a JSON file of it, as the dict."""
     if isinstance(suggestion, str | Path):
         p = Path(suggestion)
         try:
@@ -203,6 +208,14 @@ def _suggestions(suggestion: Any) -> list[dict[str, Any]]:
             ) from None
     if hasattr(suggestion, "to_dict"):
         suggestion = suggestion.to_dict()
+    return suggestion
+
+
+def _suggestions(suggestion: Any) -> list[dict[str, Any]]:
+    """Candidates of a `Suggestion`, of its `to_dict()`, or of a JSON file holding that dict."""
+    if suggestion is None:
+        return []
+    suggestion = _suggestion_dict(suggestion)
     candidates = suggestion.get("candidates") if isinstance(suggestion, Mapping) else None
     if not isinstance(candidates, list):
         raise DesignerError(
@@ -237,6 +250,23 @@ def _suggestions(suggestion: Any) -> list[dict[str, Any]]:
             }
         )
     return out
+
+
+def _suggestion_goals(suggestion: Any) -> dict[str, Any] | None:
+    """The goals and tolerance a suggestion was found for (its buttons grey out once the page's
+    goals differ), or None when it does not record them."""
+    if suggestion is None:
+        return None
+    data = _suggestion_dict(suggestion)
+    targets = data.get("targets") if isinstance(data, Mapping) else None
+    tol = data.get("tolerance") if isinstance(data, Mapping) else None
+    if not isinstance(targets, Mapping) or not isinstance(tol, int | float):
+        return None
+    goals = {}
+    for q in ("k", "c"):
+        v = targets.get(q)
+        goals[q] = float(v) if isinstance(v, int | float) else v if v in ("min", "max") else None
+    return {"targets": goals, "tolerance": float(tol)}
 
 
 def _within(f: space.Factor, v: float) -> bool:
@@ -309,6 +339,7 @@ def build_profiler(
             f"tolerance={tolerance!r} is not a fraction between 0 and 1", "give e.g. tolerance=0.1"
         )
     start = space.check_design(DEFAULT_DESIGN | dict(design or {}))
+    suggestion = None if suggestion is None else _suggestion_dict(suggestion)
     from ..design.suggestions import predictability
 
     info = predictability(surrogate, axis)
@@ -341,6 +372,7 @@ def build_profiler(
             "runs": runs,
             "tolerance": float(tolerance),
             "suggestions": _suggestions(suggestion),
+            "suggestion_goals": _suggestion_goals(suggestion),
             "wall_mm": space.WALL_MM,
             "nozzle_mm": space.NOZZLE_MM,
             "search": _search_data(),

@@ -124,20 +124,33 @@ function tcdf(t, nu) {
   const p = 0.5 * ibeta(nu / (nu + t * t), nu / 2, 0.5);
   return t > 0 ? 1 - p : p;
 }
-// probability that a printed joint lands within the tolerance of the target (predictive t distribution)
-// probability that a printed joint lands within the tolerance of the target (predictive t distribution)
-function pWithin(r, p, target) {
-  const tr = r.transform === "log" ? Math.log : (v) => v;
-  const lo = tr(target * (1 - tolerance)), hi = tr(target * (1 + tolerance));
-  return tcdf((hi - p.mean) / p.scale, r.dof) - tcdf((lo - p.mean) / p.scale, r.dof);
+// probability that a printed joint lands between two limits (designer.design.targets.probability_between):
+// the predictive t distribution in the form's fit space; under the log a lower limit at or below 0 counts as 0
+function pBetween(r, p, low, high) {
+  const log = r.transform === "log", tr = log ? Math.log : (v) => v;
+  const upper = tcdf((tr(high) - p.mean) / p.scale, r.dof);
+  const lower = log && low <= 0 ? 0 : tcdf((tr(low) - p.mean) / p.scale, r.dof);
+  return Math.max(0, Math.min(1, upper - lower));
 }
-// a goal with its Derringer-Suich bounds, as designer.design.targets.make_target sets them
-function makeGoal(r, kind, value) {
+// the limits a goal is met within: +- the tolerance around a target value, or the goal's own low and high limits
+function limitsOf(g) {
+  if (!g) return null;
+  if (g.kind === "target") return [g.value * (1 - tolerance), g.value * (1 + tolerance)];
+  if (g.kind === "limits") return [g.lsl, g.usl];
+  return null;
+}
+// probability that a printed joint meets goal g (null for min and max, which have no limits)
+function pGoal(r, p, g) { const l = limitsOf(g); return l ? pBetween(r, p, l[0], l[1]) : null; }
+// a goal with its Derringer-Suich bounds, as designer.design.targets.make_target sets them; limits
+// [low, high] are a target at their midpoint met between them (the search aims at the midpoint)
+function makeGoal(r, kind, value, limits) {
   const [lo, hi] = r.observed;
   if (kind === "none") return null;
-  if (kind !== "target") return { kind: kind, value: null, low: lo, high: hi, importance: 1, weight: 1 };
-  if (!(value > 0) || !isFinite(value)) return undefined;
-  return { kind: "target", value: value, low: Math.min(lo, 0.5 * value), high: Math.max(hi, 1.5 * value), importance: 1, weight: 1 };
+  if (kind === "min" || kind === "max") return { kind: kind, value: null, low: lo, high: hi, importance: 1, weight: 1 };
+  const v = kind === "limits" ? 0.5 * (limits[0] + limits[1]) : value;
+  const g = { kind: kind, value: v, low: Math.min(lo, 0.5 * v), high: Math.max(hi, 1.5 * v), importance: 1, weight: 1 };
+  if (kind === "limits") { g.lsl = limits[0]; g.usl = limits[1]; }
+  return g;
 }
 // Derringer-Suich desirability, as designer.design.targets' Target does it
 function desirability(t, y) {
@@ -147,20 +160,24 @@ function desirability(t, y) {
   if (y <= t.low || y >= t.high) return 0;
   return (y <= t.value ? (y - t.low) / (t.value - t.low) : (t.high - y) / (t.high - t.value)) ** t.weight;
 }
-// how a design meets the goals (designer.design.suggestions.rank): P over the predictable targets, composite D
+// how a design meets the goals (designer.design.suggestions.rank): P over the predictable goals with
+// limits (what maximize ranks by), the joint P over every stated goal with limits, the predictable and
+// the unpredictable alike (the product, as suggest's "every goal at once": given the model the responses
+// scatter independently), and the composite desirability D of the predictable responses
 function score(x) {
   const pred = {}, prob = {}, ds = [];
-  let p = null;
+  let p = null, joint = null;
   for (const r of R) {
     const y = predict(r, x), g = goals[r.name];
     pred[r.name] = y;
     if (!g) continue;
-    if (g.kind === "target") prob[r.name] = pWithin(r, y, g.value);
+    const pg = pGoal(r, y, g);
+    if (pg !== null) { prob[r.name] = pg; joint = (joint === null ? 1 : joint) * pg; }
     if (!r.predictable) continue;
     ds.push([desirability(g, y.value), g.importance]);
-    if (g.kind === "target") p = (p === null ? 1 : p) * prob[r.name];
+    if (pg !== null) p = (p === null ? 1 : p) * pg;
   }
   const wsum = ds.reduce((a, [, w]) => a + w, 0);
   const d = ds.length ? ds.reduce((a, [v, w]) => a * Math.pow(v, w / wsum), 1) : null;
-  return { pred: pred, prob: prob, p: p, d: d };
+  return { pred: pred, prob: prob, p: p, joint: joint, d: d };
 }

@@ -8,7 +8,7 @@ function weights() {
     const t = goals[r.name];
     if (!t || !r.predictable) continue;
     const scale = t.high - t.low, e = { goal: 1, wsq: 0, wlin: 0, wpi: D.search.pi_weight * t.importance / (scale * scale) };
-    if (t.kind === "target") { e.goal = t.value; e.wsq = t.importance / (scale * scale); }
+    if (t.value !== null) { e.goal = t.value; e.wsq = t.importance / (scale * scale); }
     else e.wlin = (t.kind === "min" ? 1 : -1) * t.importance / scale;
     w[r.name] = e;
   }
@@ -93,30 +93,48 @@ function cholesky(A) {
   }
   return L;
 }
-function maximize() {
-  const w = weights(), names = FC.map((f) => f.name);
-  if (!Object.keys(w).length) return null;
-  const fixed = {};
+// the search box: the locked factors held (density at 100 % where a locked width or height is solid),
+// the rest over their tested ranges in coded units u in [0, 1]
+function searchBox() {
+  const names = FC.map((f) => f.name), fixed = {};
   for (const f of F) if (locked[f.name]) fixed[f.name] = state[f.name];
   const thin = ["width", "height"].some((n) => n in fixed && fixed[n] - 2 * D.wall_mm <= D.nozzle_mm + 1e-9);
   if (thin) fixed.density = 100;
   const lows = FC.map((f) => f.low), spans = FC.map((f) => f.high - f.low), lb = names.map(() => 0), ub = names.map(() => 1);
   names.forEach((n, i) => { if (n in fixed) lb[i] = ub[i] = (fixed[n] - lows[i]) / spans[i]; });
+  const design = (u, combo) => {
+    const x = {};
+    names.forEach((n, i) => { x[n] = lows[i] + spans[i] * u[i]; });
+    FK.forEach((f, i) => { x[f.name] = combo[i]; });
+    return x;
+  };
+  return { names: names, fixed: fixed, lows: lows, spans: spans, lb: lb, ub: ub, combos: combos(fixed), design: design };
+}
+// smallest and largest predicted value of a response over the search box, as designer.design.search's
+// reachable_range finds them (per level combination, from the box's centre; each extreme as printed),
+// widened by the search's starts
+function predictedRange(r) {
+  const b = searchBox(), values = [];
+  for (const combo of b.combos) for (const sign of [1, -1]) {
+    const cost = (u) => sign * predictRaw(r, b.design(u, combo)).value;
+    for (const u0 of [b.names.map(() => 0.5)].concat(D.search.starts.slice(0, 2)))
+      values.push(predict(r, b.design(minimize(cost, u0, b.lb, b.ub), combo)).value);
+  }
+  return [Math.min(...values), Math.max(...values)];
+}
+function maximize() {
+  const w = weights(), b = searchBox(), { names, fixed, lows, spans, lb, ub } = b;
+  if (!Object.keys(w).length) return null;
   const iw = names.indexOf("width"), id = names.indexOf("density"), slb = lb.slice(), sub = ub.slice();
   slb[iw] = sub[iw] = (2 * D.wall_mm + D.nozzle_mm - lows[iw]) / spans[iw];
   slb[id] = sub[id] = (100 - lows[id]) / spans[id];
   const maybeSolid = !("width" in fixed) && !("density" in fixed) && slb[iw] >= 0 && slb[iw] <= 1;
   const held = {};
   for (const n of names) if (n in fixed) held[n] = fixed[n];
-  const cs = combos(fixed), starts = D.search.starts.slice(0, Math.max(2, Math.ceil(D.search.n_starts / cs.length)));
+  const cs = b.combos, starts = D.search.starts.slice(0, Math.max(2, Math.ceil(D.search.n_starts / cs.length)));
   const raw = [];
   for (const combo of cs) {
-    const design = (u) => {
-      const x = {};
-      names.forEach((n, i) => { x[n] = lows[i] + spans[i] * u[i]; });
-      FK.forEach((f, i) => { x[f.name] = combo[i]; });
-      return x;
-    };
+    const design = (u) => b.design(u, combo);
     const cost = (u) => {
       const x = design(u);
       let c = 0;

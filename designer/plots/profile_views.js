@@ -37,18 +37,18 @@ function rng(seed) {
 const noise = Object.assign({}, D.noise);
 function simulate(x) {
   const n = D.mc_draws, normal = rng(20251125), out = {};
-  const rs = R.filter((r) => r.predictable && goals[r.name] && goals[r.name].kind === "target");
+  const rs = R.filter((r) => r.predictable && limitsOf(goals[r.name]));
   for (const r of rs) out[r.name] = { sum: 0, sum2: 0 };
   let outside = 0;
   for (let i = 0; i < n; i++) {
     const y = Object.assign({}, x);
     for (const f of FC) y[f.name] += (noise[f.name] || 0) * normal();
     if (FC.some((f) => y[f.name] < f.low || y[f.name] > f.high)) outside++;
-    for (const r of rs) { const p = pWithin(r, predict(r, y), goals[r.name].value); out[r.name].sum += p; out[r.name].sum2 += p * p; }
+    for (const r of rs) { const p = pGoal(r, predict(r, y), goals[r.name]); out[r.name].sum += p; out[r.name].sum2 += p * p; }
   }
   for (const r of rs) {
     const o = out[r.name], mean = o.sum / n, v = Math.max(o.sum2 / n - mean * mean, 0) * n / (n - 1);
-    o.defect = 1 - mean; o.se = Math.sqrt(v / n); o.noiseless = 1 - pWithin(r, predict(r, x), goals[r.name].value);
+    o.defect = 1 - mean; o.se = Math.sqrt(v / n); o.noiseless = 1 - pGoal(r, predict(r, x), goals[r.name]);
   }
   return { draws: n, outside: outside / n, responses: out };
 }
@@ -78,7 +78,7 @@ function renderSim() {
   if (!names.length) { el.textContent = "set a target on a predictable response to get a defect rate"; return; }
   el.innerHTML = names.map((n) => {
     const o = s.responses[n];
-    return '<div id="sim-' + n + '" data-defect="' + o.defect + '" data-se="' + o.se + '" data-noiseless="' + o.noiseless + '">' + esc(n) + ": defect rate (outside \u00b1" + sig(100 * tolerance, 3) + " % of " + sig(goals[n].value, 4) + ") " +
+    return '<div id="sim-' + n + '" data-defect="' + o.defect + '" data-se="' + o.se + '" data-noiseless="' + o.noiseless + '">' + esc(n) + ": defect rate (outside " + limitsText(R.find((r) => r.name === n), goals[n]) + ") " +
       mcText(o) + " (" + s.draws + " draws)</div>";
   }).join("") + (s.outside > 0 ? '<div class="sub">' + (100 * s.outside).toFixed(1) + " % of draws fall outside the tested ranges: predicted by extrapolation</div>" : "");
 }
@@ -98,7 +98,7 @@ function commandLine(m, i) {
   return "designer export fmu " + F.map((f) => "--" + f.name + " " + sig(m.params[f.name], 6)).join(" ") + (D.axis === "x" ? "" : " --axis " + D.axis) + " -o joint" + (i + 1) + ".fmu";
 }
 function suggestionJson() {
-  const goal = (q) => { const r = R.find((x) => x.quantity === q), g = r && goals[r.name]; return !g ? null : g.kind === "target" ? g.value : g.kind; };
+  const goal = (q) => { const r = R.find((x) => x.quantity === q), g = r && goals[r.name]; return !g ? null : g.value !== null ? g.value : g.kind; };
   return JSON.stringify({ axis: D.axis, targets: { k: goal("k"), c: goal("c") }, tolerance: tolerance, surrogate_id: D.surrogate_id, fixed: {},
     statements: ["settings remembered on the profiler page"], candidates: memory.map((m) => ({ params: m.params, any: m.any, predicted: m.predicted,
       p_within: m.p_within, probability: m.probability, desirability: m.desirability })) }, null, 1);
@@ -155,11 +155,6 @@ function panel(r, f, first) {
   s += '<g clip-path="url(#c-' + r.name + f.name + ')">';
   if (f.printable_min !== null && f.printable_min > f.low)
     s += '<rect x="' + ML + '" y="' + MT + '" width="' + (xpos(Math.min(f.printable_min, f.high)) - ML) + '" height="' + (PH - MT - MB) + '" fill="#b3261e" opacity="0.08"/>';
-  if (g && g.kind === "target" && r.predictable) {
-    const t = g.value;
-    s += '<rect x="' + ML + '" width="' + (PW - ML - MR) + '" y="' + ys(t * (1 + tolerance)) + '" height="' + (ys(t * (1 - tolerance)) - ys(t * (1 + tolerance))) + '" fill="#b3261e" opacity="0.10"/>';
-    s += '<line x1="' + ML + '" x2="' + (PW - MR) + '" y1="' + ys(t) + '" y2="' + ys(t) + '" stroke="#b3261e" stroke-width="1.5" stroke-dasharray="5 3"/>';
-  }
   if (cat) pts.forEach(([, p], i) => {
     const X = xpos(i);
     s += '<line x1="' + X + '" x2="' + X + '" y1="' + ys(p.low) + '" y2="' + ys(p.high) + '" stroke="#5b7fcf" stroke-width="6" opacity="0.45"/>';
@@ -174,6 +169,7 @@ function panel(r, f, first) {
     s += '<polygon points="' + lo.concat(hi).join(" ") + '" fill="#5b7fcf" opacity="0.25"/>';
     s += '<polyline points="' + mid.join(" ") + '" fill="none" stroke="#1f5fbf" stroke-width="2"/>';
   }
+  s += bandSvg(g, ys);
   for (let j = 0; j < D.runs[r.name].length; j++) {
     if (!near(j, f.name)) continue;
     const v = D.runs[f.name][j], X = cat ? xpos(lvl(v)) + 9 : xpos(v);
@@ -191,6 +187,16 @@ function panel(r, f, first) {
   }
   s += '<text x="' + ((ML + PW - MR) / 2) + '" y="' + (PH - 5) + '" font-size="11.5" text-anchor="middle">' + esc(f.name + " (" + f.unit + ")") + "</text>";
   return s + "</svg>";
+}
+// the goal's limits (+- the tolerance, or low and high) drawn over the interval shading: an orange
+// fill and solid red edges, so the band reads against the blue; the target itself dashed
+function bandSvg(g, ys) {
+  const l = limitsOf(g);
+  if (!l) return "";
+  const top = ys(l[1]), bottom = ys(l[0]), edge = (y) => '<line class="band-edge" x1="' + ML + '" x2="' + (PW - MR) + '" y1="' + y + '" y2="' + y + '" stroke="#b3261e" stroke-width="1.5"/>';
+  let s = '<rect class="band" x="' + ML + '" width="' + (PW - ML - MR) + '" y="' + top + '" height="' + (bottom - top) + '" fill="#f08c00" opacity="0.35"/>' + edge(top) + edge(bottom);
+  if (g.kind === "target") s += '<line x1="' + ML + '" x2="' + (PW - MR) + '" y1="' + ys(g.value) + '" y2="' + ys(g.value) + '" stroke="#7a1a14" stroke-width="1.5" stroke-dasharray="5 3"/>';
+  return s;
 }
 // click or drag inside a panel sets its factor (a categorical one to the nearest level)
 let dragging = null;
