@@ -90,7 +90,7 @@ function goalText(r, p, prob) {
   if (!g) return "";
   if (!r.predictable) {
     if (!limitsOf(g)) return "goal " + g.kind + ": cannot be acted on, no setting changes it";
-    return "goal " + limitsText(r, g) + ": " + r.name + " is not predictable, any design lands there with probability " + prob.toFixed(2) + "; no setting can be chosen for it from this data";
+    return r.name + " is not predictable: any design lands within " + limitsText(r, g) + " with probability " + prob.toFixed(2) + "; no setting can be chosen for it from this data";
   }
   const d = desirability(g, p.value);
   if (!limitsOf(g)) return g.kind + " (desirability bounds " + sig(g.low, 3) + " to " + sig(g.high, 3) + " " + r.unit + "): desirability " + d.toFixed(2);
