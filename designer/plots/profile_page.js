@@ -45,8 +45,7 @@ function buildControls() {
       t.setAttribute("inputmode", "decimal");
       t.setAttribute("aria-label", f.name + " value (" + f.unit + ")");
       t.setAttribute("aria-describedby", "e-" + f.name);
-      t.onchange = () => typeValue(f, t);
-      t.onkeydown = (ev) => { if (ev.key === "Enter") typeValue(f, t); };
+      t.onchange = () => typeValue(f, t); // on Enter and on leaving the box
       d.appendChild(t);
       const e = document.createElement("div"); e.className = "err"; e.id = "e-" + f.name; e.setAttribute("role", "alert");
       d.appendChild(e);
