@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import os
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -191,7 +191,7 @@ def axis_ticks(scene: Scene) -> list[list[tuple[float, str]]]:
 
     out = []
     for i, (lo, hi) in enumerate(scene.axis_ranges):
-        ticks = round_ticks(lo, hi, 5 if i == 2 else 4)
+        ticks = round_ticks(lo, hi, 5)
         ticks = [v for v in ticks if CORNER <= (v - lo) / (hi - lo) <= 1 - (0 if i == 2 else CORNER)]
         d = decimals_for(tuple(ticks)) if ticks else 0
         out.append([(v, f"{v:.{d}f}" if d < 7 else f"{v:.2g}") for v in ticks])
@@ -259,10 +259,15 @@ def render(view: SpaceView, *, window: tuple[int, int] = WINDOW):
     if hi - lo <= 1e-9 * abs(hi):  # a constant response: the scale spans the plotted PI instead
         lo, hi = view.scene.axis_ranges[2]
     _colorbar(plotter, view.response, *colour_limits(lo, hi))
-    left = min(0.68 * window[0], window[0] - 24 - 13 * max(len(layer.name) for layer in layers))
-    for i, layer in enumerate(layers):  # the legend: each name in its layer's colour, fixed size
-        pos = (int(left), int(window[1] - 64 - 24 * i))
-        plotter.add_text(layer.name, position=pos, font_size=12, color=layer.color)
+    # the legend: a swatch of each layer's colour and its name, top left under the title
+    plotter.add_legend(
+        [(layer.name, layer.color) for layer in layers],
+        bcolor=None,
+        border=False,
+        face="rectangle",
+        loc="upper left",
+        size=(0.45, 0.032 * len(layers)),
+    )
     _axes(plotter, view.scene)
     plotter.add_text(
         view.scene.axis_labels[2],
@@ -290,7 +295,9 @@ def save_screenshot(plotter, path: str | Path) -> Path:
 
 
 def _run_layers(points: np.ndarray, near: np.ndarray) -> list[Layer]:
-    """The measured runs (unit-cube points): those at the held values in black, the others grey."""
+    """The measured runs (unit-cube points): those at the held values in black at their response; the
+    others, measured at other held values, grey on the floor (where they lie in x and y only: drawn at
+    their response they would stand in stacks that read like replicates)."""
     import pyvista as pv
 
     layers = []
@@ -304,10 +311,12 @@ def _run_layers(points: np.ndarray, near: np.ndarray) -> list[Layer]:
             )
         )
     if (~near).any():
+        floor = points[~near].copy()
+        floor[:, 2] = 0.0
         layers.append(
             Layer(
-                f"other runs ({int((~near).sum())})",
-                pv.PolyData(points[~near]),
+                f"other runs ({int((~near).sum())}), at other held values: on the floor",
+                pv.PolyData(floor),
                 color=(0.55, 0.55, 0.55),
                 size=2.5,
             )
@@ -315,11 +324,33 @@ def _run_layers(points: np.ndarray, near: np.ndarray) -> list[Layer]:
     return layers
 
 
+def _plane_name(model, response: str, pred, target: float, unit: str) -> str:
+    """What a target plane means, in `designer suggest`'s words: no design on this plane is predicted
+    at the target, and the best chance here of landing within the default tolerance (for a response no
+    form predicts, the same chance for every design)."""
+    from ..design.targets import TOLERANCE, probability_within
+
+    log = model.transform == "log"
+    best = max(
+        probability_within(pred.at(i), target, TOLERANCE, model.dof, log=log) for i in range(len(pred.value))
+    )
+    band = f"+-{100 * TOLERANCE:.0f} %"
+    if not model.predictable:
+        return f"target {target:g} {unit} (plane): {response} not predictable, P({band}) {best:.2f} anywhere"
+    return f"target {target:g} {unit} (plane): not reached here, best P({band}) {best:.2f}"
+
+
 def _target_layers(
-    surface, values: np.ndarray, target: float, unit: str, zrange: tuple[float, float]
+    surface,
+    values: np.ndarray,
+    target: float,
+    unit: str,
+    zrange: tuple[float, float],
+    plane_name: Callable[[], str],
 ) -> list[Layer]:
     """The target on a predicted surface: its contour line and that line projected on the floor, or,
-    when the surface never reaches it (a flat or distant response), a plane at its level."""
+    when the surface never reaches it (a flat or distant response), a plane at its level named by
+    `plane_name()`."""
     import pyvista as pv
 
     surface.point_data["value"] = values
@@ -333,8 +364,7 @@ def _target_layers(
         ]
     level = float(_unit(target, *zrange))
     plane = pv.Plane(center=(0.5, 0.5, level), direction=(0, 0, 1), i_size=1, j_size=1)
-    name = f"target {target:g} {unit} (plane: no design reaches it)"
-    return [Layer(name, plane.triangulate(), color=TARGET_COLOR, opacity=0.35)]
+    return [Layer(plane_name(), plane.triangulate(), color=TARGET_COLOR, opacity=0.35)]
 
 
 def surface_view(
@@ -397,7 +427,14 @@ def surface_view(
     layers += _run_layers(runs, _runs_near(table, held))
     share = None
     if target is not None:
-        layers += _target_layers(mid, pred.value, target, model.unit, (zlo, zhi))
+        layers += _target_layers(
+            mid,
+            pred.value,
+            target,
+            model.unit,
+            (zlo, zhi),
+            lambda: _plane_name(model, response, pred, target, model.unit),
+        )
         share = float(np.mean((pred.low <= target) & (target <= pred.high)))
     held_txt = ", ".join(f"{k} {v:g} {space.factor(k).unit}" for k, v in held.items())
     title = f"{response_label(response)} over {x} and {y}; held: {held_txt}"
