@@ -33,6 +33,7 @@ class Layer:
     rgb: np.ndarray | None = None
     opacity: float = 1.0
     size: float = 2.0  # point size or line width, pixels
+    tag: str | None = None  # a label written on the mesh in the PNG (an isosurface's level)
 
 
 @dataclass

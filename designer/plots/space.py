@@ -237,7 +237,21 @@ def _add_layer(plotter, layer: Layer) -> None:
         kwargs |= {"point_size": layer.size * 4, "render_points_as_spheres": True}
     elif layer.mesh.lines.size:
         kwargs["line_width"] = layer.size * 2
+    elif layer.opacity < 1:  # a translucent surface: lit mostly ambient, so it keeps its legend colour
+        kwargs |= {"ambient": 0.55, "diffuse": 0.5, "specular": 0.0}
     plotter.add_mesh(layer.mesh, **kwargs)
+    if layer.tag:  # written at the mesh's highest point, in its colour
+        top = np.asarray(layer.mesh.points)[int(np.argmax(layer.mesh.points[:, 2]))]
+        plotter.add_point_labels(
+            top[None, :],
+            [layer.tag],
+            show_points=False,
+            shape=None,
+            font_size=14,
+            bold=True,
+            text_color=layer.color,
+            always_visible=True,
+        )
 
 
 def render(view: SpaceView, *, window: tuple[int, int] = WINDOW):
@@ -266,7 +280,7 @@ def render(view: SpaceView, *, window: tuple[int, int] = WINDOW):
         border=False,
         face="rectangle",
         loc="upper left",
-        size=(0.45, 0.032 * len(layers)),
+        size=(0.0062 * max(len(layer.name) for layer in layers), 0.032 * len(layers)),
     )
     _axes(plotter, view.scene)
     plotter.add_text(
@@ -487,12 +501,22 @@ def volume_view(
         iso = vol.contour([v], scalars="value")
         if iso.n_points:
             color = tuple(_rgb(np.array([v]), *colour_limits(vlo, vhi)[:2])[0])
-            layers.append(Layer(f"{response} = {v:.3g} {model.unit}", iso, color=color, opacity=0.5))
+            layers.append(
+                Layer(f"{response} = {v:.3g} {model.unit}", iso, color=color, opacity=0.5, tag=f"{v:.3g}")
+            )
     share = None
     if target is not None:
         iso = vol.contour([target], scalars="value")
         if iso.n_points:
-            layers.append(Layer(f"target {target:g} {model.unit}", iso, color=TARGET_COLOR, opacity=0.85))
+            layers.append(
+                Layer(
+                    f"target {target:g} {model.unit}",
+                    iso,
+                    color=TARGET_COLOR,
+                    opacity=0.85,
+                    tag=f"target {target:g}",
+                )
+            )
         share = float(np.mean((pred.low <= target) & (target <= pred.high)))
     pts = np.c_[[_unit(table[f.name], f.low, f.high) for f in fs]].T
     observed = table[response].to_numpy(float)
