@@ -60,6 +60,10 @@ def test_surface_png_and_html(sur, tmp_path):
     titles = [t for t, *_ in labels]
     assert {"width (mm)", "height (mm)", "k_x (N/mm)"} <= set(titles)
     assert all(10 <= x <= 890 and 10 <= y <= 670 for _, x, y in labels), labels
+    # the page labels the PNG's round ticks (it labelled five even ones: 0.21, 0.69 ...)
+    for ax in space.axis_ticks(view.scene):
+        assert [t for _, t in ax] and all(t in titles for _, t in ax), (ax, titles)
+    assert "0.5" in titles and "1.0" in titles
 
 
 def test_small_values_get_readable_ticks(sur, tmp_path):

@@ -458,6 +458,7 @@ def surface_view(
         ((fx.low, fx.high), (fy.low, fy.high), (zlo, zhi)),
         layers,
     )
+    scene.ticks = axis_ticks(scene)
     return SpaceView(response, model.unit, [x, y], held, (vlo, vhi), target, share, scene)
 
 
@@ -534,4 +535,5 @@ def volume_view(
     scene = Scene(
         title, tuple(f"{f.name} ({f.unit})" for f in fs), tuple((f.low, f.high) for f in fs), layers
     )
+    scene.ticks = axis_ticks(scene)
     return SpaceView(response, model.unit, list(factors), held, (vlo, vhi), target, share, scene)
