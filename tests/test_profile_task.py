@@ -441,3 +441,24 @@ def test_phone_keeps_the_prediction_and_p_on_the_first_screen(browser, folder, s
     lib = sur.predict(_design(page), responses=["k_x"])["k_x"]
     assert f"{float(f'{lib.value[0]:.3g}'):g}" in seen["k"] and "P(k_x met)" in seen["p"]
     page.call("Page.close")
+
+
+def test_p_trace_per_factor_is_the_library_joint_p(page, sur):
+    """Per factor, the P trace's peak (where the page says it is) is the library's joint P there."""
+    assert page.js("document.getElementById('trace-row').hidden")  # no goal, no trace
+    for q, v in (("k_x", "0.8"), ("c_x", "2e-3")):
+        page.js(f"document.getElementById('goal-kind-{q}').focus()")
+        choose(page, f"goal-kind-{q}", "target")
+        press(page, "Tab")
+        type_keys(page, v)
+    state = _design(page)
+    peaks = page.js(
+        "[...document.querySelectorAll('#trace svg')]"
+        ".map(s => [s.dataset.trace, +s.dataset.best, +s.dataset.pbest])"
+    )
+    assert len(peaks) == 6
+    for name, at, p in peaks:
+        design = dict(state, **{name: at})
+        want = _p(sur, design, "k", 0.72, 0.88) * _p(sur, design, "c", 1.8e-3, 2.2e-3)
+        assert p == pytest.approx(want, rel=1e-9), name
+        assert p >= float(page.js("document.getElementById('overall').dataset.joint")) - 1e-15

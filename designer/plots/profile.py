@@ -65,6 +65,7 @@ SCRIPTS = (
     "profile_views.js",
     "profile_goals.js",
     "profile_contour.js",
+    "profile_trace.js",
     "profile_page.js",
 )
 

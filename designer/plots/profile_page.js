@@ -171,6 +171,7 @@ function render() {
   }
   renderReadout(sc);
   renderContour();
+  renderTrace(sc);
   renderSim();
   document.body.dataset.renders = (+(document.body.dataset.renders || 0) + 1).toString();
 }
