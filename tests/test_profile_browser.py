@@ -134,18 +134,14 @@ def _check(page, sur) -> dict[str, float]:
     return design
 
 
-def test_page_opens_fast_offline_and_at_the_default_design(page, made, sur):
+def test_page_opens_fast_offline_and_at_the_suggestion(page, made, sur):
     assert page.load_seconds < 1.0
     assert float(page.js("document.body.dataset.ready")) < 1000  # ms from navigation to the first drawing
     assert page.requests() == [made[0].resolve().as_uri()], "the page must make no request but its own file"
-    assert _check(page, sur) == {
-        "density": 60.0,
-        "length": 24.0,
-        "width": 4.5,
-        "height": 9.0,
-        "layer": 0.16,
-        "raster": 0.0,
-    }
+    # opened from a suggestion: at its first candidate (issue 36; it opened at the default design)
+    assert _check(page, sur) == pytest.approx(made[1]["candidates"][0]["params"], rel=1e-12)
+    assert made[2]["design"] == pytest.approx(made[1]["candidates"][0]["params"], rel=1e-12)
+    assert page.js("document.getElementById('source').textContent").startswith("opened at suggestion #1")
     # the CLI's --json prints the same numbers the page does
     opened = made[2]["predicted"]["k_x"]
     assert float(page.js("document.getElementById('pred-k_x').dataset.value")) == pytest.approx(

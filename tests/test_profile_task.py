@@ -462,3 +462,25 @@ def test_p_trace_per_factor_is_the_library_joint_p(page, sur):
         want = _p(sur, design, "k", 0.72, 0.88) * _p(sur, design, "c", 1.8e-3, 2.2e-3)
         assert p == pytest.approx(want, rel=1e-9), name
         assert p >= float(page.js("document.getElementById('overall').dataset.joint")) - 1e-15
+
+
+def test_opened_from_a_suggestion_alone_it_starts_there_with_its_goals(browser, folder):
+    """`designer profile --suggestion` with no goal: the suggestion's goal and first candidate, and
+    Maximize ready (it was greyed with goal "none" and no reason)."""
+    run = subprocess.run(
+        [str(EXE), "profile", "--suggestion", "sug.json", "-o", "only.html", "--json"],
+        capture_output=True,
+        text=True,
+        cwd=folder,
+    )
+    assert run.returncode == 0, run.stderr
+    first = json.loads((folder / "sug.json").read_text())["candidates"][0]
+    page = _open(browser, folder / "only.html")
+    assert _design(page) == pytest.approx(first["params"], rel=1e-12)
+    assert page.js("document.getElementById('goal-kind-k_x').value") == "target"
+    assert page.js("document.getElementById('goal-value-k_x').value") == "0.8"
+    assert not page.js("document.getElementById('maximize').disabled")
+    shown = float(page.js("document.getElementById('tgt-k_x').dataset.probability"))
+    assert shown == pytest.approx(first["p_within"], rel=1e-9)  # the P its button says
+    assert page.js("document.getElementById('sug-1').dataset.stale") == "false"
+    page.call("Page.close")

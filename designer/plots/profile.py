@@ -311,7 +311,7 @@ def build_profiler(
     *,
     axis: str = "x",
     targets: Mapping[str, float] | None = None,
-    tolerance: float = TOLERANCE,
+    tolerance: float | None = None,
     suggestion: Any = None,
     design: Mapping[str, float] | None = None,
 ) -> Profiler:
@@ -321,7 +321,8 @@ def build_profiler(
         surrogate: the fitted surrogate whose coefficients the page evaluates.
         axis: the axis of the responses (x y z theta phi psi).
         targets: goals by quantity: a target in rig units, e.g. {"k": 0.8} (N/mm), or "min" or "max".
-        tolerance: relative tolerance of "meeting the target" (0.1: within 10 %).
+        tolerance: relative tolerance of "meeting the target" (0.1: within 10 %); default the
+            suggestion's, else `TOLERANCE`.
         suggestion: a `Suggestion`, its `to_dict()` or the path of a JSON file of it (what the
             suggest command writes with its JSON option).
         design: factors the page opens at (the rest from `DEFAULT_DESIGN`), within the tested ranges.
@@ -331,6 +332,18 @@ def build_profiler(
             target that is not positive; a tolerance outside (0, 1); an unreadable suggestion.
     """
     units.check_axis(axis)
+    suggestion = None if suggestion is None else _suggestion_dict(suggestion)
+    found = _suggestion_goals(suggestion)
+    # opened from a suggestion: its goals and tolerance unless given, its first candidate unless a
+    # design is given (and the candidate lies in the tested ranges)
+    if not targets and found:
+        targets = {q: v for q, v in found["targets"].items() if v is not None}
+    if tolerance is None:
+        tolerance = found["tolerance"] if found else TOLERANCE
+    candidates = _suggestions(suggestion)
+    opened_from = None
+    if design is None and candidates and candidates[0]["inside"]:
+        design, opened_from = candidates[0]["params"], "suggestion #1"
     targets = dict(targets or {})
     for q in targets:
         if q not in ("k", "c"):
@@ -340,7 +353,6 @@ def build_profiler(
             f"tolerance={tolerance!r} is not a fraction between 0 and 1", "give e.g. tolerance=0.1"
         )
     start = space.check_design(DEFAULT_DESIGN | dict(design or {}))
-    suggestion = None if suggestion is None else _suggestion_dict(suggestion)
     from ..design.suggestions import predictability
 
     info = predictability(surrogate, axis)
@@ -372,8 +384,9 @@ def build_profiler(
             "responses": responses,
             "runs": runs,
             "tolerance": float(tolerance),
-            "suggestions": _suggestions(suggestion),
-            "suggestion_goals": _suggestion_goals(suggestion),
+            "suggestions": candidates,
+            "suggestion_goals": found,
+            "opened_from": opened_from,
             "wall_mm": space.WALL_MM,
             "nozzle_mm": space.NOZZLE_MM,
             "search": _search_data(),

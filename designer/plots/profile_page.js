@@ -194,7 +194,7 @@ function runMaximize() {
   st.textContent = "best of " + m.searched + " level combination(s) \u00d7 " + m.starts + " starts" + (lockedNames.length ? ", holding " + lockedNames.join(", ") : "") + ": " +
     (s.p === null ? "" : "P " + (100 * s.p).toFixed(1) + " %, ") + "D " + s.d.toFixed(3) + " at " + designText(m.best.x, solidAt(m.best.x) ? ["density"] : []) + "; " + suggestCommand();
 }
-document.getElementById("source").textContent = "surrogate " + D.surrogate_id + "; " + D.runs.density.length +
+document.getElementById("source").textContent = (D.opened_from ? "opened at " + D.opened_from + " and its goals; " : "") + "surrogate " + D.surrogate_id + "; " + D.runs.density.length +
   " measured runs (points: runs whose other factors lie within " + (100 * NEAR) + " % of their range of the sliders, same layer and raster); blue: 95 % prediction interval; orange with red edges: the goal's limits (\u00b1 the tolerance around a target, dashed). Click or drag inside a panel to set its factor.";
 const tolEl = document.getElementById("tolerance");
 tolEl.value = sig(100 * tolerance, 4);
