@@ -359,6 +359,19 @@ def build_profiler(
     responses = [
         _response(surrogate, f"{q}_{axis}", info[q]["statement"], targets.get(q)) for q in ("k", "c")
     ]
+    mine, report = None, None
+    if surrogate.calibration is not None:  # the user's prints and the calibrated model's own figures
+        from ..model.calibration import report as calibration_report
+
+        report = calibration_report(surrogate)["responses"]
+        table = surrogate.calibration["table"]
+        mine = {
+            c: [None if pd.isna(v) else float(v) for v in table[c]]
+            for c in [*space.FACTOR_NAMES, *(r["name"] for r in responses)]
+            if c in table
+        }
+        for r in responses:
+            r["calibrated"] = report.get(r["name"]) if report.get(r["name"], {}).get("n_runs") else None
     runs = {n: [float(v) for v in surrogate.training[n]] for n in space.FACTOR_NAMES}
     runs |= {r["name"]: [float(v) for v in surrogate.training[r["name"]]] for r in responses}
     factors = [
@@ -387,6 +400,7 @@ def build_profiler(
             "suggestions": candidates,
             "suggestion_goals": found,
             "opened_from": opened_from,
+            "mine": mine,
             "wall_mm": space.WALL_MM,
             "nozzle_mm": space.NOZZLE_MM,
             "search": _search_data(),

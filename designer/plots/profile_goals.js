@@ -88,6 +88,8 @@ function goalText(r, p, prob) {
   const g = goals[r.name];
   if (goalError[r.name]) return "no goal: " + goalError[r.name];
   if (!g) return "";
+  if (!r.predictable && r.calibrated && limitsOf(g))
+    return "P(" + limitsText(r, g) + ") = " + pct(prob) + " here: your prints pin " + r.name + " down near the designs you printed (not predictable from the six factors elsewhere; maximize does not act on it)";
   if (!r.predictable) {
     if (!limitsOf(g)) return "goal " + g.kind + ": cannot be acted on, no setting changes it";
     return r.name + " is not predictable: any design lands within " + limitsText(r, g) + " with probability " + prob.toFixed(2) + "; no setting can be chosen for it from this data";

@@ -1,6 +1,8 @@
 // ---- the page ----
 function accuracyText(r) {
-  const a = r.accuracy;
+  const a = r.accuracy, c = r.calibrated;
+  if (c && c.loo_user) return "your " + c.loo_user.n + " prints, each predicted from the others: median error " + c.loo_user.mape.toFixed(0) + " %, " +
+    (100 * c.loo_user.coverage95).toFixed(0) + " % inside the 95 % PI; printer factor " + sig(c.printer_factor.value, 3) + " [" + sig(c.printer_factor.low, 3) + ", " + sig(c.printer_factor.high, 3) + "]";
   return a.kind + ": Q2 " + a.q2.toFixed(2) + ", RMSE " + sig(a.rmse, 3) + " " + r.unit + ", MAPE " + a.mape.toFixed(0) + " %, 95 % PI coverage " + (100 * a.coverage95).toFixed(0) + " %";
 }
 function valueText(f) {
@@ -92,9 +94,9 @@ function buildRows() {
   for (const r of R) {
     const d = document.createElement("div"); d.className = "row";
     let panels = '<div class="panels" id="panels-' + r.name + '"></div>';
-    if (!r.predictable) panels = '<details class="flat" aria-label="' + esc(r.name) + ' panels"><summary>' + esc(r.name) + " against the factors: flat, the same prediction for every design</summary>" + panels + "</details>";
+    if (!r.predictable && !r.calibrated) panels = '<details class="flat" aria-label="' + esc(r.name) + ' panels"><summary>' + esc(r.name) + " against the factors: flat, the same prediction for every design</summary>" + panels + "</details>";
     d.innerHTML = '<div class="summary"><h3>' + esc(r.name) + " (" + esc(r.unit) + ')</h3><div class="pred" id="pred-' + r.name + '"></div>' +
-      '<div class="pi" id="pi-' + r.name + '"></div>' + (r.predictable ? "" : '<div class="warn">' + esc(r.statement) + "</div>") +
+      '<div class="pi" id="pi-' + r.name + '"></div>' + (r.predictable ? "" : '<div class="warn">' + esc(r.calibrated ? r.calibrated.statement : r.statement) + "</div>") +
       '<div class="tgt" id="tgt-' + r.name + '"></div><div class="acc">' + esc(accuracyText(r)) + "</div></div>" + panels;
     rows.appendChild(d);
   }
@@ -194,7 +196,7 @@ function runMaximize() {
   st.textContent = "best of " + m.searched + " level combination(s) \u00d7 " + m.starts + " starts" + (lockedNames.length ? ", holding " + lockedNames.join(", ") : "") + ": " +
     (s.p === null ? "" : "P " + (100 * s.p).toFixed(1) + " %, ") + "D " + s.d.toFixed(3) + " at " + designText(m.best.x, solidAt(m.best.x) ? ["density"] : []) + "; " + suggestCommand();
 }
-document.getElementById("source").textContent = (D.opened_from ? "opened at " + D.opened_from + " and its goals; " : "") + "surrogate " + D.surrogate_id + "; " + D.runs.density.length +
+document.getElementById("source").textContent = (D.opened_from ? "opened at " + D.opened_from + " and its goals; " : "") + "surrogate " + D.surrogate_id + "; " + (D.mine ? D.mine.density.length + " of your prints (orange diamonds, calibrated with designer calibrate) on top of the study's " : "") + D.runs.density.length +
   " measured runs (points: runs whose other factors lie within " + (100 * NEAR) + " % of their range of the sliders, same layer and raster); blue: 95 % prediction interval; orange with red edges: the goal's limits (\u00b1 the tolerance around a target, dashed). Click or drag inside a panel to set its factor.";
 const tolEl = document.getElementById("tolerance");
 tolEl.value = sig(100 * tolerance, 4);

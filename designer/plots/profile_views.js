@@ -119,10 +119,10 @@ function renderMemory() {
   document.getElementById("copy-json").disabled = document.getElementById("forget").disabled = !memory.length;
 }
 // ---- what is near the current setting ----
-function near(j, skip) {
+function near(j, skip, runs) {
   for (const f of F) {
     if (f.name === skip) continue;
-    const v = D.runs[f.name][j], s = state[f.name];
+    const v = (runs || D.runs)[f.name][j], s = state[f.name];
     if (f.categorical ? Math.abs(v - s) > 1e-9 : Math.abs(v - s) > NEAR * (f.high - f.low) + 1e-9) return false;
   }
   return true;
@@ -174,6 +174,13 @@ function panel(r, f, first) {
     if (!near(j, f.name)) continue;
     const v = D.runs[f.name][j], X = cat ? xpos(lvl(v)) + 9 : xpos(v);
     s += '<circle class="run" cx="' + X + '" cy="' + ys(D.runs[r.name][j]) + '" r="3" fill="#222" opacity="0.75"><title>run ' + (j + 1) + ": " + sig(D.runs[r.name][j], 3) + " " + r.unit + "</title></circle>";
+  }
+  // the user's own prints (a calibrated surrogate): orange diamonds, near the setting as the study's runs
+  const mine = D.mine, my = mine && mine[r.name];
+  if (my) for (let j = 0; j < my.length; j++) {
+    if (my[j] === null || !near(j, f.name, mine)) continue;
+    const v = mine[f.name][j], X = cat ? xpos(lvl(v)) - 9 : xpos(v), Y = ys(my[j]);
+    s += '<path class="mine" d="M' + X + " " + (Y - 5) + "l5 5l-5 5l-5 -5z" + '" fill="#e8590c" stroke="#fff"><title>your print ' + (j + 1) + ": " + sig(my[j], 3) + " " + r.unit + "</title></path>";
   }
   const cx = cat ? xpos(lvl(state[f.name])) : xpos(state[f.name]);
   s += '<line x1="' + cx + '" x2="' + cx + '" y1="' + MT + '" y2="' + (PH - MB) + '" stroke="#b3261e" stroke-width="1"/></g>';
