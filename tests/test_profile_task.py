@@ -20,16 +20,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import test_profile_console
 from scipy import stats
 from test_profile_browser import _design
 
 from designer.design.targets import probability_between, probability_within
-from designer.model.surrogate import Surrogate
 
 pytest.importorskip("websocket", reason="the browser tests speak to Chromium with websocket-client")
-import cdp  # noqa: E402
 
 EXE = Path(sys.executable).with_name("designer")
+#: the console tests' fixtures: the bundled surrogate and one 1280x800 browser per module
+sur, browser = test_profile_console.sur, test_profile_console.browser
 #: DevTools key descriptions: key, code, Windows virtual key code
 KEYS = {
     "Tab": ("Tab", "Tab", 9),
@@ -38,11 +39,6 @@ KEYS = {
     "ArrowDown": ("ArrowDown", "ArrowDown", 40),
     "ArrowRight": ("ArrowRight", "ArrowRight", 39),
 }
-
-
-@pytest.fixture(scope="module")
-def sur():
-    return Surrogate.load()
 
 
 @pytest.fixture(scope="module")
@@ -56,15 +52,6 @@ def folder(tmp_path_factory):
         run = subprocess.run([str(EXE), "profile", *args], capture_output=True, text=True, cwd=d)
         assert run.returncode == 0, run.stderr
     return d
-
-
-@pytest.fixture(scope="module")
-def browser():
-    exe = cdp.find_browser()
-    if exe is None:
-        pytest.skip("no headless Chromium on this machine")
-    with cdp.Browser(exe, width=1280, height=800) as b:
-        yield b
 
 
 def _open(browser, path: Path, width: int = 1280, height: int = 800):
