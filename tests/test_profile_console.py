@@ -269,8 +269,10 @@ def test_accessibility_tree_names_every_control_with_its_unit(page, sur):
     assert {f"print noise, standard deviation of {f.name} ({f.unit})" for f in space.CONTINUOUS} <= numbers
     images = [name(n) for n in by_role["image"]]
     contour = [n for n in images if n.startswith("width against height")]
-    images = [n for n in images if n not in contour]
+    trace = [n for n in images if n.startswith("P(every stated goal met) against ")]
+    images = [n for n in images if n not in contour + trace]
     assert len(contour) == 1 and "shaded" in contour[0]  # the contour view, described in words
+    assert len(trace) == 6 and all("highest" in n for n in trace)  # the P trace, one per factor
     assert len(images) == 6  # k_x's panels (c_x's are folded away: it is not predictable)
     assert all(n.startswith("k_x against ") and "N/mm" in n for n in images), images
 
