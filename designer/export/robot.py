@@ -132,6 +132,39 @@ class Servo:
         return cls(motor_inertia, bandwidth, kp, 2 * math.sqrt(kp * total))
 
 
+@dataclass(frozen=True)
+class SeriesDrive:
+    """Motor -> flexure -> link on one axis, standalone: the link (also the motor's body, the
+    flexure's clamped part), the servo, and the step advice of the flexure (motor held) and of the
+    motor (flexure held), keyed `<joint>_<axis>` and `<joint>_motor`."""
+
+    link: Sphere
+    servo: Servo
+    advice: dict[str, StepAdvice]
+
+
+def series_drive(
+    joint: Joint, a: str, *, motor_inertia: float | None = None, motor_bandwidth: float | None = None
+) -> SeriesDrive:
+    """The standalone series form's bodies, servo and advice on axis `a` (see `Servo.for_flexure`):
+    the motor turns its armature, its body and the link. The joint must carry masses."""
+    rot = units.is_rotational(a)
+    link = links(joint)[a]
+    moving = link.inertia if rot else link.mass
+    si = joint.axes[a].si()
+    flex = step_advice(si["k"], si["c"], moving, basis="about the joint axis: the link, the motor held")
+    servo = Servo.for_flexure(
+        flex, carried=2 * moving, motor_inertia=motor_inertia, bandwidth=motor_bandwidth
+    )
+    motor = step_advice(
+        servo.kp,
+        servo.kv,
+        servo.motor_inertia + 2 * moving,
+        basis="about the joint axis: the motor's armature, its body and the link, the flexure held",
+    )
+    return SeriesDrive(link, servo, {f"{joint.name}_{a}": flex, f"{joint.name}_motor": motor})
+
+
 def check_rest(
     rest: float, span: tuple[float, float] | None, joint_name: str, unit: str, allow: bool
 ) -> None:
