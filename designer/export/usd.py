@@ -184,9 +184,9 @@ def export_usd(
         if form == "series":
             raise DesignerError(
                 "form='series' into a USD robot is not written: it needs a motor body inserted between the "
-                "joint's two bodies, placed in the world and given mass and inertia the robot does not state",
-                "use form='parallel' (the robot joint's drive becomes the flexure), or the standalone "
-                "series joint (no into=), or export mjcf with form='series' into the robot's MJCF",
+                "joint's two bodies and placed in the world, which this export does not do yet",
+                "use form='parallel' (the robot joint's drive becomes the flexure), or export mjcf with "
+                "form='series' into the robot's MJCF, or write the standalone series joint without into=",
             )
         advice, notes = into_parallel(
             joint,

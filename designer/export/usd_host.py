@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -66,15 +67,20 @@ def open_host(host: Path, joint_name: str) -> UsdHost:
 
     if not host.is_file():
         raise DesignerError(f"into={str(host)!r} does not exist", "give the path of the robot's USD file")
+    if host.suffix.lower() not in (".usd", ".usda", ".usdc", ".usdz"):
+        raise DesignerError(
+            f"into={str(host)!r} is not a USD file (.usd, .usda, .usdc or .usdz)",
+            "convert the robot to USD first (Isaac Sim's URDF or MJCF importer, urdf2any), or export urdf "
+            "or mjcf into it",
+        )
     try:
         stage = Usd.Stage.Open(str(host))
     except Tf.ErrorException as exc:
-        reason = " ".join(str(exc).split())
-        raise DesignerError(f"usd-core cannot open into={str(host)!r}: {reason}", "give a USD file") from None
-    if stage is None:
+        said = re.findall(r"'([^']+)'", str(exc))  # usd-core's own sentence, without its source location
         raise DesignerError(
-            f"usd-core cannot open into={str(host)!r}", "give a USD file (.usd, .usda, .usdc)"
-        )
+            f"usd-core cannot open into={str(host)!r}: {said[-1] if said else str(exc).strip()}",
+            "give a USD file that usd-core opens (usdcat FILE shows the problem)",
+        ) from None
     kinds = [
         p
         for p in Usd.PrimRange.Stage(stage)
