@@ -347,7 +347,7 @@ def into_parallel(
     if missing:
         return {}, (
             *notes,
-            f"no step advice: {missing} states no mass (PhysX computes it from collision shapes)",
+            f"no step advice: body {missing} states no mass or inertia (PhysX computes them from its shapes)",
         )
     armature = values.get("m") or h.si("m", h.joint.GetAttribute(ARMATURE).Get() or 0.0)
     return {h.joint.GetName(): step_advice(si["k"], si["c"], inertia + armature, basis=INERTIA_BASIS)}, notes

@@ -9,6 +9,7 @@ joint-space inertia with the other joints held; on a prismatic joint it is their
 
 from __future__ import annotations
 
+import math
 from collections import deque
 
 AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
@@ -57,7 +58,8 @@ def _moved_bodies(stage, joint) -> list:
 
 def moved_inertia(stage, joint, rotational: bool) -> tuple[float, str | None]:
     """The inertia (kg.m^2) or mass (kg) that robot joint `joint` moves, the other joints held, and
-    None; or (0, the path of the first moved body that states no positive mass)."""
+    None; or (0, the path of the first moved body that states no positive mass, or no inertia on a
+    revolute joint)."""
     from pxr import Gf, Usd, UsdGeom, UsdPhysics
 
     meters, kilograms = UsdGeom.GetStageMetersPerUnit(stage), UsdPhysics.GetStageKilogramsPerUnit(stage)
@@ -79,16 +81,20 @@ def moved_inertia(stage, joint, rotational: bool) -> tuple[float, str | None]:
         if not rotational:
             total += m
             continue
+        # MassAPI's fallbacks mean "computed from the shapes": centre -inf (taken as the body's origin),
+        # principal axes (0, 0, 0, 0) (taken as the body's axes), diagonal inertia 0 (not stated)
+        diagonal = mass_api.GetDiagonalInertiaAttr().Get() or Gf.Vec3f(0)
+        if not any(diagonal):
+            return 0.0, str(path)
         world = Gf.Matrix4d(UsdGeom.Xformable(prim).ComputeLocalToWorldTransform(Usd.TimeCode.Default()))
         world = world.RemoveScaleShear()
-        centre = world.Transform(Gf.Vec3d(mass_api.GetCenterOfMassAttr().Get() or Gf.Vec3f(0)))
-        principal = mass_api.GetPrincipalAxesAttr().Get() or Gf.Quatf(1)
-        turn = (
-            Gf.Rotation(Gf.Quatd(principal.GetReal(), Gf.Vec3d(principal.GetImaginary())))
-            * world.ExtractRotation()
-        )
-        n = turn.GetInverse().TransformDir(axis)
-        diagonal = mass_api.GetDiagonalInertiaAttr().Get() or Gf.Vec3f(0)
+        local = mass_api.GetCenterOfMassAttr().Get()
+        local = Gf.Vec3d(local) if local is not None and all(math.isfinite(v) for v in local) else Gf.Vec3d(0)
+        centre = world.Transform(local)
+        principal = mass_api.GetPrincipalAxesAttr().Get()
+        principal = principal if principal is not None and principal.GetLength() > 0 else Gf.Quatf(1)
+        turn = Gf.Rotation(Gf.Quatd(principal.GetReal(), Gf.Vec3d(principal.GetImaginary())))
+        n = (turn * world.ExtractRotation()).GetInverse().TransformDir(axis)
         spin = sum(d * c * c for d, c in zip(diagonal, n, strict=True)) * kilograms * meters**2
         r = (centre - pos) * meters
         across = r - axis * (r * axis)
