@@ -13,7 +13,6 @@ the joint's edited values may differ, and they must read back as written.
 from __future__ import annotations
 
 import math
-import os
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -21,14 +20,12 @@ from pathlib import Path
 
 from .. import units
 from ..errors import DesignerError
-from ..files import atomic_path
 from ..joint import Joint
 from . import robot
 from .stability import StepAdvice, step_advice
 from .usd_drive import ARMATURE, FRICTION, drive_instance, set_drive
+from .usd_layer import over_layer, stage_changes, write_over
 
-#: root-layer fields the layer does not copy from the robot's: its own sublayers and its description
-OWN_FIELDS = {"subLayers", "subLayerOffsets", "documentation", "comment", "primChildren"}
 #: what the advice's inertia is for a robot joint
 INERTIA_BASIS = (
     "about the joint axis at the robot's authored pose: the bodies the joint moves (MassAPI mass, "
@@ -189,104 +186,13 @@ def _values(
     return new, tuple(notes)
 
 
-def _layer(host: UsdHost, path: Path, values: dict[str, float]):
-    """The layer over the robot: its metadata, the robot as sublayer (relative to `path`'s folder) and
-    the joint's new drive values."""
-    from pxr import Sdf, Usd, UsdPhysics
-
-    source = host.stage.GetRootLayer()
-    layer = Sdf.Layer.CreateAnonymous(path.suffix)
-    for key in source.pseudoRoot.ListInfoKeys():
-        if key not in OWN_FIELDS:
-            layer.pseudoRoot.SetInfo(key, source.pseudoRoot.GetInfo(key))
-    layer.subLayerPaths.append(str(host.path.absolute()))
-    stage = Usd.Stage.Open(layer)
-    prim = stage.GetPrimAtPath(host.joint.GetPath())
-    set_drive(prim, host.rotational, values, host.units)
-    drive = UsdPhysics.DriveAPI.Get(prim, drive_instance(host.rotational))
-    if drive.GetTypeAttr().Get() == "acceleration":
-        drive.CreateTypeAttr().Set("force")
-    del stage  # a stage would recompose on the change of sublayer path below
-    try:
-        relative = os.path.relpath(host.path.absolute(), path.absolute().parent)
-    except ValueError:  # another drive (Windows): the absolute path
-        relative = str(host.path.absolute())
-    layer.subLayerPaths[0] = Path(relative).as_posix()
-    return layer
-
-
-def _same(a: object, b: object) -> bool:
-    """Equal values, NaN equal to NaN (arrays of floats compare by their text)."""
-    return a == b or repr(a) == repr(b)
-
-
-def _prim_changes(before, after, skip: set[str]) -> list[str]:
-    """What differs between two prims: metadata, attributes (value, time samples, metadata) and
-    relationship targets, leaving out attributes named in `skip`."""
-    changed = []
-    meta_a, meta_b = before.GetAllMetadata(), after.GetAllMetadata()
-    if "apiSchemas" in skip:  # the joint: its schemas may only gain the drive's and PhysX's
-        gained = set(after.GetAppliedSchemas()) - set(before.GetAppliedSchemas())
-        lost = set(before.GetAppliedSchemas()) - set(after.GetAppliedSchemas())
-        if lost or not gained <= {
-            s for s in after.GetAppliedSchemas() if s.startswith(("PhysicsDriveAPI", "Physx"))
-        }:
-            changed.append("apiSchemas")
-        meta_a.pop("apiSchemas", None), meta_b.pop("apiSchemas", None)
-    if not _same(meta_a, meta_b):
-        changed.append("metadata")
-    names_a = {a.GetName() for a in before.GetAttributes()} - skip
-    # on the joint, a schema the edit applies brings its attributes' fallbacks, unauthored
-    names_b = {
-        a.GetName() for a in after.GetAttributes() if not skip or a.IsAuthored() or a.GetName() in names_a
-    } - skip
-    changed += sorted(names_a ^ names_b)
-    for name in sorted(names_a & names_b):
-        x, y = before.GetAttribute(name), after.GetAttribute(name)
-        samples = x.GetTimeSamples()
-        if not (
-            _same(x.GetAllMetadata(), y.GetAllMetadata())
-            and _same(x.Get(), y.Get())
-            and _same(samples, y.GetTimeSamples())
-            and all(_same(x.Get(t), y.Get(t)) for t in samples)
-        ):
-            changed.append(name)
-    rels_a = {r.GetName(): r.GetTargets() for r in before.GetRelationships()}
-    rels_b = {r.GetName(): r.GetTargets() for r in after.GetRelationships()}
-    changed += [name for name in sorted(set(rels_a) | set(rels_b)) if rels_a.get(name) != rels_b.get(name)]
-    return changed
-
-
-def stage_changes(before, after, joint_path, edited: set[str]) -> list[str]:
-    """Every difference between the robot's stage and the layered one ("prim: what"), leaving out the
-    `edited` attributes of the joint at `joint_path` and the schemas they need."""
-    from pxr import Usd
-
-    changes = []
-    keys = set(before.GetRootLayer().pseudoRoot.ListInfoKeys()) - OWN_FIELDS
-    changes += [
-        f"stage metadata {k}" for k in sorted(keys) if not _same(before.GetMetadata(k), after.GetMetadata(k))
-    ]
-    every = Usd.PrimAllPrimsPredicate
-    paths_a = [p.GetPath() for p in Usd.PrimRange.Stage(before, every)]
-    paths_b = [p.GetPath() for p in Usd.PrimRange.Stage(after, every)]
-    if paths_a != paths_b:
-        return [*changes, "prims: " + ", ".join(str(p) for p in set(paths_a) ^ set(paths_b))]
-    for p in paths_a:
-        skip = edited | {"apiSchemas"} if p == joint_path else set()
-        changes += [
-            f"{p}: {what}" for what in _prim_changes(before.GetPrimAtPath(p), after.GetPrimAtPath(p), skip)
-        ]
-    return changes
-
-
 def _check(host: UsdHost, values: dict[str, float], edited: set[str]) -> Callable[[object], None]:
     """A check of the layered stage: the joint holds `values` (as 32-bit floats) and nothing else changed."""
     import numpy as np
     from pxr import UsdPhysics
 
     def check(after) -> None:
-        changes = stage_changes(host.stage, after, host.joint.GetPath(), edited)
+        changes = stage_changes(host.stage, after, {host.joint.GetPath(): edited})
         if changes:
             raise RuntimeError(f"the layer changes more than the joint's drive: {'; '.join(changes)}")
         prim = after.GetPrimAtPath(host.joint.GetPath())
@@ -327,21 +233,22 @@ def into_parallel(
     Raises:
         DesignerError: no such file or joint, an axis of the wrong kind, a rest outside the range.
     """
-    from pxr import Usd
+    from pxr import UsdPhysics
 
     from .usd_inertia import moved_inertia
 
     h = open_host(host, joint_name)
     a = host_axis(joint, axis, h, joint_name)
     values, notes = _values(h, joint, a, rest, allow_outside_range)
-    layer = _layer(h, path, values)
+    layer, stage = over_layer(h.stage, h.path, path.suffix)
+    prim = stage.GetPrimAtPath(h.joint.GetPath())
+    set_drive(prim, h.rotational, values, h.units)
+    drive = UsdPhysics.DriveAPI.Get(prim, drive_instance(h.rotational))
+    if drive.GetTypeAttr().Get() == "acceleration":
+        drive.CreateTypeAttr().Set("force")
+    del stage, prim, drive
     spec = layer.GetPrimAtPath(h.joint.GetPath())
-    edited = set(spec.attributes.keys()) if spec else set()
-    with atomic_path(path) as tmp:
-        if not layer.Export(str(tmp)):
-            raise RuntimeError(f"usd-core could not write {tmp}")
-        after = Usd.Stage.Open(str(tmp))
-        _check(h, values, edited)(after)
+    write_over(layer, h.path, path, _check(h, values, set(spec.attributes.keys())))
     si = joint.axes[a].si()
     inertia, missing = moved_inertia(h.stage, h.joint, h.rotational)
     if missing:
