@@ -164,10 +164,14 @@ def _flat_specs(stage) -> dict:
     return specs
 
 
-def _unchanged_but(host_stage, flex_stage, joint_path: str) -> set[str]:
-    """The flattened property paths that differ between the two stages: must all be on the joint."""
+def _unchanged_but(host_stage, flex_stage, joint_path: str, added: tuple[str, ...] = ()) -> set[str]:
+    """The flattened property paths that differ between the two stages: must all be on the joint (or
+    in the `added` prims, which the host must not have)."""
     a, b = _flat_specs(host_stage), _flat_specs(flex_stage)
     differ = {p for p in set(a) | set(b) if repr(a.get(p)) != repr(b.get(p))}
+    new = {p for p in differ if p in added or p.startswith(tuple(f"{n}." for n in added))}
+    assert not any(p in a for p in new)
+    differ -= new
     assert all(p.startswith(joint_path + ".") for p in differ), sorted(differ)[:10]
     for key in ("metersPerUnit", "kilogramsPerUnit", "upAxis"):
         assert host_stage.GetMetadata(key) == flex_stage.GetMetadata(key)
@@ -309,7 +313,7 @@ def test_refusals_name_the_problem(iiwa_usd, tmp_path, monkeypatch, capsys):
             "lbr_iiwa_joint_4",
             "--form",
             "series",
-        ): "--form series into a USD",
+        ): "has no mass on axis theta",
         ("--into", "iiwa.usda", "--joint", "lbr_iiwa_joint_4", "--rest", "3"): "outside the range",
     }
     for extra, message in cases.items():
@@ -317,3 +321,74 @@ def test_refusals_name_the_problem(iiwa_usd, tmp_path, monkeypatch, capsys):
         assert code == 2 and message in " ".join(err.split()), err
         assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
     assert not (tmp_path / "x.usda").exists()
+
+
+def test_series_into_newton_cartpole(tmp_path, monkeypatch, capsys):
+    """motor -> flexure -> cart on the rail: a servo added (the rail has no drive), the load on the cart
+    deflects the flexure by F / k, every host value as it was but the flexure joint's."""
+    assets = package_dir("newton", "examples/assets")
+    if assets is None or not (assets / "cartpole.usda").is_file():
+        pytest.skip("newton (its example assets) is not installed")
+    folder = tmp_path / "assets"
+    folder.mkdir()
+    os.symlink(assets / "cartpole.usda", folder / "cartpole.usda")
+    monkeypatch.chdir(folder)
+    args = [
+        "export",
+        "usd",
+        "--into",
+        "cartpole.usda",
+        "--joint",
+        "railCartJoint",
+        "--k",
+        "0.8",
+        "--c",
+        "0.05",
+    ]
+    # Newton's Featherstone applies a drive's damping explicitly: at 1 ms the default motor (armature
+    # 0.1 kg, servo damping 746 N.s/m on the 0.11 kg rotor: 6.8 x dt / m) diverged to NaN; a 1 kg motor holds
+    args += ["--m", "0.01", "--axis", "x", "--form", "series", "--motor-inertia", "1", "-o", "sea.usda"]
+    code, out, err = run_inprocess(args, capsys)
+    assert code == 0, err
+    assert "a servo at" in out and "the robot joint had no drive" in " ".join(out.split())
+    host, flex = Usd.Stage.Open("cartpole.usda"), Usd.Stage.Open("sea.usda")
+    motor, rotor = "/cartPole/railCartJoint_motor", "/cartPole/railCartJoint_motor_rotor"
+    _unchanged_but(host, flex, "/cartPole/railCartJoint", (motor, rotor))
+    joint = flex.GetPrimAtPath("/cartPole/railCartJoint")
+    assert joint.GetRelationship("physics:body0").GetTargets() == [rotor]
+    assert joint.GetAttribute("physics:upperLimit").Get() == math.inf
+    m = flex.GetPrimAtPath(motor)
+    assert m.GetAttribute("physics:upperLimit").Get() == 4.0 and m.GetAttribute("physics:axis").Get() == "Y"
+    assert drive(flex, "/cartPole/railCartJoint", "linear")["k"] == 800.0
+    rest, k, q = newton_static(Path("sea.usda"), "railCartJoint", 8.0, 5.0)
+    assert k == 800.0 and q - rest == pytest.approx(8.0 / 800.0, rel=0.01)
+
+
+def test_series_into_iiwa_keeps_the_motor_drive(iiwa_usd, tmp_path):
+    """The converted PD drive (100 N.m/rad, 300 N.m) and the limits move to the motor joint."""
+    out = export_usd(
+        JOINT,
+        iiwa_usd.parent / "sea.usda",
+        into=iiwa_usd,
+        joint_name="lbr_iiwa_joint_4",
+        axis="theta",
+        form="series",
+    )
+    stage = Usd.Stage.Open(str(out.path))
+    path = "/lbr_iiwa/joints/lbr_iiwa_joint_4"
+    _unchanged_but(
+        Usd.Stage.Open(str(iiwa_usd)),
+        stage,
+        path,
+        (path + "_motor", "/lbr_iiwa/lbr_iiwa_joint_4_motor_rotor"),
+    )
+    motor = drive(stage, path + "_motor", "angular")
+    assert motor["k"] == f32(100 * math.pi / 180) and motor["armature"] == f32(1e-4)  # 10 x the flexure's
+    m = stage.GetPrimAtPath(path + "_motor")
+    assert m.GetAttribute("drive:angular:physics:maxForce").Get() == 300.0
+    assert (m.GetAttribute("physics:lowerLimit").Get(), m.GetAttribute("physics:upperLimit").Get()) == (
+        -120,
+        120,
+    )
+    assert drive(stage, path, "angular")["k"] == f32(0.05 * math.pi / 180)
+    assert "lbr_iiwa_joint_4_motor" in out.advice and "lbr_iiwa_joint_4" in out.advice

@@ -27,6 +27,7 @@ from ..joint import Joint, check_joint
 from . import robot
 from .usd_drive import ARMATURE, FRICTION, set_drive
 from .usd_host import into_parallel
+from .usd_series import into_series
 
 SUFFIXES = (".usda", ".usd", ".usdc")
 FORMS = ("parallel", "series")
@@ -182,21 +183,26 @@ def export_usd(
             raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
         check_type(joint_name, str, "joint_name", expected="a name", fix="give e.g. joint_name='knee'")
         if form == "series":
-            raise DesignerError(
-                "form='series' into a USD robot is not written: it needs a motor body inserted between the "
-                "joint's two bodies and placed in the world, which this export does not do yet",
-                "use form='parallel' (the robot joint's drive becomes the flexure), or export mjcf with "
-                "form='series' into the robot's MJCF, or write the standalone series joint without into=",
+            advice, notes = into_series(
+                joint,
+                Path(into),
+                path,
+                joint_name=joint_name,
+                axis=axis,
+                rest=0.0 if rest is None else rest,
+                motor_inertia=motor_inertia,
+                motor_bandwidth=motor_bandwidth,
             )
-        advice, notes = into_parallel(
-            joint,
-            Path(into),
-            path,
-            joint_name=joint_name,
-            axis=axis,
-            rest=rest,
-            allow_outside_range=allow_outside_range,
-        )
+        else:
+            advice, notes = into_parallel(
+                joint,
+                Path(into),
+                path,
+                joint_name=joint_name,
+                axis=axis,
+                rest=rest,
+                allow_outside_range=allow_outside_range,
+            )
         return robot.RobotExport(path, advice, notes + READERS)
     if rest not in (None, 0.0):
         raise DesignerError(

@@ -106,7 +106,7 @@ def host_axis(joint: Joint, axis: str | None, host: UsdHost, joint_name: str) ->
     return a
 
 
-def _span(host: UsdHost) -> tuple[float, float] | None:
+def joint_span(host: UsdHost) -> tuple[float, float] | None:
     """The joint's limits in SI (rad or m), None when it has none (UsdPhysics: unauthored or infinite)."""
     from pxr import UsdPhysics
 
@@ -117,7 +117,7 @@ def _span(host: UsdHost) -> tuple[float, float] | None:
     return host.si("r", lo), host.si("r", hi)
 
 
-def _old(host: UsdHost) -> dict[str, float | None]:
+def host_values(host: UsdHost) -> dict[str, float | None]:
     """The joint's drive and PhysX values in SI; None where the robot authors none."""
     from pxr import UsdPhysics
 
@@ -146,10 +146,10 @@ def _values(
 ) -> tuple[dict[str, float], tuple[str, ...]]:
     """The drive's new values (SI) and one note per robot value changed or kept (old -> new, SI)."""
     si = joint.axes[a].si()
-    old = _old(host)
+    old = host_values(host)
     name = host.joint.GetName()
     unit = "rad" if host.rotational else "m"
-    span = _span(host)
+    span = joint_span(host)
     new = {"k": si["k"], "c": si["c"]}
     notes = []
     if rest is None:
@@ -186,27 +186,36 @@ def _values(
     return new, tuple(notes)
 
 
-def _check(host: UsdHost, values: dict[str, float], edited: set[str]) -> Callable[[object], None]:
-    """A check of the layered stage: the joint holds `values` (as 32-bit floats) and nothing else changed."""
+def check_drive(prim, rotational: bool, stage_units: tuple[float, float], values: dict[str, float]) -> None:
+    """Raise unless joint `prim` reads back the drive `values` (SI, as `set_drive` takes them) as the
+    32-bit floats they were written as, in the stage's units."""
     import numpy as np
     from pxr import UsdPhysics
+
+    drive = UsdPhysics.DriveAPI.Get(prim, drive_instance(rotational))
+    read = {
+        "k": drive.GetStiffnessAttr,
+        "c": drive.GetDampingAttr,
+        "r": drive.GetTargetPositionAttr,
+        "F": drive.GetMaxForceAttr,
+        "m": lambda: prim.GetAttribute(ARMATURE),
+        "friction": lambda: prim.GetAttribute(FRICTION),
+    }
+    for q, v in values.items():
+        scale = 1.0 if q == "friction" else units.usd_factor(q, rotational, *stage_units)
+        want, got = float(np.float32(v * scale)), read[q]().Get()
+        if got != want:
+            raise RuntimeError(f"joint {prim.GetPath()} reads {q} = {got!r}, not {want!r}")
+
+
+def _check(host: UsdHost, values: dict[str, float], edited: set[str]) -> Callable[[object], None]:
+    """A check of the layered stage: the joint holds `values` and nothing else changed."""
 
     def check(after) -> None:
         changes = stage_changes(host.stage, after, {host.joint.GetPath(): edited})
         if changes:
             raise RuntimeError(f"the layer changes more than the joint's drive: {'; '.join(changes)}")
-        prim = after.GetPrimAtPath(host.joint.GetPath())
-        drive = UsdPhysics.DriveAPI.Get(prim, drive_instance(host.rotational))
-        read = {
-            "k": drive.GetStiffnessAttr().Get(),
-            "c": drive.GetDampingAttr().Get(),
-            "r": drive.GetTargetPositionAttr().Get(),
-            "m": prim.GetAttribute(ARMATURE).Get() if "m" in values else None,
-        }
-        for q, v in values.items():
-            want = float(np.float32(v * units.usd_factor(q, host.rotational, *host.units)))
-            if read[q] != want:
-                raise RuntimeError(f"joint {prim.GetPath()} reads {q} = {read[q]!r}, not {want!r}")
+        check_drive(after.GetPrimAtPath(host.joint.GetPath()), host.rotational, host.units, values)
 
     return check
 

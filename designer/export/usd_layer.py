@@ -88,7 +88,8 @@ def _prim_changes(before, after, skip: set[str]) -> list[str]:
             changed.append(name)
     rels_a = {r.GetName(): r.GetTargets() for r in before.GetRelationships()}
     rels_b = {r.GetName(): r.GetTargets() for r in after.GetRelationships()}
-    changed += [name for name in sorted(set(rels_a) | set(rels_b)) if rels_a.get(name) != rels_b.get(name)]
+    rels = (set(rels_a) | set(rels_b)) - skip
+    changed += [name for name in sorted(rels) if rels_a.get(name) != rels_b.get(name)]
     return changed
 
 
