@@ -179,6 +179,10 @@ def _unchanged_but(host_stage, flex_stage, joint_path: str, added: tuple[str, ..
     return differ
 
 
+#: per file given to `newton_static`, the armature Newton read on the joint (physxJoint:armature)
+ARMATURES: dict[str, float] = {}
+
+
 def newton_static(path: Path, joint: str, load: float, seconds: float) -> tuple[float, float, float]:
     """Newton's reading of `path` (PhysX attributes too) and its joint's coordinate after `seconds` of a
     constant generalised load (N or N.m), no gravity, 1 ms steps: (rest, k, coordinate). A robot joint
@@ -204,6 +208,7 @@ def newton_static(path: Path, joint: str, load: float, seconds: float) -> tuple[
     solver = newton.solvers.SolverFeatherstone(model)
     s0, s1, control = model.state(), model.state(), model.control()
     rest, k = float(control.joint_target_q.numpy()[dof]), float(model.joint_target_ke.numpy()[dof])
+    ARMATURES[str(path)] = float(model.joint_armature.numpy()[dof])
     f = control.joint_f.numpy()
     f[dof] = load
     control.joint_f.assign(f)
@@ -260,6 +265,7 @@ def test_into_newton_cartpole_from_its_folder(tmp_path, monkeypatch, capsys):
     # cart 1 kg and two 0.25 kg poles ride on the rail: 1.51 kg with the armature, zeta 0.74
     rest, k, q = newton_static(Path("cartpole_flex.usda"), "railCartJoint", 8.0, 5.0)
     assert k == 800.0 and q - rest == pytest.approx(8.0 / 800.0, rel=0.01)
+    assert ARMATURES["cartpole_flex.usda"] == pytest.approx(0.01, rel=1e-7)
 
 
 @pytest.fixture(scope="module")
@@ -392,3 +398,21 @@ def test_series_into_iiwa_keeps_the_motor_drive(iiwa_usd, tmp_path):
     )
     assert drive(stage, path, "angular")["k"] == f32(0.05 * math.pi / 180)
     assert "lbr_iiwa_joint_4_motor" in out.advice and "lbr_iiwa_joint_4" in out.advice
+
+
+def test_layer_written_elsewhere_points_back_relatively(tmp_path, monkeypatch):
+    """-o in another folder: the sublayer is the robot's path from there; moved together, it still opens."""
+    robot_dir = tmp_path / "robot"
+    robot_dir.mkdir()
+    _centimetre_robot(robot_dir)
+    (tmp_path / "out").mkdir()
+    monkeypatch.chdir(robot_dir)
+    out = export_usd(JOINT, Path("../out/flex.usda"), into="cm_robot.usda", joint_name="slide", axis="x")
+    assert Sdf.Layer.FindOrOpen(str(out.path)).subLayerPaths == ["../robot/cm_robot.usda"]
+    moved = tmp_path / "moved"
+    moved.mkdir()
+    os.rename(robot_dir, moved / "robot")
+    os.rename(tmp_path / "out", moved / "out")
+    stage = Usd.Stage.Open(str(moved / "out" / "flex.usda"))
+    assert drive(stage, "/robot/slide", "linear")["k"] == 800.0
+    assert stage.GetPrimAtPath("/robot/arm").IsValid() and UsdGeom.GetStageMetersPerUnit(stage) == 0.01

@@ -78,6 +78,42 @@ def _motor_joint(stage, host: UsdHost, path, rotor, drive: dict[str, float], kin
         prim.GetAttribute(f"drive:{drive_instance(host.rotational)}:physics:type").Set(kind)
 
 
+def _motor_drive(
+    h: UsdHost,
+    old: dict,
+    si: dict,
+    link: float,
+    rotor: float,
+    missing: str | None,
+    motor_inertia: float | None,
+    motor_bandwidth: float | None,
+) -> tuple[dict[str, float], robot.Servo | None]:
+    """The motor joint's drive values (SI): the robot joint's drive, or, when it has none, a servo for
+    the `link` (what the flexure moves) and the `rotor`; armature `motor_inertia`, else the robot's,
+    else 10 x the flexure's moving inertia."""
+    name = h.joint.GetName()
+    armature = motor_inertia if motor_inertia is not None else (old["m"] or 10 * si["m"])
+    servo = None
+    if old["k"] is None:
+        if missing:
+            raise DesignerError(
+                f"robot joint '{name}' has no drive to be the motor, and body {missing} states no mass to "
+                "size a servo for",
+                "give the joint a drive (the motor's gains) in the robot, or state the bodies' masses",
+            )
+        flex = step_advice(si["k"], si["c"], link)
+        servo = robot.Servo.for_flexure(
+            flex, carried=link + rotor, motor_inertia=armature, bandwidth=motor_bandwidth
+        )
+        drive = {"k": servo.kp, "c": servo.kv, "r": 0.0}
+    else:
+        drive = {q: old[q] for q in ("k", "c", "r", "F") if old[q] is not None}
+    drive["m"] = armature
+    if old["friction"]:
+        drive["friction"] = old["friction"]
+    return drive, servo
+
+
 def into_series(
     joint: Joint,
     host: Path,
@@ -115,27 +151,8 @@ def into_series(
     old = host_values(h)
     moved, missing = moved_inertia(h.stage, h.joint, rot)
     link = moved + si["m"]
-    armature = motor_inertia if motor_inertia is not None else (old["m"] or 10 * si["m"])
-    servo = None
-    if old["k"] is None:
-        if missing:
-            raise DesignerError(
-                f"robot joint '{name}' has no drive to be the motor, and body {missing} states no mass to "
-                "size a servo for",
-                "give the joint a drive (the motor's gains) in the robot, or state the bodies' masses",
-            )
-        servo = robot.Servo.for_flexure(
-            step_advice(si["k"], si["c"], link),
-            carried=link + (clamp.inertia if rot else clamp.mass),
-            motor_inertia=armature,
-            bandwidth=motor_bandwidth,
-        )
-        drive = {"k": servo.kp, "c": servo.kv, "r": 0.0}
-    else:
-        drive = {q: old[q] for q in ("k", "c", "r", "F") if old[q] is not None}
-    drive["m"] = armature
-    if old["friction"]:
-        drive["friction"] = old["friction"]
+    rotor = clamp.inertia if rot else clamp.mass
+    drive, servo = _motor_drive(h, old, si, link, rotor, missing, motor_inertia, motor_bandwidth)
     layer, stage = over_layer(h.stage, h.path, path.suffix)
     _rotor(stage, h, rotor_path, clamp)
     _motor_joint(stage, h, motor_path, rotor_path, drive, old["type"])
@@ -162,7 +179,9 @@ def into_series(
     return _advice(h, name, si, link, drive, clamp, missing), _notes(h, name, old, drive, servo, rest)
 
 
-def _advice(h, name, si, link, motor, clamp, missing) -> dict[str, StepAdvice]:
+def _advice(
+    h: UsdHost, name: str, si: dict, link: float, motor: dict, clamp: robot.Sphere, missing: str | None
+) -> dict[str, StepAdvice]:
     """The flexure's advice (the link, motor held) and the motor's (flexure held), when masses are known."""
     if missing:
         return {}
@@ -175,7 +194,9 @@ def _advice(h, name, si, link, motor, clamp, missing) -> dict[str, StepAdvice]:
     return advice
 
 
-def _notes(h, name, old, motor, servo, rest) -> tuple[str, ...]:
+def _notes(
+    h: UsdHost, name: str, old: dict, motor: dict, servo: robot.Servo | None, rest: float
+) -> tuple[str, ...]:
     """Where each robot value went (SI)."""
     unit = "rad" if h.rotational else "m"
     notes = [
