@@ -21,7 +21,7 @@ import json
 from pathlib import Path
 
 from .. import units
-from ..errors import DesignerError, check_type
+from ..errors import DesignerError, check_type, path_argument
 from ..files import atomic_path, check_suffix
 from ..joint import Joint, check_joint
 from . import robot
@@ -182,10 +182,11 @@ def export_usd(
         if joint_name is None:
             raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
         check_type(joint_name, str, "joint_name", expected="a name", fix="give e.g. joint_name='knee'")
+        into = path_argument(into, "into", what="a USD robot")
         if form == "series":
             advice, notes = into_series(
                 joint,
-                Path(into),
+                into,
                 path,
                 joint_name=joint_name,
                 axis=axis,
@@ -196,7 +197,7 @@ def export_usd(
         else:
             advice, notes = into_parallel(
                 joint,
-                Path(into),
+                into,
                 path,
                 joint_name=joint_name,
                 axis=axis,
