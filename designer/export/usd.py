@@ -12,7 +12,8 @@ The flexure's moving inertia and its friction (none) go into the PhysX joint att
 module, so they are authored by their schema names, as PhysX's own converters write them: Isaac Sim
 reads them, Newton reads the armature when given its PhysX schema resolver, other readers ignore them.
 
-Written and read with usd-core (`pxr`), no USDA text by hand. Into a robot: see `usd_host`.
+Written and read with usd-core (`pxr`), no USDA text by hand. Into a robot: `usd_host` (parallel),
+`usd_series`, `usd_layer` (the layer over the robot and its check).
 """
 
 from __future__ import annotations
@@ -37,7 +38,8 @@ AXIS_TOKENS = {"x": "X", "y": "Y", "z": "Z", "phi": "X", "theta": "Y", "psi": "Z
 READERS = (
     "the drive (stiffness, damping, targetPosition) is read by Isaac Sim / PhysX and Newton; "
     f"{ARMATURE} and {FRICTION} by Isaac Sim (Newton reads the armature with its PhysX schema resolver, "
-    "newton.usd.SchemaResolverPhysx)",
+    "newton.usd.SchemaResolverPhysx); they are authored by name with PhysxJointAPI applied by name, as "
+    "usd-core has no PhysxSchema module",
 )
 
 
@@ -166,13 +168,15 @@ def export_usd(
     Standalone (`into` None): form "parallel" is a chain of links, one per axis, each on a joint whose
     drive is the spring-damper; "series" is motor -> flexure -> link on one axis (see `series_stage`).
     With `into` (a USD robot) and `joint_name` (the joint prim's name or path): a layer that has the
-    robot as its sublayer (by its path relative to `path`'s folder) and changes only that revolute or
-    prismatic joint's drive and PhysX attributes (see `usd_host.into_parallel`): the robot's file is
-    not written. `rest` (rad or m): None keeps the host's drive target when inside the joint's limits.
+    robot as its sublayer (by its path relative to `path`'s folder); in parallel it changes only that
+    revolute or prismatic joint's drive and PhysX attributes (see `usd_host.into_parallel`), in series
+    it inserts a motor joint and rotor before it (see `usd_series.into_series`); the robot's file is
+    not written. `rest` (rad or m): in parallel None keeps the host's drive target when inside the
+    joint's limits; in series it is the flexure's (default 0).
 
     Raises:
-        DesignerError: a wrong suffix, unknown form, missing mass, a rest on a standalone joint, an
-            `into` problem, or form "series" with `into` (refused: see `usd_host`).
+        DesignerError: a wrong suffix, unknown form, missing mass, a rest on a standalone joint, or an
+            `into` problem.
     """
     path = check_suffix(path, SUFFIXES, what="a USD")
     check_joint(joint)
