@@ -13,6 +13,7 @@ from __future__ import annotations
 import hashlib
 import math
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -143,32 +144,62 @@ def test_into_centimetre_stage_converts_units(tmp_path, monkeypatch):
         export_usd(JOINT, Path("x.usda"), into="cm_robot.usda", joint_name="slide", axis="x", rest=0.2)
 
 
+def _plain(info: dict) -> dict:
+    """Spec info with list ops (targets, references, payloads) as their items: their repr is an address."""
+    fields = (
+        "explicitItems",
+        "prependedItems",
+        "appendedItems",
+        "deletedItems",
+        "orderedItems",
+        "addedItems",
+    )
+    return {
+        k: tuple(list(getattr(v, f)) for f in fields) if hasattr(v, "GetAddedOrExplicitItems") else v
+        for k, v in info.items()
+    }
+
+
 def _flat_specs(stage) -> dict:
-    """Every property of the flattened stage: (prim path, name) -> (default, time samples, info)."""
+    """Every spec of the flattened stage, as text: path -> (default, time samples, info) for a property,
+    (type, specifier, info) for a prim. Flatten writes instanced content as /Flattened_Prototype_N in an
+    order of its own, so those are renamed in the order of their content."""
     layer = stage.Flatten()
     specs = {}
 
     def visit(path):
         spec = layer.GetObjectAtPath(path)
         if isinstance(spec, Sdf.PropertySpec):
-            info = {k: spec.GetInfo(k) for k in spec.ListInfoKeys() if k not in ("default", "timeSamples")}
+            info = _plain(
+                {k: spec.GetInfo(k) for k in spec.ListInfoKeys() if k not in ("default", "timeSamples")}
+            )
             samples = {t: layer.QueryTimeSample(path, t) for t in layer.ListTimeSamplesForPath(path)}
-            specs[str(path)] = (spec.default if hasattr(spec, "default") else None, samples, repr(info))
+            specs[str(path)] = repr((spec.default if hasattr(spec, "default") else None, samples, info))
         elif isinstance(spec, Sdf.PrimSpec):
             # Flatten documents the layer it came from; the joint's schemas are compared in drive()
             skip = {"apiSchemas", "documentation"} if path == Sdf.Path.absoluteRootPath else {"apiSchemas"}
-            info = {k: spec.GetInfo(k) for k in spec.ListInfoKeys() if k not in skip}
-            specs[str(path)] = (spec.typeName, spec.specifier, repr(info))
+            info = _plain({k: spec.GetInfo(k) for k in spec.ListInfoKeys() if k not in skip})
+            specs[str(path)] = repr((spec.typeName, spec.specifier, info))
 
     layer.Traverse(Sdf.Path.absoluteRootPath, visit)
-    return specs
+    prototypes = sorted({p.split("/")[1] for p in specs if p.startswith("/Flattened_Prototype_")})
+    content = {
+        n: repr(sorted((p[len(n) + 1 :], v) for p, v in specs.items() if p.startswith(f"/{n}")))
+        for n in prototypes
+    }
+    names = {n: f"Prototype{i}" for i, n in enumerate(sorted(prototypes, key=content.get))}
+    pattern = re.compile(r"Flattened_Prototype_\d+")
+    return {
+        pattern.sub(lambda m: names[m.group(0)], p): pattern.sub(lambda m: names[m.group(0)], v)
+        for p, v in specs.items()
+    }
 
 
 def _unchanged_but(host_stage, flex_stage, joint_path: str, added: tuple[str, ...] = ()) -> set[str]:
     """The flattened property paths that differ between the two stages: must all be on the joint (or
     in the `added` prims, which the host must not have)."""
     a, b = _flat_specs(host_stage), _flat_specs(flex_stage)
-    differ = {p for p in set(a) | set(b) if repr(a.get(p)) != repr(b.get(p))}
+    differ = {p for p in set(a) | set(b) if a.get(p) != b.get(p)}
     new = {p for p in differ if p in added or p.startswith(tuple(f"{n}." for n in added))}
     assert not any(p in a for p in new)
     differ -= new
@@ -416,3 +447,76 @@ def test_layer_written_elsewhere_points_back_relatively(tmp_path, monkeypatch):
     stage = Usd.Stage.Open(str(moved / "out" / "flex.usda"))
     assert drive(stage, "/robot/slide", "linear")["k"] == 800.0
     assert stage.GetPrimAtPath("/robot/arm").IsValid() and UsdGeom.GetStageMetersPerUnit(stage) == 0.01
+
+
+def _newton_asset_joints() -> list[tuple[str, str]]:
+    """(asset file, joint path) for every revolute and prismatic joint of Newton's example assets."""
+    assets = package_dir("newton", "examples/assets")
+    if assets is None:
+        return []
+    out = []
+    for f in sorted(assets.glob("*.usd*")):
+        stage = Usd.Stage.Open(str(f))
+        out += [
+            (f.name, str(p.GetPath()))
+            for p in stage.Traverse()
+            if p.IsA(UsdPhysics.RevoluteJoint) or p.IsA(UsdPhysics.PrismaticJoint)
+        ]
+    return out
+
+
+@pytest.mark.parametrize("form", ["parallel", "series"])
+def test_every_joint_of_newtons_assets(tmp_path, form):
+    """Each export into each joint of every asset Newton ships runs, or (series, a joint with no drive
+    whose bodies state no mass to size a servo for) is refused with that reason; the layered stage
+    differs from the robot only in that joint (and the motor's new prims)."""
+    cases = _newton_asset_joints()
+    if not cases:
+        pytest.skip("newton (its example assets) is not installed")
+    assets = package_dir("newton", "examples/assets")
+    ran = refused = 0
+    for i, (name, joint) in enumerate(cases):
+        host = Usd.Stage.Open(str(assets / name))
+        rot = host.GetPrimAtPath(joint).IsA(UsdPhysics.RevoluteJoint)
+        out = tmp_path / f"flex{i}.usda"  # usd-core keeps an opened layer by its path while it is in use
+        try:
+            export_usd(
+                JOINT, out, into=assets / name, joint_name=joint, axis="theta" if rot else "x", form=form
+            )
+        except DesignerError as exc:
+            assert form == "series" and "has no drive to be the motor" in str(exc), (name, joint, exc)
+            refused += 1
+            continue
+        ran += 1
+        flex = Usd.Stage.Open(str(out))
+        added = (
+            f"{joint}_motor",
+            f"{flex.GetPrimAtPath(joint).GetRelationship('physics:body0').GetTargets()[0]}",
+        )
+        _unchanged_but(host, flex, joint, added if form == "series" else ())
+        got = drive(flex, joint, "angular" if rot else "linear")
+        assert got["k"] == (f32(0.05 * math.pi / 180) if rot else 800.0), (name, joint)
+    # 23 joints in 6 assets: all run in parallel; in series 6 joints without a drive are refused
+    assert ran + refused == len(cases) >= 23 and refused <= (6 if form == "series" else 0), (ran, refused)
+
+
+def test_the_exporters_check_sees_any_other_change(tmp_path):
+    """usd_layer.stage_changes, the check every export runs before its file replaces the output, reports
+    an attribute, a relationship and a prim changed outside the joint, and stage metadata."""
+    from designer.export.usd_layer import over_layer, stage_changes
+
+    host_path = _centimetre_robot(tmp_path)
+    host = Usd.Stage.Open(str(host_path))
+    layer, stage = over_layer(host, host_path, ".usda")
+    stage.GetPrimAtPath("/robot/arm").GetAttribute("physics:mass").Set(3.0)
+    stage.GetPrimAtPath("/robot/hinge").GetRelationship("physics:body1").SetTargets(["/robot/base"])
+    stage.DefinePrim("/robot/extra")
+    assert stage_changes(host, stage, {Sdf.Path("/robot/slide"): set()}) == ["prims: /robot/extra"]
+    stage.RemovePrim("/robot/extra")
+    UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+    changes = stage_changes(host, stage, {Sdf.Path("/robot/slide"): set()})
+    assert changes == [
+        "stage metadata metersPerUnit",
+        "/robot/arm: physics:mass",
+        "/robot/hinge: physics:body1",
+    ]

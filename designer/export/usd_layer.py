@@ -104,7 +104,7 @@ def stage_changes(before, after, edited: dict, added: frozenset = frozenset()) -
     changes += [
         f"stage metadata {k}" for k in sorted(keys) if not _same(before.GetMetadata(k), after.GetMetadata(k))
     ]
-    every = Usd.PrimAllPrimsPredicate
+    every = Usd.TraverseInstanceProxies(Usd.PrimAllPrimsPredicate)  # instanced content too
     paths_a = [p.GetPath() for p in Usd.PrimRange.Stage(before, every)]
     paths_b = [p.GetPath() for p in Usd.PrimRange.Stage(after, every) if p.GetPath() not in added]
     if paths_a != paths_b:
