@@ -261,8 +261,24 @@ def _sha(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
-def test_into_newton_cartpole_from_its_folder(tmp_path, monkeypatch, capsys):
-    """Newton's own cart-pole: the rail (prismatic, no drive) becomes the flexure, run as typed."""
+#: `export usd` into the cart-pole's rail: 800 N/m, 50 N.s/m (rig units)
+CARTPOLE_ARGS = (
+    "export",
+    "usd",
+    "--into",
+    "cartpole.usda",
+    "--joint",
+    "railCartJoint",
+    "--k",
+    "0.8",
+    "--c",
+    "0.05",
+)
+
+
+def cartpole_here(tmp_path: Path, monkeypatch) -> Path:
+    """Newton's cart-pole linked into a folder that becomes the current one; returns Newton's assets
+    folder (pytest.skip without newton)."""
     assets = package_dir("newton", "examples/assets")
     if assets is None or not (assets / "cartpole.usda").is_file():
         pytest.skip("newton (its example assets) is not installed")
@@ -270,19 +286,14 @@ def test_into_newton_cartpole_from_its_folder(tmp_path, monkeypatch, capsys):
     folder.mkdir()
     os.symlink(assets / "cartpole.usda", folder / "cartpole.usda")
     monkeypatch.chdir(folder)
+    return assets
+
+
+def test_into_newton_cartpole_from_its_folder(tmp_path, monkeypatch, capsys):
+    """Newton's own cart-pole: the rail (prismatic, no drive) becomes the flexure, run as typed."""
+    assets = cartpole_here(tmp_path, monkeypatch)
     host_hash = _sha(assets / "cartpole.usda")
-    args = [
-        "export",
-        "usd",
-        "--into",
-        "cartpole.usda",
-        "--joint",
-        "railCartJoint",
-        "--k",
-        "0.8",
-        "--c",
-        "0.05",
-    ]
+    args = list(CARTPOLE_ARGS)
     code, out, err = run_inprocess([*args, "--m", "0.01", "--axis", "x", "-o", "cartpole_flex.usda"], capsys)
     assert code == 0, err
     assert "stiffness: none -> 800 (SI)" in out and "damping: none -> 50 (SI)" in out
@@ -363,25 +374,8 @@ def test_refusals_name_the_problem(iiwa_usd, tmp_path, monkeypatch, capsys):
 def test_series_into_newton_cartpole(tmp_path, monkeypatch, capsys):
     """motor -> flexure -> cart on the rail: a servo added (the rail has no drive), the load on the cart
     deflects the flexure by F / k, every host value as it was but the flexure joint's."""
-    assets = package_dir("newton", "examples/assets")
-    if assets is None or not (assets / "cartpole.usda").is_file():
-        pytest.skip("newton (its example assets) is not installed")
-    folder = tmp_path / "assets"
-    folder.mkdir()
-    os.symlink(assets / "cartpole.usda", folder / "cartpole.usda")
-    monkeypatch.chdir(folder)
-    args = [
-        "export",
-        "usd",
-        "--into",
-        "cartpole.usda",
-        "--joint",
-        "railCartJoint",
-        "--k",
-        "0.8",
-        "--c",
-        "0.05",
-    ]
+    cartpole_here(tmp_path, monkeypatch)
+    args = list(CARTPOLE_ARGS)
     # Newton's Featherstone applies a drive's damping explicitly: at 1 ms the default motor (armature
     # 0.1 kg, servo damping 746 N.s/m on the 0.11 kg rotor: 6.8 x dt / m) diverged to NaN; a 1 kg motor holds
     args += ["--m", "0.01", "--axis", "x", "--form", "series", "--motor-inertia", "1", "-o", "sea.usda"]

@@ -12,7 +12,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .. import units
-from ..errors import DesignerError, check_type
+from ..errors import DesignerError
 from ..files import atomic_write, check_suffix
 from ..joint import Joint, check_joint
 from . import robot
@@ -187,9 +187,7 @@ def export_mjcf(
     if form not in FORMS:
         raise DesignerError(f"form={form!r} is not a form", f"use one of: {', '.join(FORMS)}")
     if into is not None:
-        if joint_name is None:
-            raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
-        check_type(joint_name, str, "joint_name", expected="a name", fix="give e.g. joint_name='knee'")
+        joint_name = robot.robot_joint_name(joint_name)
         with _mujoco_warnings() as warned:
             advice, notes = _into(
                 joint,

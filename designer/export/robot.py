@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .. import units
-from ..errors import DesignerError
+from ..errors import DesignerError, check_type
 from ..joint import PRB_GAMMA, Joint
 from ..mass import specimen_mass
 from ..study import space
@@ -67,6 +67,18 @@ class RobotExport:
             "advice": {n: a.to_dict() for n, a in self.advice.items()},
             "notes": list(self.notes),
         }
+
+
+def robot_joint_name(joint_name: object) -> str:
+    """The `joint_name` an export into a robot needs (the robot joint to make flexible).
+
+    Raises:
+        DesignerError: none given, or not a str.
+    """
+    if joint_name is None:
+        raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
+    check_type(joint_name, str, "joint_name", expected="a name", fix="give e.g. joint_name='knee'")
+    return joint_name
 
 
 def pick_axis(joint: Joint, axis: str | None, rotational: bool | None = None) -> str:

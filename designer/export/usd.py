@@ -22,7 +22,7 @@ import json
 from pathlib import Path
 
 from .. import units
-from ..errors import DesignerError, check_type, path_argument
+from ..errors import DesignerError, path_argument
 from ..files import atomic_path, check_suffix
 from ..joint import Joint, check_joint
 from . import robot
@@ -183,9 +183,7 @@ def export_usd(
     if form not in FORMS:
         raise DesignerError(f"form={form!r} is not a form", f"use one of: {', '.join(FORMS)}")
     if into is not None:
-        if joint_name is None:
-            raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
-        check_type(joint_name, str, "joint_name", expected="a name", fix="give e.g. joint_name='knee'")
+        joint_name = robot.robot_joint_name(joint_name)
         into = path_argument(into, "into", what="a USD robot")
         if form == "series":
             advice, notes = into_series(
