@@ -36,7 +36,7 @@ import typer  # noqa: E402
 from designer.errors import DesignerError  # noqa: E402
 
 from . import common, cosim, design, export, loop, plots, printing, rig, sweep  # noqa: E402
-from .common import flag_message  # noqa: E402
+from .common import Typer, flag_message  # noqa: E402
 
 try:  # typer 0.28 vendors click
     from typer._click import exceptions as _click_errors
@@ -54,10 +54,10 @@ SETTINGS = dict(
     add_completion=False,
     rich_markup_mode="rich",
 )
-app = typer.Typer(**SETTINGS)
+app = Typer(**SETTINGS)
 #: typer builds the click tree of every registered command on each call: a design command gets an
 #: app with only fit, predict and suggest (the help of `designer` itself still lists everything)
-design_app = typer.Typer(**SETTINGS)
+design_app = Typer(**SETTINGS)
 
 
 def _version(value: bool) -> None:
