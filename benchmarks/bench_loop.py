@@ -213,6 +213,7 @@ def summary(prints: list[int], max_prints: int) -> dict:
     a = np.array(prints, dtype=float)
     return {
         "runs": len(a),
+        "prints": [int(x) for x in a],  # per run, in the order printers x targets (the baseline's too)
         "median": float(np.median(a)),
         "p90": float(np.percentile(a, 90, method="higher")),
         "never": int(np.sum(a > max_prints)),

@@ -266,6 +266,7 @@ FLAGS: tuple[Flag, ...] = (
         r"--package-path \1=DIR",
         "as ROS's package path would: package_paths={'arm': 'DIR'}",
     ),
+    Flag(r"\bmax_cases=(\d+)", r"--max-cases \1", "or pass max_cases=2000000 if that many are meant"),
     Flag(r"\bpackage_paths\['([^']+)'\]=", r"--package-path \1=", "package_paths['arm']='x' is not a folder"),
 )
 

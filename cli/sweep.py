@@ -35,6 +35,12 @@ def sweep(
         typer.Option("--path", help="fmu (co-simulate every case) or engine (mujoco.rollout fast path)"),
     ] = None,
     plot: Annotated[bool, typer.Option("--plot/--no-plot", help="draw metrics.png")] = True,
+    max_cases: Annotated[
+        int | None,
+        typer.Option(
+            "--max-cases", min=1, help="most cases to run (default 1000000); checked before any work"
+        ),
+    ] = None,
     json_out: JsonOpt = False,
 ) -> None:
     """Run a design sweep: a grid, suggestion candidates or Monte Carlo draws over the prediction intervals.
@@ -56,6 +62,8 @@ def sweep(
         if path not in ("fmu", "engine"):
             raise DesignerError(f"--path {path} is not allowed", "use --path fmu or --path engine")
         s = replace(s, path=path)
+    max_cases = sw.MAX_CASES if max_cases is None else max_cases
+    sw.check_size(s, max_cases)
     check_output_folder(out, OUTPUT_FILES)
     made = _missing_folders(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -63,7 +71,9 @@ def sweep(
     try:
         with executor(workers=workers, scheduler=scheduler, cluster=s.cluster) as ex:
             with progress(f"sweeping {spec.name}", enabled=not json_out) as bar:
-                result = sw.run(s, executor=ex, journal=out / "cases.jsonl", progress=bar)
+                result = sw.run(
+                    s, executor=ex, journal=out / "cases.jsonl", progress=bar, max_cases=max_cases
+                )
         finishing()
         files = sw.write_results(result, out, plot=plot)
     except BaseException:  # stopped or failed: keep the finished cases for a rerun, nothing else

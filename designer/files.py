@@ -37,7 +37,8 @@ def format_bytes(n: float) -> str:
     """1536 -> '1.5 KiB': sizes in messages, binary units, two significant figures at most."""
     for unit in ("B", "KiB", "MiB", "GiB", "TiB"):
         if abs(n) < 1024 or unit == "TiB":
-            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.2g} {unit}"
+            # two significant figures without an exponent: 300 MiB, not 3e+02 MiB
+            return f"{n:.0f} {unit}" if unit == "B" else f"{float(f'{n:.2g}'):g} {unit}"
         n /= 1024
     raise AssertionError("unreachable")
 

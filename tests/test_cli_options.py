@@ -88,7 +88,7 @@ def test_help_texts_share_one_style():
     """Every option's and argument's help starts in lower case (unless with a name such as MuJoCo or
     JSON) and ends without a full stop, as most of them did; `suggest --help` states each exit code once."""
     odd = []
-    for path, cmd in COMMANDS.items():
+    for path, cmd in [*COMMANDS.items(), ("designer", typer.main.get_command(app))]:
         for p in cmd.params:
             text = (getattr(p, "help", None) or "").strip()
             first = text.split()[0] if text else ""

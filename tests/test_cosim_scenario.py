@@ -279,6 +279,9 @@ def test_scenario_built_in_code_runs_in_memory_and_writes_nothing(tmp_path, monk
         ({"outputs": {"pdf": True}}, "not a set of switches"),
         ({"duration": 1e9}, "needs about .* of memory, .* available"),
         ({"validation_steps": (1e-3,)}, "fewer than two steps"),
+        # issue 37, cause 8: 100 000 duplicate steps ran one after another
+        ({"validation_steps": (1e-3,) * 100_000}, "lists 0.001 more than once"),
+        ({"validation_steps": tuple(1e-3 / (i + 1) for i in range(11))}, "lists 11 steps; .* 2 to 10"),
     ],
 )
 def test_invalid_scenario_built_in_code_is_refused_naming_the_field(changes, message):

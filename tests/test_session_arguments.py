@@ -49,3 +49,19 @@ def test_numpy_numbers_run_as_python_floats(session):
     )
     assert numpy.laws["j1"]["k"] == 0.25 and numpy.laws["j1"]["c"] == 8.3e-4
     assert np.allclose(numpy.values, plain.values, rtol=1e-6, atol=1e-12)
+
+
+def test_enabled_switches_the_spring_damper_as_documented(session):
+    """The FMU's documented Boolean `theta.enabled` (it was refused as "not a finite number", a
+    Boolean having no Real setter). Off, the joint is free: the same trace as k = c = 0, and the laws
+    the metrics and references use say so; a number for it is refused."""
+    off = session.run({"j1": {"theta.enabled": False}}, duration=0.2)
+    free = session.run({"j1": {"theta.k": 0.0, "theta.c": 0.0}}, duration=0.2)
+    on = session.run({"j1": {"theta.enabled": np.bool_(True)}}, duration=0.2)
+    plain = session.run(None, duration=0.2)
+    assert np.array_equal(off.values, free.values)
+    assert off.laws["j1"]["k"] == 0.0 and off.laws["j1"]["c"] == 0.0
+    assert np.array_equal(on.values, plain.values) and not np.array_equal(on.values, off.values)
+    assert session.run(None, duration=0.2).laws == plain.laws  # a case's switch does not stick
+    with pytest.raises(DesignerError, match="is not true or false"):
+        session.run({"j1": {"theta.enabled": 0}})

@@ -125,6 +125,7 @@ class FmuDescription:
         self.version = 3 if md.fmiVersion.startswith("3") else 2
         self.refs = {v.name: v.valueReference for v in md.modelVariables}
         self.starts = {v.name: v.start for v in md.modelVariables}
+        self.kinds = {v.name: v.type for v in md.modelVariables}  # Real/Float64, Boolean, ...
         causality = {v.name: v.causality for v in md.modelVariables}
         self.interface = "force" if causality.get(f"{axes[0]}.f") == "output" else "body"
 
@@ -338,7 +339,10 @@ class FmuSystem:
                 raise DesignerError(
                     f"FMU {self.description.path} has no parameter '{key}'", "use names such as theta.k"
                 )
-            self._set_scalar(refs[key], float(value))
+            if self.description.kinds[key] == "Boolean":
+                self._set_boolean(refs[key], bool(value))
+            else:
+                self._set_scalar(refs[key], float(value))
         self._initialize()
 
     def reset(self, parameters: Mapping[str, float] | None = None) -> None:
@@ -472,6 +476,9 @@ class FmuSystem:
             self.fmu.setFloat64([vr], [value])
         else:
             self.fmu.setReal([vr], [value])
+
+    def _set_boolean(self, vr: int, value: bool) -> None:
+        self.fmu.setBoolean([vr], [value])
 
     def get(self) -> np.ndarray:
         try:

@@ -14,11 +14,15 @@ decide which type a scenario is. The README documents every key.
 from __future__ import annotations
 
 import math
+import numbers
 from abc import ABC, abstractmethod
+from collections import Counter
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, ClassVar
+
+import numpy as np
 
 from .. import units
 from ..errors import DesignerError
@@ -71,7 +75,7 @@ class JointSource:
                     f"parameter '{key}' is not a parameter of axis {self.axis}",
                     f"use {', '.join(f'{self.axis}.{f}' for f in PARAMETER_FIELDS)}",
                 )
-            finite(value, f"parameter '{key}'")
+            parameter_value(name, value, f"parameter '{key}'")
         if self.fmu is None:
             self.joint.axis(self.axis)
             return self
@@ -80,6 +84,9 @@ class JointSource:
         check_fmu(self.fmu, [self.axis])
         return replace(self, fmu=Path(self.fmu))
 
+
+#: the most validation steps a scenario lists: each is a whole run, the order of convergence needs 2
+MAX_VALIDATION_STEPS = 10
 
 #: the one-line refusal of a scenario that is neither (or both) a robot and the rig
 NEITHER = (
@@ -175,6 +182,18 @@ class Scenario(ABC):
             raise DesignerError(
                 f"validation_steps = {list(steps)} lists fewer than two steps", "e.g. [1e-3, 5e-4]"
             )
+        twice = sorted(s for s, n in Counter(steps).items() if n > 1)
+        if twice:
+            raise DesignerError(
+                f"validation_steps lists {', '.join(f'{s:g}' for s in twice)} more than once",
+                "list each step once, e.g. [1e-3, 5e-4]",
+            )
+        if len(steps) > MAX_VALIDATION_STEPS:
+            raise DesignerError(
+                f"validation_steps lists {len(steps)} steps; a convergence check takes 2 to "
+                f"{MAX_VALIDATION_STEPS}, each run in turn",
+                "list a few steps halving down, e.g. [1e-3, 5e-4, 2.5e-4]",
+            )
         span = (
             self.duration
             if self.validation_duration is None
@@ -254,6 +273,23 @@ def finite(value: Any, what: str) -> float:
     """
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise DesignerError(f"{what} = {value!r} is not a finite number", "give a finite number")
+    return float(value)
+
+
+def parameter_value(field: str, value: Any, what: str) -> float | bool:
+    """A joint parameter's value checked: `enabled` a bool (Python's or numpy's), the others a finite
+    number (numpy's float32 and int64 included, a bool not).
+
+    Raises:
+        DesignerError: the value is not of its field's kind, naming `what`.
+    """
+    if field == "enabled":
+        if not isinstance(value, (bool, np.bool_)):
+            raise DesignerError(f"{what} = {value!r} is not true or false", "give True or False")
+        return bool(value)
+    real = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+    if not real or not math.isfinite(value):
+        raise DesignerError(f"{what} = {value!r} is not a finite number", "give its value in SI")
     return float(value)
 
 

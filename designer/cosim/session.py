@@ -18,12 +18,8 @@ every path, also when `prepare` fails halfway.
 from __future__ import annotations
 
 import contextlib
-import math
-import numbers
 from collections.abc import Mapping
 from pathlib import Path
-
-import numpy as np
 
 from ..errors import DesignerError, check_type, describe
 from ..files import temporary_folder
@@ -31,7 +27,15 @@ from .fmu import FmuDescription, FmuSystem, unpack
 from .kernel import ENGINES, Bound, bind, run_master
 from .master import Master, Trace
 from .result import Result
-from .scenario import PARAMETER_FIELDS, JointSource, Progress, Scenario, check_memory, positive
+from .scenario import (
+    PARAMETER_FIELDS,
+    JointSource,
+    Progress,
+    Scenario,
+    check_memory,
+    parameter_value,
+    positive,
+)
 
 
 def _unpacked(src: JointSource, interface: str, folder: Path) -> Path:
@@ -111,11 +115,15 @@ class Session:
 
     # ------------------------------------------------------------------ one run
 
-    def parameters(self, parameters: Mapping[str, Mapping[str, float]] | None) -> dict[str, dict[str, float]]:
-        """A case's parameters checked: {system: {"axis.field": SI value}} (systems as in `laws`).
+    def parameters(
+        self, parameters: Mapping[str, Mapping[str, float | bool]] | None
+    ) -> dict[str, dict[str, float | bool]]:
+        """A case's parameters checked: {system: {"axis.field": SI value, or a bool for "axis.enabled"}}
+        (systems as in `laws`).
 
         Raises:
-            DesignerError: an unknown system or parameter, or a value that is not a finite number.
+            DesignerError: an unknown system or parameter, a value that is not a finite number, or an
+                `enabled` that is not a bool.
         """
         out: dict[str, dict[str, float]] = {name: {} for name in self.systems}
         example = 'give {"j1": {"theta.k": 0.3, "theta.c": 8e-4}} (SI, by joint)'
@@ -137,27 +145,23 @@ class Session:
                         f"parameters['{name}'] has '{key}', not a parameter of axis {axis}",
                         f"use {', '.join(f'{axis}.{f}' for f in PARAMETER_FIELDS)}",
                     )
-                # numpy's float32 and int64 are numbers too; a bool (numpy's included) is not one
-                real = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
-                if not real or not math.isfinite(value):
-                    raise DesignerError(
-                        f"parameters['{name}']['{key}'] = {value!r} is not a finite number",
-                        "give its value in SI",
-                    )
-                out[name][str(key)] = float(value)
+                out[name][str(key)] = parameter_value(field, value, f"parameters['{name}']['{key}']")
         return out
 
     def laws(self, case: Mapping[str, Mapping[str, float]]) -> dict[str, dict[str, float]]:
         """The SI m, c, k, offset each joint FMU runs with: start values, the scenario's overrides,
-        then the case's (`case` as `parameters` returns it)."""
+        then the case's (`case` as `parameters` returns it); k and c are 0 where `enabled` is False."""
         out = {}
         for name, src in self.scenario.sources().items():
             law = self.descriptions[name].parameters(src.axis)
-            for key, value in (dict(src.parameters) | case[name]).items():
+            given = dict(src.parameters) | case[name]
+            for key, value in given.items():
                 axis, _, field = key.partition(".")
                 if axis == src.axis and field in ("m", "c", "k", "offset"):
                     law[field] = float(value)
             law.setdefault("offset", 0.0)
+            if given.get(f"{src.axis}.enabled") is False:  # the spring-damper off: the joint is free
+                law["k"] = law["c"] = 0.0
             out[name] = law
         return out
 

@@ -271,6 +271,8 @@ class CalibratedSurface(ResponseSurface):
         K = self._cross(R, self._sgu, self._Hu, self.own) + self.noise**2 * np.eye(len(mu0))
         self._Kinv = np.linalg.inv(K) if len(mu0) else np.zeros((0, 0))
         self._alpha = self._Kinv @ (np.log(self.observed) - mu0)
+        #: a run's prior variance as `log_moments` states it at its design, less its diagonal in K
+        self._excess = self._prior_var(s0, self._Hu) - np.diag(K)
 
     def _cross(self, R: np.ndarray, sa: np.ndarray, Ha: np.ndarray, ua: np.ndarray) -> np.ndarray:
         """Prior covariance of log y between designs a (rows) and the runs (columns), given their
@@ -279,6 +281,25 @@ class CalibratedSurface(ResponseSurface):
         shared = np.outer(sa, self._sgu) * R
         printer = (Ha * self._Sb) @ self._Hu.T + self.local_sd**2 * np.outer(ua, self.own) * R
         return shared + printer
+
+    def _prior_var(self, s0: np.ndarray, H: np.ndarray) -> np.ndarray:
+        """Variance of log y on the user's printer before any run, at designs of study spread s0
+        and mechanism terms H (n, terms)."""
+        sg = _local_sd(s0, self.noise)
+        return s0**2 + (self.amplitude**2 - 1) * sg**2 + H**2 @ self._Sb + self.local_sd**2
+
+    def own_loo(self) -> Prediction:
+        """Each of the user's runs predicted as `predict` would from every other run (the study's
+        and the user's) with it left out, in closed form: for the Gaussian model in log space, the
+        mean is log y_i - alpha_i / (K^-1)_ii and the variance 1 / (K^-1)_ii less the print scatter
+        the diagonal carries (the settings come from the study, so nothing is refitted). One
+        inversion instead of one calibration per run. Shape (n_own,), in the user's run order."""
+        mine = self.own > 0
+        d = np.diag(self._Kinv)[mine]
+        mu = np.log(self.observed[mine]) - self._alpha[mine] / d
+        s = np.sqrt(np.maximum(self._excess[mine] + 1.0 / d, self.noise**2))
+        half = self.t95 * s
+        return Prediction(np.exp(mu), np.exp(mu - half), np.exp(mu + half))
 
     @property
     def transform(self) -> str:
@@ -294,8 +315,7 @@ class CalibratedSurface(ResponseSurface):
         )
         H = mechanisms.basis(self._base, designs)
         C = self._cross(_correlation(Z, self._Zu, self.length), self.amplitude * sg, H, np.ones(len(Z)))
-        prior = s0**2 + (self.amplitude**2 - 1) * sg**2 + H**2 @ self._Sb + self.local_sd**2
-        var = prior - np.einsum("ij,jk,ik->i", C, self._Kinv, C)
+        var = self._prior_var(s0, H) - np.einsum("ij,jk,ik->i", C, self._Kinv, C)
         return mu0 + C @ self._alpha, np.sqrt(np.maximum(var, self.noise**2))
 
     def predict(self, X: Any) -> Prediction:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
+import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -18,6 +19,8 @@ import numpy as np
 from .. import units
 from ..cosim.scenario import JointSource
 from ..errors import DesignerError
+from ..files import format_bytes
+from ..limits import check_memory
 from ..model.surrogate import Surrogate
 from ..study import space
 from .draws import joint_draws, on_axis, source_axis
@@ -181,7 +184,53 @@ def montecarlo(spec: Spec) -> list[Case]:
     return cases
 
 
-def make_cases(spec: Spec) -> list[Case]:
-    """The spec's cases, each keyed by its hash."""
+#: the most cases a sweep builds unless told otherwise (`max_cases`): a million co-simulations are
+#: hours on a cluster; more is usually a grid with one axis too many
+MAX_CASES = 1_000_000
+#: memory per case planned for: the case and its result row (measured 1.5 kB for a two-joint grid's
+#: cases and rows of ten values; the summary's table and the metrics columns take more)
+BYTES_PER_CASE = 4096
+
+
+def case_count(spec: Spec) -> int:
+    """How many cases `spec` makes, counted without building them."""
+    c = spec.cases
+    if c.type == "grid":
+        return math.prod(len(values) for table in c.joints.values() for values in table.values())
+    if c.type == "suggestion":
+        from ..design.candidates import Suggestion
+
+        numbers = len(c.candidates) or len(Suggestion.load(c.file).candidates)
+        return numbers ** len(c.joints)
+    return c.n
+
+
+def check_size(spec: Spec, max_cases: int = MAX_CASES) -> int:
+    """The number of cases, checked before any is built: at most `max_cases`, and their memory within
+    what the machine has.
+
+    Raises:
+        DesignerError: more cases than `max_cases` (naming the count, its memory and the argument
+            that allows more), or more memory than available.
+    """
+    n = case_count(spec)
+    need = format_bytes(n * BYTES_PER_CASE)
+    if n > max_cases:
+        raise DesignerError(
+            f"the sweep makes {n:.3g} cases (about {need} of memory, each a co-simulation of "
+            f"{spec.scenario.duration:g} s), more than the {max_cases} a sweep makes unless told",
+            f"vary fewer values, or pass max_cases={n} if that many are meant",
+        )
+    check_memory(n * BYTES_PER_CASE, what=f"a sweep of {n:.3g} cases", fix="vary fewer values")
+    return n
+
+
+def make_cases(spec: Spec, *, max_cases: int = MAX_CASES) -> list[Case]:
+    """The spec's cases, each keyed by its hash.
+
+    Raises:
+        DesignerError: as `check_size`, before any case is built; a bad grid key or suggestion file.
+    """
+    check_size(spec, max_cases)
     made = {"grid": grid, "suggestion": suggestion, "montecarlo": montecarlo}[spec.cases.type](spec)
     return finish(made, spec)

@@ -14,7 +14,7 @@ from typing import IO
 import pandas as pd
 
 from ..errors import DesignerError, describe
-from .cases import Case, make_cases
+from .cases import MAX_CASES, Case, make_cases
 from .evaluate import Task, batches, evaluate, holding
 from .spec import Spec, check
 
@@ -173,17 +173,19 @@ def run(
     executor: Executor | None = None,
     journal: str | Path | None = None,
     progress: Progress = None,
+    max_cases: int = MAX_CASES,
 ) -> SweepResult:
     """Evaluate every case of a sweep and summarise; nothing is written but the optional journal.
 
     `executor` is any `concurrent.futures` executor (default: local processes, or the spec's
-    [cluster]); `journal` a JSON-lines file of finished cases, read to skip them and appended to.
+    [cluster]); `journal` a JSON-lines file of finished cases, read to skip them and appended to;
+    `max_cases` the most cases built (`check_size`, checked before any is).
     """
     from .summary import summarize
 
     spec = check(spec)
     journal = None if journal is None else Path(journal)
-    cases = make_cases(spec)
+    cases = make_cases(spec, max_cases=max_cases)
     rows, resumed = evaluate_cases(spec, cases, executor=executor, journal=journal, progress=progress)
     frame = table(rows)
     return SweepResult(frame, summarize(spec, frame=frame, cases=cases), spec, resumed)
