@@ -15,8 +15,9 @@ goal, every third holds raster at 0 deg), these policies, each counting prints u
 +-10 % of every predictable target (k; c is not predictable from the factors):
 
 - `loop`: calibrate to the runs so far (`designer.calibrate`), `designer.next_prints(n=1)`: print
-  the recommendation when its P >= 0.9, else the print it proposes; every print is measured, so the
-  first print within the tolerance ends the run (as for the baseline);
+  what it proposes (the recommendation, design #1; "print design #1" once its P >= 0.9, or the
+  nearest design when the calibrated model finds the target out of reach); every print is measured,
+  so the first print within the tolerance ends the run (as for the baseline);
 - `one-shot`: the study surrogate's recommendation, printed once (hit or not);
 - `augment`: `doe --augment` (3 prints near the target), refit on the study plus the user's runs,
   suggest, print the recommendation; repeated while it misses (`--augment N` printers; default 0);
@@ -53,7 +54,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import printers as truth  # noqa: E402
 
 import designer  # noqa: E402
-from designer.model.calibration import new_printer
 from designer.study.doe import plan_next
 
 TOLERANCE = 0.10
@@ -76,23 +76,18 @@ def _predictable(sug) -> dict:
     return {q: t.value for q, t in sug.targets.items() if sug.predictability[q]["predictable"]}
 
 
-def loop(study, printer, goals, fixed, rng, max_prints, stated, policy="next"):
+def loop(study, printer, goals, fixed, rng, max_prints, stated):
     """Prints until a printed recommendation lands; `stated` gets (P, hit, round, stop) of every round's
     recommendation, printed hypothetically from its own stream."""
     runs = pd.DataFrame()
     check = np.random.default_rng([printer.seed, int(1e4 * goals["k"]), 7])
     for count in range(1, max_prints + 1):
         surrogate = designer.calibrate(study, runs)
-        if policy == "recommend":  # print the recommendation every round
-            surrogate = new_printer(surrogate)
-            rec = designer.suggest(surrogate, **goals, fixed=fixed, top=1, tolerance=TOLERANCE).candidates[0]
-            design, p_now, stop = rec.params, rec.p_within, False
-        else:
-            nxt = designer.next_prints(surrogate, **goals, fixed=fixed, n=1, tolerance=TOLERANCE)
-            rec, p_now, stop = nxt.recommendation, nxt.p_now, nxt.stop
-            # no print proposed (stop, or the calibrated model finds the target out of reach): the
-            # recommendation itself, the nearest design
-            design = nxt.prints[0].params if nxt.prints else rec.params
+        nxt = designer.next_prints(surrogate, **goals, fixed=fixed, n=1, tolerance=TOLERANCE)
+        rec, p_now, stop = nxt.recommendation, nxt.p_now, nxt.stop
+        # no print proposed (stop, or the calibrated model finds the target out of reach): the
+        # recommendation itself, the nearest design
+        design = nxt.prints[0].params if nxt.prints else rec.params
         targets = {q: v for q, v in goals.items() if q == "k"}
         stated.append((p_now, _lands(printer, rec.params, check, targets)[0], count, stop))
         hit, run = _lands(printer, design, rng, targets)
@@ -255,12 +250,6 @@ def main() -> None:
     parser.add_argument("--augment", type=int, default=0, help="printers run through the augment baseline")
     parser.add_argument("--quick", action="store_true", help="3 printers x 3 targets (a smoke run)")
     parser.add_argument("--json", action="store_true")
-    parser.add_argument(
-        "--policy",
-        choices=("next", "recommend"),
-        default="next",
-        help="next: print what designer next proposes; recommend: print suggest's #1 each round",
-    )
     parser.add_argument("--seed", type=int, default=1000, help="seed of the first printer")
     parser.add_argument(
         "--truth",
@@ -298,9 +287,7 @@ def main() -> None:
                 unreachable += 1
                 continue
             rng = np.random.default_rng(10_000 * p + i)
-            results["loop"].append(
-                loop(study, printer, goals, fixed, rng, args.max_prints, stated_loop, args.policy)
-            )
+            results["loop"].append(loop(study, printer, goals, fixed, rng, args.max_prints, stated_loop))
             results["one_shot"].append(one_shot(study, printer, goals, fixed, rng, cache, stated_one))
             rng = np.random.default_rng([10_000 * p + i, 2])
             results["baseline"].append(baseline(study, printer, goals, fixed, rng, args.max_prints, grids))

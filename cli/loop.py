@@ -148,10 +148,11 @@ def next_(
 ) -> None:
     """The designs to print and measure next so that the recommendation lands on your target.
 
-    Each proposed print is chosen for how much measuring it raises the chance that the best design
-    afterwards lands within --tolerance of the targets (a knowledge gradient), among printable
-    designs near the target. When the current best already lands with probability --stop or more,
-    it says to print design #1 and proposes nothing else. Exit 1 when the target is out of reach
+    The first print is design #1, the one most likely to land now; each further one (--n) is chosen
+    for how much measuring it raises the chance that the best design afterwards lands within
+    --tolerance of the targets (a knowledge gradient), among printable designs near the target. When
+    design #1 already lands with probability --stop or more, it says to print it and proposes
+    nothing else. Exit 1 when the target is out of reach
     (the reason is printed, no print is proposed), 2 on bad input.
 
     Example: designer next --k 0.8 --n 3 --surrogate mine.json

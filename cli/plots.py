@@ -329,8 +329,12 @@ def profile_cmd(
         typer.Option("--target", help="target in rig units, QUANTITY=VALUE (repeat): k=0.8, c=2e-3"),
     ] = None,
     tolerance: Annotated[
-        float, typer.Option("--tolerance", help="a joint meets its target within this many %")
-    ] = 10.0,
+        float | None,
+        typer.Option(
+            "--tolerance",
+            help="a joint meets its target within this many %; default the suggestion's, else 10",
+        ),
+    ] = None,
     suggestion: Annotated[
         Path | None,
         typer.Option("--suggestion", help="output of designer suggest --json: candidates to click"),
@@ -345,10 +349,11 @@ def profile_cmd(
 ) -> None:
     """An interactive prediction profiler: one self-contained HTML page (no server, no network).
 
-    Sliders per factor, per response the prediction and its 95 % PI against each factor; goals
-    (target, min, max) with the probability of meeting them; locks and "maximize" (the search of
-    designer suggest, in the page); a print-noise simulator; remembered settings copied as export
-    commands; suggestions to click.
+    Sliders and typed values per factor, per response the prediction and its 95 % PI against each
+    factor; goals (target, low and high limits, min, max) with the probability of meeting each and all
+    of them; locks and "maximize" (the search of designer suggest, in the page); a contour view and a
+    P trace; a print-noise simulator; remembered settings copied as export commands; suggestions to
+    click. Opened with --suggestion, the page starts at its first candidate with its goals.
 
     Example: designer profile --target k=0.8 -o profiler.html
     """
@@ -356,7 +361,7 @@ def profile_cmd(
     from designer.plots import profile
     from designer.study import space
 
-    if not 0 < tolerance < 100:
+    if tolerance is not None and not 0 < tolerance < 100:
         raise DesignerError(
             f"--tolerance {tolerance:g} is not a percentage in (0, 100)", "give e.g. --tolerance 10"
         )
@@ -364,7 +369,12 @@ def profile_cmd(
     targets = parse_fix(target, flag="--target", example="k=0.8", names=None)
     start = parse_fix(design, flag="--design", example="width=3.5")
     page = profile.build_profiler(
-        sur, axis=axis, targets=targets, tolerance=tolerance / 100, suggestion=suggestion, design=start
+        sur,
+        axis=axis,
+        targets=targets,
+        tolerance=None if tolerance is None else tolerance / 100,
+        suggestion=suggestion,
+        design=start or None,
     )
     finishing()
     path = profile.write_profiler(page, output)

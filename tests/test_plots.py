@@ -187,6 +187,27 @@ def test_plot_loo_prints_the_figures_it_draws(tmp_path):
     assert_inside(fig)
 
 
+def test_loo_keeps_c_above_zero_and_names_the_misses():
+    """c is not negative: its intervals (fitted without a log) are cut at 0 and marked, the axes start
+    at 0; every run an interval misses is labelled with its run number."""
+    from matplotlib.collections import LineCollection
+
+    from designer.model.surrogate import Surrogate
+    from designer.plots import loo
+
+    sur = Surrogate.load()
+    table = loo.loo_table(sur, "c_x")
+    assert (table.lo < 0).any()  # the model's interval does reach below 0
+    fig = loo.plot_loo(sur, responses=["c_x"])
+    ax = fig.axes[0]
+    assert ax.get_ylim()[0] == 0 and ax.get_xlim()[0] == 0
+    bars = [seg for c in ax.collections if isinstance(c, LineCollection) for seg in c.get_segments()]
+    assert bars and min(float(np.min(seg[:, 1])) for seg in bars) >= 0
+    labels = {t.get_text() for t in ax.texts}
+    assert labels == {f"run {r}" for r in table.run[~table.covered]}
+    assert any(t.get_text().startswith("interval cut at 0") for t in ax.get_legend().get_texts())
+
+
 def test_signal_units_follow_the_axis():
     from designer.plots.timeseries import signal_unit
 
@@ -242,6 +263,40 @@ def test_coinciding_curves_all_show():
     assert len({(ln.get_color(), str(ln.get_linestyle())) for ln in lines}) == 5
     widths = [ln.get_linewidth() for ln in lines]
     assert widths == sorted(widths, reverse=True) and widths[0] > widths[-1]
+
+
+@pytest.mark.parametrize("n", [2, 5])
+def test_panel_titles_are_not_built_from_legend_labels(n):
+    """A panel of curves with free names (the validation report's FMU and SSP figures) is titled by
+    what it shows, from its y label or the caller's title, never by pasting the legend's labels."""
+    from designer.plots.timeseries import plot_timeseries
+
+    t = np.linspace(0, 1, 20)
+    names = ["analytic", "FMI 2 CoSimulation", "FMI 2 ModelExchange", "libcosim, 2k in the SSV", "fmpy, k"][
+        :n
+    ]
+    errors = [f"{c} error" for c in names[1:]]
+    frame = pd.DataFrame({"t": t} | {c: np.sin(t) for c in names + errors})
+    fig = plot_timeseries(frame, panels={"x.s (m)": names, "error (m)": errors})
+    for ax in fig.axes:
+        title = ax.get_title(loc="left")
+        labels = [text.get_text() for text in ax.get_legend().get_texts()]
+        assert title and not any(label in title for label in labels), (title, labels)
+        assert "legend" not in title and " more" not in title
+    assert [ax.get_title(loc="left") for ax in fig.axes] == ["deflection s", "error"]
+    fig = plot_timeseries(frame, panels={"x.s (m)": names}, titles={"x.s (m)": "under a 2 N step"})
+    assert fig.axes[0].get_title(loc="left") == "under a 2 N step"
+
+
+def test_every_report_figure_has_its_own_caption():
+    """Each figure a validation check writes has a caption saying what it shows (not its file name)."""
+    from designer.validate import report
+
+    names = set()
+    for path in (Path(report.__file__).parent).glob("*.py"):
+        names |= set(re.findall(r'figures / "(\w+)\.png"', path.read_text()))
+    assert {"fmu_step_response", "ssp_runners", "cosim_convergence"} <= names
+    assert names <= set(report.CAPTIONS), names - set(report.CAPTIONS)
 
 
 def test_importing_and_plotting_leave_the_process_alone(tmp_path):

@@ -60,6 +60,10 @@ def test_surface_png_and_html(sur, tmp_path):
     titles = [t for t, *_ in labels]
     assert {"width (mm)", "height (mm)", "k_x (N/mm)"} <= set(titles)
     assert all(10 <= x <= 890 and 10 <= y <= 670 for _, x, y in labels), labels
+    # the page labels the PNG's round ticks (it labelled five even ones: 0.21, 0.69 ...)
+    for ax in space.axis_ticks(view.scene):
+        assert [t for _, t in ax] and all(t in titles for _, t in ax), (ax, titles)
+    assert "0.5" in titles and "1.0" in titles
 
 
 def test_small_values_get_readable_ticks(sur, tmp_path):
@@ -120,11 +124,24 @@ def test_ticks_are_round_and_clear_of_the_corners(sur):
     assert space.colour_limits(0.4429, 1.055) == pytest.approx((0.4, 1.2, 5))
 
 
+def _any_design() -> dict[str, float]:
+    """The design the c_x view holds (c_x is the same everywhere: any design in the tested box)."""
+    return {"density": 60.0, "length": 24.0, "width": 4.5, "height": 9.0, "layer": 0.16, "raster": 0.0}
+
+
 def test_target_plane_when_no_design_reaches_the_target(sur, tmp_path):
     """c_x is flat (not predictable): a target gets a plane at its level, and the CLI says why."""
     view = space.surface_view(sur, "c_x", target=2e-3, resolution=9)
     plane = [layer for layer in view.scene.layers if layer.name.startswith("target 0.002 N.s/mm (plane")]
     assert len(plane) == 1
+    # it says what suggest says (issue 36: it said "no design reaches it"): any design meets the
+    # target within +-10 % with the same probability
+    from designer.design.targets import probability_within
+
+    pred = sur.predict(_any_design(), responses=["c_x"])["c_x"].at(0)
+    chance = probability_within(pred, 2e-3, 0.1, sur.model("c_x").dof, log=False)
+    assert plane[0].name.endswith(f"c_x not predictable, P(+-10 %) {chance:.2f} anywhere"), plane[0].name
+    assert "reaches" not in plane[0].name
     lo, hi = view.scene.axis_ranges[2]
     assert plane[0].mesh.points[:, 2] == pytest.approx((2e-3 - lo) / (hi - lo))
     # a target the surface crosses gets its contour line, no plane
@@ -146,6 +163,10 @@ def test_volume_png(sur, tmp_path):
     plotter.close()
     assert_margins_clear(assert_picture(tmp_path / "v.png", size=space.WINDOW))
     assert set(view.held) == {"length", "layer", "raster"}
+    # each isosurface is labelled with its level in the picture, and drawn in its legend colour
+    iso = [layer for layer in view.scene.layers if layer.name.startswith("k_x = ")]
+    assert iso and all(layer.tag == layer.name.split(" = ")[1].split()[0] for layer in iso)
+    assert len({layer.color for layer in iso}) == len(iso)
 
 
 def test_space_rejects_bad_requests(sur, tmp_path):

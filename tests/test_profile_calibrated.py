@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 from test_profile_browser import _check
+from test_profile_console import _check_k
 
 import designer
 from designer.model.surrogate import Surrogate
@@ -75,3 +76,38 @@ def test_maximize_on_a_calibrated_page_agrees_with_suggest(calibrated):
     want = json.loads(run.stdout)["candidates"][0]
     assert json.loads(status["design"]) == pytest.approx(want["params"], abs=1e-9)
     assert float(status["p"]) == pytest.approx(want["p_within"], rel=1e-9)
+
+
+def test_calibrated_page_shows_your_prints_and_the_calibrated_figures(calibrated, tmp_path):
+    """Issue 36: the calibrated page said "44 measured runs", showed the study's accuracy and folded
+    c away as flat; it shows the user's prints, the calibration's own figures and c's panels."""
+    from designer.model.calibration import report
+    from designer.plots import profile
+
+    exe = cdp.find_browser()
+    if exe is None:
+        pytest.skip("no headless Chromium on this machine")
+    sur = Surrogate.load(calibrated / "mine.json")
+    mine = sur.calibration["table"]
+    first = {n: float(mine[n].iloc[0]) for n in space.FACTOR_NAMES}
+    page_path = profile.write_profiler(
+        profile.build_profiler(sur, targets={"k": 0.8}, design=first), tmp_path / "at_mine.html"
+    )
+    figures = report(sur)["responses"]
+    with cdp.Browser(exe) as browser:
+        page = browser.new_page()
+        page.goto(page_path.resolve().as_uri())
+        source = page.js("document.getElementById('source').textContent")
+        assert f"{len(mine)} of your prints" in source
+        rows = page.js("document.getElementById('rows').textContent")
+        for name in ("k_x", "c_x"):
+            loo = figures[name]["loo_user"]
+            assert (
+                f"your {loo['n']} prints, each predicted from the others: median error {loo['mape']:.0f} %"
+                in rows
+            )
+        assert page.js("document.querySelectorAll('details.flat').length") == 0  # c's panels shown
+        assert page.js("document.querySelectorAll('#panels-c_x svg').length") == 6
+        # at the design of the first print, that print is drawn in every panel of k
+        assert page.js("document.querySelectorAll('#panels-k_x path.mine').length") >= 6
+        _check_k(page, sur, ("k_x", "c_x"))

@@ -262,10 +262,17 @@ def test_accessibility_tree_names_every_control_with_its_unit(page, sur):
             assert pressed[f"{f.name} {lv:g} {f.unit}"] in (["true"], ["false"])
     checks = {name(n) for n in by_role["checkbox"]}
     assert {f"lock {f.name} (hold it when maximizing)" for f in space.FACTORS} <= checks
-    fields = {name(n) for n in by_role["spinbutton"]}
-    assert "target k_x (N/mm)" in fields and "tolerance around a target, \u00b1 %" in fields
-    assert {f"print noise, standard deviation of {f.name} ({f.unit})" for f in space.CONTINUOUS} <= fields
+    numbers = {name(n) for n in by_role["spinbutton"]}
+    typed = {name(n) for n in by_role["textbox"]}  # typed numbers are read by the page, errors shown
+    assert "target k_x (N/mm)" in typed and "tolerance around a target, \u00b1 %" in typed
+    assert {f"{f.name} value ({f.unit})" for f in space.CONTINUOUS} <= typed
+    assert {f"print noise, standard deviation of {f.name} ({f.unit})" for f in space.CONTINUOUS} <= numbers
     images = [name(n) for n in by_role["image"]]
+    contour = [n for n in images if n.startswith("width against height")]
+    trace = [n for n in images if n.startswith("P(every stated goal met) against ")]
+    images = [n for n in images if n not in contour + trace]
+    assert len(contour) == 1 and "shaded" in contour[0]  # the contour view, described in words
+    assert len(trace) == 6 and all("highest" in n for n in trace)  # the P trace, one per factor
     assert len(images) == 6  # k_x's panels (c_x's are folded away: it is not predictable)
     assert all(n.startswith("k_x against ") and "N/mm" in n for n in images), images
 

@@ -33,8 +33,20 @@ def session(tmp_path_factory):
         ({"duration": "2"}, "duration"),
         ({"duration": 1e300}, "memory"),
         ({"duration": -1.0}, "duration"),
+        # it ran, diverged and advised "a smaller step"
+        ({"parameters": {"j1": {"theta.c": 1e308}}}, "N.m.s/rad is beyond any physical joint"),
     ],
-    ids=["str", "int", "joint float", "text value", "numpy bool", "str duration", "1e300 s", "negative"],
+    ids=[
+        "str",
+        "int",
+        "joint float",
+        "text value",
+        "numpy bool",
+        "str duration",
+        "1e300 s",
+        "negative",
+        "c 1e308",
+    ],
 )
 def test_wrong_arguments_are_named(session, kwargs, words):
     with pytest.raises(DesignerError, match=words.replace("[", r"\[").replace("]", r"\]")):

@@ -26,7 +26,7 @@ import numpy as np
 
 from .. import units
 from ..errors import DesignerError
-from ..joint import Joint
+from ..joint import MAX_COEFFICIENT, Joint
 from .master import ALGORITHMS, Master, Series, System, Trace
 from .robot import INTEGRATORS
 
@@ -75,7 +75,7 @@ class JointSource:
                     f"parameter '{key}' is not a parameter of axis {self.axis}",
                     f"use {', '.join(f'{self.axis}.{f}' for f in PARAMETER_FIELDS)}",
                 )
-            parameter_value(name, value, f"parameter '{key}'")
+            parameter_value(axis, name, value, f"parameter '{key}'")
         if self.fmu is None:
             self.joint.axis(self.axis)
             return self
@@ -276,12 +276,13 @@ def finite(value: Any, what: str) -> float:
     return float(value)
 
 
-def parameter_value(field: str, value: Any, what: str) -> float | bool:
+def parameter_value(axis: str, field: str, value: Any, what: str) -> float | bool:
     """A joint parameter's value checked: `enabled` a bool (Python's or numpy's), the others a finite
-    number (numpy's float32 and int64 included, a bool not).
+    number (numpy's float32 and int64 included, a bool not), m, c and k no larger than any physical
+    joint's (`designer.joint.MAX_COEFFICIENT` in rig units).
 
     Raises:
-        DesignerError: the value is not of its field's kind, naming `what`.
+        DesignerError: the value is not of its field's kind or beyond a joint's, naming `what`.
     """
     if field == "enabled":
         if not isinstance(value, (bool, np.bool_)):
@@ -290,6 +291,12 @@ def parameter_value(field: str, value: Any, what: str) -> float | bool:
     real = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
     if not real or not math.isfinite(value):
         raise DesignerError(f"{what} = {value!r} is not a finite number", "give its value in SI")
+    if field in ("m", "c", "k") and units.from_si(field, axis, float(value)) > MAX_COEFFICIENT:
+        top = units.to_si(field, axis, MAX_COEFFICIENT)
+        raise DesignerError(
+            f"{what} = {float(value):g} {units.si_unit(field, axis)} is beyond any physical joint",
+            f"give it in SI, at most {top:g} {units.si_unit(field, axis)}",
+        )
     return float(value)
 
 

@@ -145,7 +145,7 @@ class Session:
                         f"parameters['{name}'] has '{key}', not a parameter of axis {axis}",
                         f"use {', '.join(f'{axis}.{f}' for f in PARAMETER_FIELDS)}",
                     )
-                out[name][str(key)] = parameter_value(field, value, f"parameters['{name}']['{key}']")
+                out[name][str(key)] = parameter_value(axis, field, value, f"parameters['{name}']['{key}']")
         return out
 
     def laws(self, case: Mapping[str, Mapping[str, float]]) -> dict[str, dict[str, float]]:

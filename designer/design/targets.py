@@ -40,15 +40,23 @@ def probability_within(
     target (1 - tolerance) <= 0 under the log. `dof` is the fitted surface's `dof` in the surrogate
     JSON; `value`, `low` and `high` are the prediction's, in rig units. Returns a float in [0, 1].
     """
+    return probability_between(prediction, target * (1 - tolerance), target * (1 + tolerance), dof, log=log)
+
+
+def probability_between(
+    prediction: Prediction, low: float, high: float, dof: float, *, log: bool = True
+) -> float:
+    """Probability that a printed joint's response lies between two limits (spec limits, `low` < `high`,
+    rig units): `probability_within`'s predictive Student t in the fit space, with the lower term 0
+    when `low` <= 0 under the log. The profiler page's asymmetric goals use the same formula."""
     from scipy.special import stdtr, stdtrit  # numbers, not CasADi symbols: no need in the graph
 
     g = math.log if log else (lambda v: v)
     t95 = float(stdtrit(dof, 0.975))
     mu = g(float(prediction.value))
     s = (g(float(prediction.high)) - g(float(prediction.low))) / (2 * t95)
-    hi_edge, lo_edge = target * (1 + tolerance), target * (1 - tolerance)
-    upper = float(stdtr(dof, (g(hi_edge) - mu) / s))
-    lower = 0.0 if (log and lo_edge <= 0) else float(stdtr(dof, (g(lo_edge) - mu) / s))
+    upper = float(stdtr(dof, (g(high) - mu) / s))
+    lower = 0.0 if (log and low <= 0) else float(stdtr(dof, (g(low) - mu) / s))
     return max(0.0, min(1.0, upper - lower))
 
 

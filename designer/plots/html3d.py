@@ -33,6 +33,7 @@ class Layer:
     rgb: np.ndarray | None = None
     opacity: float = 1.0
     size: float = 2.0  # point size or line width, pixels
+    tag: str | None = None  # a label written on the mesh in the PNG (an isosurface's level)
 
 
 @dataclass
@@ -43,6 +44,8 @@ class Scene:
     axis_labels: tuple[str, str, str]
     axis_ranges: tuple[tuple[float, float], tuple[float, float], tuple[float, float]]
     layers: list[Layer] = field(default_factory=list)
+    #: per axis, the (value, text) ticks to label (round values clear of the corners); None: five even ones
+    ticks: list[list[tuple[float, str]]] | None = None
 
 
 def _payload(layer: Layer) -> dict[str, Any]:
@@ -90,6 +93,7 @@ def write_scene(scene: Scene, path: str | Path) -> Path:
         "labels": list(scene.axis_labels),
         "ranges": [list(map(float, r)) for r in scene.axis_ranges],
         "layers": [_payload(layer) for layer in scene.layers],
+        "ticks": None if scene.ticks is None else [[[float(v), str(t)] for v, t in ax] for ax in scene.ticks],
     }
     template = (resources.files("designer.plots") / "scene.html").read_text(encoding="utf-8")
     page = template.replace("__TITLE__", html.escape(scene.title)).replace(

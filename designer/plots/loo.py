@@ -17,9 +17,11 @@ def loo_table(surrogate, response: str) -> pd.DataFrame:
     """Per training run: observed, LOO prediction and its 95 % PI, and whether the PI covers the run."""
     model = surrogate.model(response)
     pred = model.nested_predictions or model.loo_predictions
-    observed = surrogate.table[response].to_numpy(float)
+    table = surrogate.table
+    observed = table[response].to_numpy(float)
     return pd.DataFrame(
         {
+            "run": table["run"].to_numpy(int) if "run" in table else np.arange(1, len(table) + 1),
             "observed": observed,
             "predicted": np.asarray(pred.value, float),
             "lo": np.asarray(pred.low, float),
@@ -29,7 +31,11 @@ def loo_table(surrogate, response: str) -> pd.DataFrame:
 
 
 def plot_loo(surrogate, *, responses: list[str] | None = None, fig: Figure | None = None) -> Figure:
-    """One panel per response (default: all): LOO predictions with PI bars against the measurements."""
+    """One panel per response (default: all): LOO predictions with PI bars against the measurements.
+
+    k and c are not negative: an interval reaching below 0 (c's, whose form is fitted without a log)
+    is cut at 0 and marked, both axes start at 0, and each run the interval misses is labelled with
+    its run number."""
     responses = surrogate.responses if responses is None else responses
     fig = new_figure(figsize=(5.2 * len(responses), 4.8), fig=fig)
     axes = fig.subplots(1, len(responses), squeeze=False)
@@ -44,7 +50,7 @@ def plot_loo(surrogate, *, responses: list[str] | None = None, fig: Figure | Non
             ax.errorbar(
                 s.observed,
                 s.predicted,
-                yerr=[s.predicted - s.lo, s.hi - s.predicted],
+                yerr=[s.predicted - s.lo.clip(lower=0.0), s.hi - s.predicted],
                 fmt="o",
                 ms=4,
                 color=color,
@@ -53,8 +59,30 @@ def plot_loo(surrogate, *, responses: list[str] | None = None, fig: Figure | Non
                 alpha=0.8,
                 label=f"{label} ({len(s)})",
             )
-        lim = [min(d.observed.min(), d.lo.min()), max(d.observed.max(), d.hi.max())]
+        cut = d[d.lo < 0]
+        if len(cut):
+            ax.plot(
+                cut.observed,
+                np.zeros(len(cut)),
+                "v",
+                ms=5,
+                color="0.3",
+                label=f"interval cut at 0 ({len(cut)})",
+            )
+        for r in d[~d.covered].itertuples():
+            ax.annotate(
+                f"run {r.run}",
+                (r.observed, r.predicted),
+                xytext=(5, 3),
+                textcoords="offset points",
+                fontsize=7.5,
+                color="tab:red",
+                bbox={"fc": "white", "ec": "none", "alpha": 0.8, "pad": 0.6},
+            )
+        lim = [0.0, 1.04 * max(d.observed.max(), d.hi.max())]
         ax.plot(lim, lim, "k--", lw=0.8, label="predicted = observed")
+        ax.set_xlim(lim)
+        ax.set_ylim(lim)
         ax.set_xlabel(f"observed {response_label(resp)}")
         nested = model.nested_predictions is not None
         ax.set_ylabel(f"{'nested ' if nested else ''}leave-one-out prediction {response_label(resp)}")

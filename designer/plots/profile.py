@@ -58,6 +58,16 @@ _RANGE_POINTS = 5
 PRINT_NOISE: dict[str, float] = {"density": 0.0, "length": 0.1, "width": 0.1, "height": 0.1}
 #: the simulator's Monte Carlo size (draws of the print noise)
 MC_DRAWS = 4000
+#: the page's scripts, in the order the page runs them (each uses what the ones before define)
+SCRIPTS = (
+    "profile_model.js",
+    "profile_search.js",
+    "profile_views.js",
+    "profile_goals.js",
+    "profile_contour.js",
+    "profile_trace.js",
+    "profile_page.js",
+)
 
 
 class _Expr:
@@ -183,10 +193,8 @@ def _response(surrogate: Surrogate, name: str, statement: str, target: float | s
     }
 
 
-def _suggestions(suggestion: Any) -> list[dict[str, Any]]:
-    """Candidates of a `Suggestion`, of its `to_dict()`, or of a JSON file holding that dict."""
-    if suggestion is None:
-        return []
+def _suggestion_dict(suggestion: Any) -> Any:
+    """A `Suggestion`, its `to_dict()` or the path of a JSON file of it, as the dict."""
     if isinstance(suggestion, str | Path):
         p = Path(suggestion)
         try:
@@ -201,6 +209,14 @@ def _suggestions(suggestion: Any) -> list[dict[str, Any]]:
             ) from None
     if hasattr(suggestion, "to_dict"):
         suggestion = suggestion.to_dict()
+    return suggestion
+
+
+def _suggestions(suggestion: Any) -> list[dict[str, Any]]:
+    """Candidates of a `Suggestion`, of its `to_dict()`, or of a JSON file holding that dict."""
+    if suggestion is None:
+        return []
+    suggestion = _suggestion_dict(suggestion)
     candidates = suggestion.get("candidates") if isinstance(suggestion, Mapping) else None
     if not isinstance(candidates, list):
         raise DesignerError(
@@ -237,6 +253,23 @@ def _suggestions(suggestion: Any) -> list[dict[str, Any]]:
     return out
 
 
+def _suggestion_goals(suggestion: Any) -> dict[str, Any] | None:
+    """The goals and tolerance a suggestion was found for (its buttons grey out once the page's
+    goals differ), or None when it does not record them."""
+    if suggestion is None:
+        return None
+    data = _suggestion_dict(suggestion)
+    targets = data.get("targets") if isinstance(data, Mapping) else None
+    tol = data.get("tolerance") if isinstance(data, Mapping) else None
+    if not isinstance(targets, Mapping) or not isinstance(tol, int | float):
+        return None
+    goals = {}
+    for q in ("k", "c"):
+        v = targets.get(q)
+        goals[q] = float(v) if isinstance(v, int | float) else v if v in ("min", "max") else None
+    return {"targets": goals, "tolerance": float(tol)}
+
+
 def _within(f: space.Factor, v: float) -> bool:
     """Whether a value lies in a factor's tested range (one of its levels when categorical)."""
     if f.categorical:
@@ -264,10 +297,13 @@ class Profiler:
 
     def to_html(self) -> str:
         """The self-contained page: the template with this data embedded."""
-        template = (resources.files("designer.plots") / "profile.html").read_text(encoding="utf-8")
+        here = resources.files("designer.plots")
+        template = (here / "profile.html").read_text(encoding="utf-8")
+        script = "\n".join((here / name).read_text(encoding="utf-8") for name in SCRIPTS)
         payload = json.dumps(self.data, separators=(",", ":"), allow_nan=False).replace("</", "<\\/")
         title = f"Prediction profiler, axis {self.data['axis']}"
-        return template.replace("__TITLE__", html.escape(title)).replace("__DATA__", payload)
+        page = template.replace("__TITLE__", html.escape(title)).replace("__SCRIPT__", script)
+        return page.replace("__DATA__", payload)
 
 
 def build_profiler(
@@ -275,7 +311,7 @@ def build_profiler(
     *,
     axis: str = "x",
     targets: Mapping[str, float] | None = None,
-    tolerance: float = TOLERANCE,
+    tolerance: float | None = None,
     suggestion: Any = None,
     design: Mapping[str, float] | None = None,
 ) -> Profiler:
@@ -285,7 +321,8 @@ def build_profiler(
         surrogate: the fitted surrogate whose coefficients the page evaluates.
         axis: the axis of the responses (x y z theta phi psi).
         targets: goals by quantity: a target in rig units, e.g. {"k": 0.8} (N/mm), or "min" or "max".
-        tolerance: relative tolerance of "meeting the target" (0.1: within 10 %).
+        tolerance: relative tolerance of "meeting the target" (0.1: within 10 %); default the
+            suggestion's, else `TOLERANCE`.
         suggestion: a `Suggestion`, its `to_dict()` or the path of a JSON file of it (what the
             suggest command writes with its JSON option).
         design: factors the page opens at (the rest from `DEFAULT_DESIGN`), within the tested ranges.
@@ -295,6 +332,18 @@ def build_profiler(
             target that is not positive; a tolerance outside (0, 1); an unreadable suggestion.
     """
     units.check_axis(axis)
+    suggestion = None if suggestion is None else _suggestion_dict(suggestion)
+    found = _suggestion_goals(suggestion)
+    # opened from a suggestion: its goals and tolerance unless given, its first candidate unless a
+    # design is given (and the candidate lies in the tested ranges)
+    if not targets and found:
+        targets = {q: v for q, v in found["targets"].items() if v is not None}
+    if tolerance is None:
+        tolerance = found["tolerance"] if found else TOLERANCE
+    candidates = _suggestions(suggestion)
+    opened_from = None
+    if design is None and candidates and candidates[0]["inside"]:
+        design, opened_from = candidates[0]["params"], "suggestion #1"
     targets = dict(targets or {})
     for q in targets:
         if q not in ("k", "c"):
@@ -310,6 +359,19 @@ def build_profiler(
     responses = [
         _response(surrogate, f"{q}_{axis}", info[q]["statement"], targets.get(q)) for q in ("k", "c")
     ]
+    mine, report = None, None
+    if surrogate.calibration is not None:  # the user's prints and the calibrated model's own figures
+        from ..model.calibration import report as calibration_report
+
+        report = calibration_report(surrogate)["responses"]
+        table = surrogate.calibration["table"]
+        mine = {
+            c: [None if pd.isna(v) else float(v) for v in table[c]]
+            for c in [*space.FACTOR_NAMES, *(r["name"] for r in responses)]
+            if c in table
+        }
+        for r in responses:
+            r["calibrated"] = report.get(r["name"]) if report.get(r["name"], {}).get("n_runs") else None
     runs = {n: [float(v) for v in surrogate.training[n]] for n in space.FACTOR_NAMES}
     runs |= {r["name"]: [float(v) for v in surrogate.training[r["name"]]] for r in responses}
     factors = [
@@ -335,7 +397,10 @@ def build_profiler(
             "responses": responses,
             "runs": runs,
             "tolerance": float(tolerance),
-            "suggestions": _suggestions(suggestion),
+            "suggestions": candidates,
+            "suggestion_goals": found,
+            "opened_from": opened_from,
+            "mine": mine,
             "wall_mm": space.WALL_MM,
             "nozzle_mm": space.NOZZLE_MM,
             "search": _search_data(),

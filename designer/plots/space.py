@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import os
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -191,7 +191,7 @@ def axis_ticks(scene: Scene) -> list[list[tuple[float, str]]]:
 
     out = []
     for i, (lo, hi) in enumerate(scene.axis_ranges):
-        ticks = round_ticks(lo, hi, 5 if i == 2 else 4)
+        ticks = round_ticks(lo, hi, 5)
         ticks = [v for v in ticks if CORNER <= (v - lo) / (hi - lo) <= 1 - (0 if i == 2 else CORNER)]
         d = decimals_for(tuple(ticks)) if ticks else 0
         out.append([(v, f"{v:.{d}f}" if d < 7 else f"{v:.2g}") for v in ticks])
@@ -237,7 +237,21 @@ def _add_layer(plotter, layer: Layer) -> None:
         kwargs |= {"point_size": layer.size * 4, "render_points_as_spheres": True}
     elif layer.mesh.lines.size:
         kwargs["line_width"] = layer.size * 2
+    elif layer.opacity < 1:  # a translucent surface: lit mostly ambient, so it keeps its legend colour
+        kwargs |= {"ambient": 0.55, "diffuse": 0.5, "specular": 0.0}
     plotter.add_mesh(layer.mesh, **kwargs)
+    if layer.tag:  # written at the mesh's highest point, in its colour
+        top = np.asarray(layer.mesh.points)[int(np.argmax(layer.mesh.points[:, 2]))]
+        plotter.add_point_labels(
+            top[None, :],
+            [layer.tag],
+            show_points=False,
+            shape=None,
+            font_size=14,
+            bold=True,
+            text_color=layer.color,
+            always_visible=True,
+        )
 
 
 def render(view: SpaceView, *, window: tuple[int, int] = WINDOW):
@@ -259,10 +273,15 @@ def render(view: SpaceView, *, window: tuple[int, int] = WINDOW):
     if hi - lo <= 1e-9 * abs(hi):  # a constant response: the scale spans the plotted PI instead
         lo, hi = view.scene.axis_ranges[2]
     _colorbar(plotter, view.response, *colour_limits(lo, hi))
-    left = min(0.68 * window[0], window[0] - 24 - 13 * max(len(layer.name) for layer in layers))
-    for i, layer in enumerate(layers):  # the legend: each name in its layer's colour, fixed size
-        pos = (int(left), int(window[1] - 64 - 24 * i))
-        plotter.add_text(layer.name, position=pos, font_size=12, color=layer.color)
+    # the legend: a swatch of each layer's colour and its name, top left under the title
+    plotter.add_legend(
+        [(layer.name, layer.color) for layer in layers],
+        bcolor=None,
+        border=False,
+        face="rectangle",
+        loc="upper left",
+        size=(0.0062 * max(len(layer.name) for layer in layers), 0.032 * len(layers)),
+    )
     _axes(plotter, view.scene)
     plotter.add_text(
         view.scene.axis_labels[2],
@@ -290,7 +309,9 @@ def save_screenshot(plotter, path: str | Path) -> Path:
 
 
 def _run_layers(points: np.ndarray, near: np.ndarray) -> list[Layer]:
-    """The measured runs (unit-cube points): those at the held values in black, the others grey."""
+    """The measured runs (unit-cube points): those at the held values in black at their response; the
+    others, measured at other held values, grey on the floor (where they lie in x and y only: drawn at
+    their response they would stand in stacks that read like replicates)."""
     import pyvista as pv
 
     layers = []
@@ -304,10 +325,12 @@ def _run_layers(points: np.ndarray, near: np.ndarray) -> list[Layer]:
             )
         )
     if (~near).any():
+        floor = points[~near].copy()
+        floor[:, 2] = 0.0
         layers.append(
             Layer(
-                f"other runs ({int((~near).sum())})",
-                pv.PolyData(points[~near]),
+                f"other runs ({int((~near).sum())}), at other held values: on the floor",
+                pv.PolyData(floor),
                 color=(0.55, 0.55, 0.55),
                 size=2.5,
             )
@@ -315,11 +338,33 @@ def _run_layers(points: np.ndarray, near: np.ndarray) -> list[Layer]:
     return layers
 
 
+def _plane_name(model, response: str, pred, target: float, unit: str) -> str:
+    """What a target plane means, in `designer suggest`'s words: no design on this plane is predicted
+    at the target, and the best chance here of landing within the default tolerance (for a response no
+    form predicts, the same chance for every design)."""
+    from ..design.targets import TOLERANCE, probability_within
+
+    log = model.transform == "log"
+    best = max(
+        probability_within(pred.at(i), target, TOLERANCE, model.dof, log=log) for i in range(len(pred.value))
+    )
+    band = f"+-{100 * TOLERANCE:.0f} %"
+    if not model.predictable:
+        return f"target {target:g} {unit} (plane): {response} not predictable, P({band}) {best:.2f} anywhere"
+    return f"target {target:g} {unit} (plane): not reached here, best P({band}) {best:.2f}"
+
+
 def _target_layers(
-    surface, values: np.ndarray, target: float, unit: str, zrange: tuple[float, float]
+    surface,
+    values: np.ndarray,
+    target: float,
+    unit: str,
+    zrange: tuple[float, float],
+    plane_name: Callable[[], str],
 ) -> list[Layer]:
     """The target on a predicted surface: its contour line and that line projected on the floor, or,
-    when the surface never reaches it (a flat or distant response), a plane at its level."""
+    when the surface never reaches it (a flat or distant response), a plane at its level named by
+    `plane_name()`."""
     import pyvista as pv
 
     surface.point_data["value"] = values
@@ -333,8 +378,7 @@ def _target_layers(
         ]
     level = float(_unit(target, *zrange))
     plane = pv.Plane(center=(0.5, 0.5, level), direction=(0, 0, 1), i_size=1, j_size=1)
-    name = f"target {target:g} {unit} (plane: no design reaches it)"
-    return [Layer(name, plane.triangulate(), color=TARGET_COLOR, opacity=0.35)]
+    return [Layer(plane_name(), plane.triangulate(), color=TARGET_COLOR, opacity=0.35)]
 
 
 def surface_view(
@@ -397,7 +441,14 @@ def surface_view(
     layers += _run_layers(runs, _runs_near(table, held))
     share = None
     if target is not None:
-        layers += _target_layers(mid, pred.value, target, model.unit, (zlo, zhi))
+        layers += _target_layers(
+            mid,
+            pred.value,
+            target,
+            model.unit,
+            (zlo, zhi),
+            lambda: _plane_name(model, response, pred, target, model.unit),
+        )
         share = float(np.mean((pred.low <= target) & (target <= pred.high)))
     held_txt = ", ".join(f"{k} {v:g} {space.factor(k).unit}" for k, v in held.items())
     title = f"{response_label(response)} over {x} and {y}; held: {held_txt}"
@@ -407,6 +458,7 @@ def surface_view(
         ((fx.low, fx.high), (fy.low, fy.high), (zlo, zhi)),
         layers,
     )
+    scene.ticks = axis_ticks(scene)
     return SpaceView(response, model.unit, [x, y], held, (vlo, vhi), target, share, scene)
 
 
@@ -450,12 +502,22 @@ def volume_view(
         iso = vol.contour([v], scalars="value")
         if iso.n_points:
             color = tuple(_rgb(np.array([v]), *colour_limits(vlo, vhi)[:2])[0])
-            layers.append(Layer(f"{response} = {v:.3g} {model.unit}", iso, color=color, opacity=0.5))
+            layers.append(
+                Layer(f"{response} = {v:.3g} {model.unit}", iso, color=color, opacity=0.5, tag=f"{v:.3g}")
+            )
     share = None
     if target is not None:
         iso = vol.contour([target], scalars="value")
         if iso.n_points:
-            layers.append(Layer(f"target {target:g} {model.unit}", iso, color=TARGET_COLOR, opacity=0.85))
+            layers.append(
+                Layer(
+                    f"target {target:g} {model.unit}",
+                    iso,
+                    color=TARGET_COLOR,
+                    opacity=0.85,
+                    tag=f"target {target:g}",
+                )
+            )
         share = float(np.mean((pred.low <= target) & (target <= pred.high)))
     pts = np.c_[[_unit(table[f.name], f.low, f.high) for f in fs]].T
     observed = table[response].to_numpy(float)
@@ -473,4 +535,5 @@ def volume_view(
     scene = Scene(
         title, tuple(f"{f.name} ({f.unit})" for f in fs), tuple((f.low, f.high) for f in fs), layers
     )
+    scene.ticks = axis_ticks(scene)
     return SpaceView(response, model.unit, list(factors), held, (vlo, vhi), target, share, scene)

@@ -92,16 +92,17 @@ def _styles(cols: list[str]) -> dict[str, dict]:
     }
 
 
-def _title(cols: list[str], columns: list[str]) -> str:
-    """What a panel shows: the signals' descriptions (a load named torque or force by its unit), or
-    the columns themselves."""
+def _title(label: str, cols: list[str], columns: list[str]) -> str:
+    """What a panel shows: the signals' descriptions (a load named torque or force by its unit), else
+    the quantity its y label names ("x.s (m)" -> "deflection s", "error (m)" -> "error"); never the
+    curves' names, which the legend gives."""
     variables = list(dict.fromkeys(str(c).rsplit(".", 1)[-1] for c in cols))
     if all(v in SIGNALS for v in variables):
         loads = {signal_unit(c, columns) for c in cols if str(c).endswith(".f")}
         word = {frozenset({"N.m"}): "torque f", frozenset({"N"}): "force f"}.get(frozenset(loads), "load f")
         return ", ".join(word if v == "f" else SIGNALS[v][0] for v in variables)
-    text = ", ".join(map(str, cols))
-    return text if len(text) <= 70 else f"{cols[0]} and {len(cols) - 1} more (legend)"
+    quantity = label.split(" (")[0].strip()
+    return SIGNALS.get(quantity.rsplit(".", 1)[-1], (quantity,))[0]
 
 
 def _panels(frame: pd.DataFrame, columns: list[str] | None, time: str) -> dict[str, list[str]]:
@@ -121,11 +122,13 @@ def plot_timeseries(
     time: str = "t",
     reference: pd.DataFrame | None = None,
     panels: Mapping[str, list[str]] | None = None,
+    titles: Mapping[str, str] | None = None,
     fig: Figure | None = None,
 ) -> Figure:
     """Columns of `frame` against `time` (s), one panel per kind of signal with its unit (or as
     `panels` maps a y label to its columns); the same column of `reference` dashed black, where it
-    has one. Each panel is titled; the legend stands to the right of the data.
+    has one. Each panel is titled (`titles` by y label, else from the signals or the y label's
+    quantity, never from the curves' names); the legend stands to the right of the data.
 
     Raises:
         DesignerError: no `time` column, a column not in `frame`, or more than `MAX_PANELS` panels.
@@ -161,7 +164,8 @@ def plot_timeseries(
                     label=f"{col}, reference",
                 )
         ax.legend(fontsize=7.5, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, borderaxespad=0)
-        ax.set_title(_title(cols, list(frame.columns)), fontsize=9, loc="left")
+        title = (titles or {}).get(label) or _title(label, cols, list(frame.columns))
+        ax.set_title(title, fontsize=9, loc="left")
         ax.set_ylabel(label, fontsize=8.5)
         ax.grid(alpha=0.3)
     axes[-1, 0].set_xlabel(f"{time} (s)")

@@ -130,7 +130,15 @@ def check_fmus(ctx: Context) -> CheckResult:
     errors = {f"{name} error": curves[name] - exact for name in curves}
     frame = pd.DataFrame({"t": t, "analytic": exact, **curves}).assign(**errors)
     fig = save_figure(
-        plot_timeseries(frame, panels={"x.s (m)": ["analytic", *curves], "error (m)": list(errors)}),
+        plot_timeseries(
+            frame,
+            panels={"x.s (m)": ["analytic", *curves], "error (m)": list(errors)},
+            titles={
+                "x.s (m)": f"deflection under a {FMU_LOAD:g} N step: the analytic solution and "
+                f"{len(curves)} FMU runs (wider lines underneath)",
+                "error (m)": "each FMU run minus the analytic solution",
+            },
+        ),
         ctx.figures / "fmu_step_response.png",
     )
     table = pd.DataFrame(rows)
@@ -248,7 +256,14 @@ def check_ssp(ctx: Context) -> CheckResult:
         )
     t = SSP_STEP * np.arange(1, len(next(iter(runs.values()))) + 1)
     frame = pd.DataFrame({"t": t, **runs})
-    fig = save_figure(plot_timeseries(frame, panels={"x.s (m)": list(runs)}), ctx.figures / "ssp_runners.png")
+    title = (
+        f"deflection under a {FMU_LOAD:g} N step: libcosim and fmpy, as exported (k) and with k "
+        "doubled in the SSV"
+    )
+    fig = save_figure(
+        plot_timeseries(frame, panels={"x.s (m)": list(runs)}, titles={"x.s (m)": title}),
+        ctx.figures / "ssp_runners.png",
+    )
     table = pd.DataFrame(rows)
     summary = (
         f"{int(table.passed.sum())} of {len(table)} SSP runs settle at F/k: libcosim applies the SSD's "

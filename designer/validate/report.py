@@ -50,9 +50,11 @@ CAPTIONS = {
     "below.",
     "identification": "Closed loop: joints simulated on the virtual rig, then identified from the log; "
     "identified over true, minus one, for k (circles) and c (squares), the 1 % band shaded.",
+    "ssp_runners": "An exported SSP run in libcosim and in fmpy under a step load: each settles at F/k; with "
+    "k doubled in the bound SSV alone the deflection halves in both (the curves of one k coincide).",
     "cosim_convergence": "Two-link arm: largest joint-angle error against macro step, against an RK4 "
-    "reference at a quarter of the finest step (first order expected) and against the same spring-damper "
-    "inside MuJoCo at the same step (round-off).",
+    "reference at a quarter of the finest step (first order expected; the dashed guide of slope 1 runs "
+    "above the RK4 errors) and against the same spring-damper inside MuJoCo at the same step (round-off).",
     "cosim_arm": "Two-link arm, co-simulated: link angles (top) with the reference dashed, and the joints' "
     "torques (bottom); one colour per joint.",
 }

@@ -38,7 +38,10 @@ def _profiler(tmp: Path, out: Path) -> None:
     sys.path.insert(0, str(ROOT / "tests"))
     import cdp
 
-    subprocess.run(["designer", "profile", "--target", "k=0.8", "-o", str(tmp / "p.html")], check=True)
+    subprocess.run(
+        ["designer", "profile", "--target", "k=0.8", "--target", "c=2e-3", "-o", str(tmp / "p.html")],
+        check=True,
+    )
     with cdp.Browser(cdp.find_browser(), width=1280, height=800) as browser:
         page = browser.new_page()
         page.viewport(1280, 800)
@@ -47,8 +50,9 @@ def _profiler(tmp: Path, out: Path) -> None:
         page.click("#lock-raster")
         page.click("#maximize")
         page.call(
-            "Emulation.setDeviceMetricsOverride", width=1280, height=1060, deviceScaleFactor=1, mobile=False
+            "Emulation.setDeviceMetricsOverride", width=1280, height=1640, deviceScaleFactor=1, mobile=False
         )
+        page.js("window.scrollTo(0, 0)")
         data = page.call("Page.captureScreenshot", format="png")["data"]
     import base64
 
