@@ -261,6 +261,10 @@ def test_next_prints_proposes_distinct_printable_designs_and_stops_when_sure(stu
         assert p.params["width"] >= 2.0 and p.params["layer"] in (0.12, 0.16, 0.2)
     keys = {tuple(round(p.params[f], 2) for f in FACTORS) for p in nxt.prints}
     assert len(keys) == 3
+    # the first print is design #1, the design most likely to land now (the loop measured fewer
+    # prints to a hit so than with the knowledge gradient's exploratory first print); the others not
+    assert nxt.prints[0].params == nxt.recommendation.params and nxt.prints[0].recommended
+    assert not any(p.recommended for p in nxt.prints[1:])
     # four prints at one design that measures 0.8: the recommendation there is sure enough
     rec = nxt.recommendation.params
     runs = pd.DataFrame([rec] * 4).assign(k_x=0.8, c_x=2e-3)

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..errors import DesignerError
 from . import binding as kb
+from .clock import without_clock
 from .master import Master, Trace, diverged, steps
 
 ENGINES = ("auto", "kernel", "python")
@@ -272,12 +273,14 @@ def run_master(
     if engine not in ENGINES:
         raise DesignerError(f"unknown engine '{engine}'", f"use one of: {', '.join(ENGINES)}")
     if engine == "python":
-        return master.run(duration, step, progress)
+        with without_clock():
+            return master.run(duration, step, progress)
     if bound is None:
         try:
             bound = bind(master)
         except DesignerError:
             if engine == "kernel":
                 raise
-            return master.run(duration, step, progress)
+            with without_clock():
+                return master.run(duration, step, progress)
     return bound.run(duration, step, progress=progress)

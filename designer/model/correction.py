@@ -40,6 +40,7 @@ from ..study import space
 from . import mechanisms
 from .forms import as_printed
 from .prediction import Prediction, ResponseSurface
+from .roots import brentq
 
 
 class Study(Protocol):
@@ -180,8 +181,6 @@ def fit_amplitude(base: ResponseSurface, X: Mapping[str, Any], y: np.ndarray, no
     for c, whose surface is a constant in raw space, the log-normal stand-in understates how far its
     runs spread (2.46).
     """
-    from scipy.optimize import brentq
-
     held = base.nested_predictions or base.loo_predictions
     if held is None:
         return 1.0
