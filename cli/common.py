@@ -250,6 +250,7 @@ FLAGS: tuple[Flag, ...] = (
     ),
     Flag(r"\baxis=(?='\w+'(, or| is | does ))", "--use-axis ", "axis='x' is not an axis of the joint"),
     Flag(r"\bform=(?='\w*' is not a form)", "--form ", "form='serial' is not a form"),
+    Flag(r"\bform='(\w+)'", r"--form \1", "form='series' into a USD robot is not written"),
     Flag(r"\bmsl=", "--msl ", "msl='3.2' is not supported"),
     Flag(r"\brest=(?=\S+ is for exports into)", "--rest ", "rest=0.1 is for exports into a robot"),
     Flag(r"\bmotor_inertia=", "--motor-inertia ", "motor_inertia=0 and motor_bandwidth=0 must be positive"),

@@ -1,4 +1,4 @@
-"""`designer export fmu|modelica|mjcf|urdf|sdf|ssp`: a joint for simulators.
+"""`designer export fmu|modelica|mjcf|urdf|sdf|usd|ssp`: a joint for simulators.
 
 The joint comes from numbers, a design or a suggestion.
 """
@@ -19,7 +19,7 @@ from designer.errors import DesignerError
 from .common import Typer, console, err_console, finishing, flag_message, print_json, progress
 
 export_app = Typer(
-    help="Export a joint: FMU (FMI 2/3), Modelica, MJCF, URDF, SDF or SSP.", no_args_is_help=True
+    help="Export a joint: FMU (FMI 2/3), Modelica, MJCF, URDF, SDF, USD or SSP.", no_args_is_help=True
 )
 
 
@@ -232,6 +232,13 @@ def _mjcf(joint: Joint, output: Path, _from: Source, *, axis_pick: str | None, *
     from designer.export.mjcf import export_mjcf
 
     return export_mjcf(joint, output, axis=axis_pick, **options)
+
+
+def _usd(joint: Joint, output: Path, _from: Source, *, axis_pick: str | None, **options):
+    """USD standalone or --into a robot (a layer over it); the CLI's --use-axis is the writer's `axis`."""
+    from designer.export.usd import export_usd
+
+    return export_usd(joint, output, axis=axis_pick, **options)
 
 
 def package_paths(items: list[str] | None) -> dict[str, Path]:
@@ -453,6 +460,15 @@ def _formats(snippet: Callable[..., None]) -> None:
         _urdf,
         "designer export urdf --k 50 --c 0.5 --m 1e-5 --axis theta -o joint.urdf",
         (INTO, ROBOT_JOINT, REST, AXIS_PICK, OUTSIDE_RANGE, PACKAGE_PATH),
+    )
+    snippet(
+        "usd",
+        ".usda",
+        "an OpenUSD joint (UsdPhysics drive: stiffness, damping, targetPosition; PhysX armature)",
+        _usd,
+        "designer export usd --k 50 --c 0.5 --m 1e-5 --axis theta --into robot.usda --joint elbow "
+        "-o robot_flex.usda",
+        MJCF_OPTIONS,
     )
     snippet(
         "sdf",

@@ -10,7 +10,7 @@ The public API (computing returns data; writing and plotting are separate calls)
     mine = designer.calibrate(sur, "my_runs.csv")      # the surrogate updated by your own prints
     nxt = designer.next_prints(mine, k=0.8, n=3)       # what to print and measure next
     joint = designer.Joint.from_suggestion(sug)        # or Joint.from_design / from_coefficients
-    designer.export_fmu(joint, "joint.fmu")            # export_modelica, export_mjcf, export_urdf
+    designer.export_fmu(joint, "joint.fmu")            # export_modelica, export_mjcf, export_urdf, export_usd
     fits = designer.identify(["run1.csv"])             # rig logs -> coefficients
     result = designer.cosim.run(designer.cosim.load("arm.toml"))  # in memory; result.to_frame()
 
@@ -43,6 +43,7 @@ _PUBLIC = {
     "export_mjcf": "export",
     "export_urdf": "export",
     "export_sdf": "export",
+    "export_usd": "export",
     "export_ssp": "export",
     "identify": "rig.identify",
 }

@@ -7,6 +7,8 @@ FMUs, Modelica, MJCF and URDF use SI.
 
 from __future__ import annotations
 
+import math
+
 from .errors import DesignerError
 
 TRANSLATIONAL: tuple[str, ...] = ("x", "y", "z")
@@ -79,3 +81,46 @@ def from_si(quantity: str, axis: str, value: float) -> float:
 def fmt(value: float, quantity: str, axis: str, digits: int = 4) -> str:
     """A value with its rig unit, for people: fmt(0.8, 'k', 'x') == '0.8 N/mm'."""
     return f"{value:.{digits}g} {rig_unit(quantity, axis)}"
+
+
+#: per (quantity, rotational) of a UsdPhysics joint value: the powers of kilogramsPerUnit and of
+#: metersPerUnit in its stage unit, whether it is per degree (1) or in degrees (-1), and its unit in a
+#: stage of 1 kg and 1 m per unit. Quantities: k, c (drive stiffness, damping), m (armature), r (drive
+#: target, limits), F (drive maxForce)
+_USD: dict[tuple[str, bool], tuple[int, int, int, str]] = {
+    ("k", False): (1, 0, 0, "N/m"),
+    ("c", False): (1, 0, 0, "N.s/m"),
+    ("m", False): (1, 0, 0, "kg"),
+    ("r", False): (0, 1, 0, "m"),
+    ("F", False): (1, 1, 0, "N"),
+    ("k", True): (1, 2, 1, "N.m/deg"),
+    ("c", True): (1, 2, 1, "N.m.s/deg"),
+    ("m", True): (1, 2, 0, "kg.m^2"),
+    ("r", True): (0, 0, -1, "deg"),
+    ("F", True): (1, 2, 0, "N.m"),
+}
+
+
+def _usd_entry(quantity: str, rotational: bool) -> tuple[int, int, int, str]:
+    try:
+        return _USD[(quantity, rotational)]
+    except KeyError:
+        raise DesignerError(f"unknown USD quantity '{quantity}'", "use k, c, m, r or F") from None
+
+
+def usd_factor(quantity: str, rotational: bool, meters_per_unit: float, kilograms_per_unit: float) -> float:
+    """The factor such that USD = factor * SI for a joint value in a stage with these units.
+
+    UsdPhysics states angular drives per degree (stiffness N.m/deg, damping N.m.s/deg, targetPosition
+    and limits in degrees) and everything else in the stage's units: a stage unit of force is
+    kilogramsPerUnit * metersPerUnit N, of torque kilogramsPerUnit * metersPerUnit^2 N.m. So a linear
+    stiffness in N/m becomes k / kilogramsPerUnit, an angular one k * (pi / 180) / (kilogramsPerUnit *
+    metersPerUnit^2); a linear position r / metersPerUnit, an angular one degrees(r).
+    """
+    kg, m, deg, _ = _usd_entry(quantity, rotational)
+    return (math.pi / 180) ** deg / (kilograms_per_unit**kg * meters_per_unit**m)
+
+
+def usd_unit(quantity: str, rotational: bool) -> str:
+    """The unit of a UsdPhysics joint value in a stage of 1 kg and 1 m per unit, e.g. 'N.m/deg'."""
+    return _usd_entry(quantity, rotational)[3]

@@ -80,7 +80,13 @@ def test_one_prediction_shape_everywhere():
 
 @pytest.mark.parametrize(
     "writer, suffix",
-    [("export_fmu", ".mo"), ("export_modelica", ".fmu"), ("export_mjcf", ".mo"), ("export_urdf", ".xml")],
+    [
+        ("export_fmu", ".mo"),
+        ("export_modelica", ".fmu"),
+        ("export_mjcf", ".mo"),
+        ("export_urdf", ".xml"),
+        ("export_usd", ".xml"),
+    ],
 )
 def test_a_writer_refuses_a_suffix_that_is_not_its_format(tmp_path, writer, suffix):
     joint = designer.Joint.from_coefficients({"x": {"k": 0.8, "c": 2e-3, "m": 0.01}})

@@ -603,6 +603,12 @@ def _api_cases():
         "export_mjcf(dict)": ("joint", lambda: designer.export_mjcf({"k": 1}, "j.xml")),
         "export_urdf(None)": ("joint", lambda: designer.export_urdf(None, "j.urdf")),
         "export_sdf(str)": ("joint", lambda: designer.export_sdf("joint", "j.sdf")),
+        "export_usd(str)": ("joint", lambda: designer.export_usd("joint", "j.usda")),
+        "export_usd(into=3)": ("into", lambda: designer.export_usd(joint, "j.usda", into=3, joint_name="j")),
+        "export_usd(joint_name=3)": (
+            "joint_name",
+            lambda: designer.export_usd(joint, "j.usda", into="r.usda", joint_name=3),
+        ),
         "export_modelica(None)": ("joint", lambda: designer.export_modelica(None, "j.mo")),
         "export_ssp(None)": ("joints", lambda: designer.export_ssp(None, "j.ssp")),
         "export_ssp([None])": ("joints[0]", lambda: designer.export_ssp([None], "j.ssp")),

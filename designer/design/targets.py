@@ -14,7 +14,6 @@ import numpy as np
 
 from .. import units
 from ..errors import DesignerError, number_argument
-from ..model import student
 from ..model.prediction import Prediction
 from ..model.surrogate import Surrogate
 
@@ -37,8 +36,8 @@ def probability_within(
 
         P = F_dof((g(target (1 + tolerance)) - mu) / s) - F_dof((g(target (1 - tolerance)) - mu) / s)
 
-    with F_dof the t CDF (`designer.model.student`, as scipy's `stdtr`; t95 its quantile) and the
-    lower term 0 when target (1 - tolerance) <= 0 under the log. `dof` is the fitted surface's `dof`
+    with F_dof the t CDF (scipy's `stdtr`; t95 from `stdtrit`) and the lower term 0 when
+    target (1 - tolerance) <= 0 under the log. `dof` is the fitted surface's `dof`
     in the surrogate JSON; `value`, `low` and `high` are the prediction's, in rig units. Returns a
     float in [0, 1].
     """
@@ -51,12 +50,14 @@ def probability_between(
     """Probability that a printed joint's response lies between two limits (spec limits, `low` < `high`,
     rig units): `probability_within`'s predictive Student t in the fit space, with the lower term 0
     when `low` <= 0 under the log. The profiler page's asymmetric goals use the same formula."""
+    from scipy.special import stdtr, stdtrit  # numbers, not CasADi symbols: no need in the graph
+
     g = math.log if log else (lambda v: v)
-    t95 = student.quantile(dof, 0.975)
+    t95 = float(stdtrit(dof, 0.975))
     mu = g(float(prediction.value))
     s = (g(float(prediction.high)) - g(float(prediction.low))) / (2 * t95)
-    upper = student.cdf(dof, (g(high) - mu) / s)
-    lower = 0.0 if (log and low <= 0) else student.cdf(dof, (g(low) - mu) / s)
+    upper = float(stdtr(dof, (g(high) - mu) / s))
+    lower = 0.0 if (log and low <= 0) else float(stdtr(dof, (g(low) - mu) / s))
     return max(0.0, min(1.0, upper - lower))
 
 

@@ -1,4 +1,4 @@
-"""Exporters of a Joint: FMU (FMI 2/3), Modelica package, MJCF, URDF, SDF and SSP.
+"""Exporters of a Joint: FMU (FMI 2/3), Modelica package, MJCF, URDF, SDF, USD and SSP.
 
 Each writer takes a `designer.Joint` and a path, writes atomically, refuses a suffix that is not its
 format, and returns the path written (the robot formats a `RobotExport`: the path, usable as one, and
@@ -16,6 +16,7 @@ _PUBLIC = {
     "export_mjcf": "mjcf",
     "export_urdf": "urdf",
     "export_sdf": "urdf",
+    "export_usd": "usd",
     "export_ssp": "ssp",
 }
 

@@ -12,13 +12,13 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .. import units
-from ..errors import DesignerError, check_type
+from ..errors import DesignerError
 from ..files import atomic_write, check_suffix
 from ..joint import Joint, check_joint
 from . import robot
 from .mjcf_into import into_parallel
 from .mjcf_series import into_series
-from .stability import StepAdvice, step_advice
+from .stability import StepAdvice
 
 FORMS = ("parallel", "series")
 
@@ -74,24 +74,9 @@ def series_text(
     implicitly. The actuator's ctrl is the motor angle (rad) or position (m).
     """
     rot = units.is_rotational(a)
-    link = robot.links(joint)[a]
-    moving = link.inertia if rot else link.mass
-    si = joint.axes[a].si()
-    flex = step_advice(si["k"], si["c"], moving, basis="about the joint axis: the link, the motor held")
-    # the motor turns its armature, its body (the flexure's clamped part, as the link) and the link
-    servo = robot.Servo.for_flexure(
-        flex, carried=2 * moving, motor_inertia=motor_inertia, bandwidth=motor_bandwidth
-    )
-    n = joint.name
-    advice = {
-        f"{n}_{a}": flex,
-        f"{n}_motor": step_advice(
-            servo.kp,
-            servo.kv,
-            servo.motor_inertia + 2 * moving,
-            basis="about the joint axis: the motor's armature, its body and the link, the flexure held",
-        ),
-    }
+    series = robot.series_drive(joint, a, motor_inertia=motor_inertia, motor_bandwidth=motor_bandwidth)
+    link, servo, advice = series.link, series.servo, series.advice
+    n, si = joint.name, joint.axes[a].si()
     kind = "hinge" if rot else "slide"
     body = [
         f'    <body name="{n}_motor_rotor">',
@@ -102,7 +87,7 @@ def series_text(
         f'damping="{robot.num(servo.kv)}" armature="{robot.num(servo.motor_inertia)}" frictionloss="0" '
         'limited="false"/>',
         f'      <body name="{n}_{a}_link">',
-        f"        {robot.xml_comment(f'{n}_{a} flexure, motor held: ' + flex.text())}",
+        f"        {robot.xml_comment(f'{n}_{a} flexure, motor held: ' + advice[f'{n}_{a}'].text())}",
         f"        {robot.xml_comment('link: ' + link.basis)}",
         f"        {robot.inertial_xml(link)}",
         f"        {_joint_element(f'{n}_{a}', a, si['k'], si['c'])}",
@@ -202,9 +187,7 @@ def export_mjcf(
     if form not in FORMS:
         raise DesignerError(f"form={form!r} is not a form", f"use one of: {', '.join(FORMS)}")
     if into is not None:
-        if joint_name is None:
-            raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
-        check_type(joint_name, str, "joint_name", expected="a name", fix="give e.g. joint_name='knee'")
+        joint_name = robot.robot_joint_name(joint_name)
         with _mujoco_warnings() as warned:
             advice, notes = _into(
                 joint,

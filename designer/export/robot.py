@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .. import units
-from ..errors import DesignerError
+from ..errors import DesignerError, check_type
 from ..joint import PRB_GAMMA, Joint
 from ..mass import specimen_mass
 from ..study import space
@@ -67,6 +67,18 @@ class RobotExport:
             "advice": {n: a.to_dict() for n, a in self.advice.items()},
             "notes": list(self.notes),
         }
+
+
+def robot_joint_name(joint_name: object) -> str:
+    """The `joint_name` an export into a robot needs (the robot joint to make flexible).
+
+    Raises:
+        DesignerError: none given, or not a str.
+    """
+    if joint_name is None:
+        raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
+    check_type(joint_name, str, "joint_name", expected="a name", fix="give e.g. joint_name='knee'")
+    return joint_name
 
 
 def pick_axis(joint: Joint, axis: str | None, rotational: bool | None = None) -> str:
@@ -130,6 +142,39 @@ class Servo:
         total = motor_inertia + carried
         kp = total * (2 * math.pi * bandwidth) ** 2
         return cls(motor_inertia, bandwidth, kp, 2 * math.sqrt(kp * total))
+
+
+@dataclass(frozen=True)
+class SeriesDrive:
+    """Motor -> flexure -> link on one axis, standalone: the link (also the motor's body, the
+    flexure's clamped part), the servo, and the step advice of the flexure (motor held) and of the
+    motor (flexure held), keyed `<joint>_<axis>` and `<joint>_motor`."""
+
+    link: Sphere
+    servo: Servo
+    advice: dict[str, StepAdvice]
+
+
+def series_drive(
+    joint: Joint, a: str, *, motor_inertia: float | None = None, motor_bandwidth: float | None = None
+) -> SeriesDrive:
+    """The standalone series form's bodies, servo and advice on axis `a` (see `Servo.for_flexure`):
+    the motor turns its armature, its body and the link. The joint must carry masses."""
+    rot = units.is_rotational(a)
+    link = links(joint)[a]
+    moving = link.inertia if rot else link.mass
+    si = joint.axes[a].si()
+    flex = step_advice(si["k"], si["c"], moving, basis="about the joint axis: the link, the motor held")
+    servo = Servo.for_flexure(
+        flex, carried=2 * moving, motor_inertia=motor_inertia, bandwidth=motor_bandwidth
+    )
+    motor = step_advice(
+        servo.kp,
+        servo.kv,
+        servo.motor_inertia + 2 * moving,
+        basis="about the joint axis: the motor's armature, its body and the link, the flexure held",
+    )
+    return SeriesDrive(link, servo, {f"{joint.name}_{a}": flex, f"{joint.name}_motor": motor})
 
 
 def check_rest(

@@ -15,7 +15,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from .. import units
-from ..errors import DesignerError, check_type
+from ..errors import DesignerError
 from ..files import atomic_path, atomic_write, check_suffix
 from ..joint import Joint, check_joint
 from . import robot, urdf_drake, xmltext
@@ -373,9 +373,7 @@ def export_urdf(
     path = check_suffix(path, (".urdf",), what="a URDF")
     check_joint(joint)
     if into is not None:
-        if joint_name is None:
-            raise DesignerError("into= needs joint_name=", "name the robot joint to make flexible")
-        check_type(joint_name, str, "joint_name", expected="a name", fix="give e.g. joint_name='knee'")
+        joint_name = robot.robot_joint_name(joint_name)
         data, advice, notes = _into_urdf(
             joint,
             Path(into),

@@ -40,7 +40,6 @@ from ..study import space
 from . import mechanisms
 from .forms import as_printed
 from .prediction import Prediction, ResponseSurface
-from .roots import brentq
 
 
 class Study(Protocol):
@@ -195,6 +194,8 @@ def fit_amplitude(base: ResponseSurface, X: Mapping[str, Any], y: np.ndarray, no
         return 1.0
     if excess(MAX_AMPLITUDE) > 0:
         return MAX_AMPLITUDE
+    from scipy.optimize import brentq
+
     return float(brentq(excess, 1.0, MAX_AMPLITUDE, xtol=1e-6))
 
 

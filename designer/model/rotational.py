@@ -26,7 +26,6 @@ import numpy as np
 
 from .. import units
 from ..study import space
-from . import student
 from .prediction import Prediction, ResponseSurface
 
 if TYPE_CHECKING:
@@ -76,7 +75,9 @@ class PRBSurface(ResponseSurface):
         return self.base.accuracy
 
     def _t95(self) -> float:
-        return student.quantile(self.base.dof, 0.975)
+        from scipy.special import stdtrit
+
+        return float(stdtrit(self.base.dof, 0.975))
 
     def predict(self, X: Any) -> Prediction:
         p = self.base.predict(X)

@@ -306,6 +306,42 @@ class Profiler:
         return page.replace("__DATA__", payload)
 
 
+def _calibrated(surrogate: Surrogate, responses: list[dict[str, Any]]) -> dict[str, list] | None:
+    """On a calibrated surrogate: the user's prints (factor and response columns, None where not
+    measured), and each response's calibration figures put on it (`calibrated`); else None."""
+    if surrogate.calibration is None:
+        return None
+    from ..model.calibration import report as calibration_report
+
+    report = calibration_report(surrogate)["responses"]
+    table = surrogate.calibration["table"]
+    for r in responses:
+        r["calibrated"] = report.get(r["name"]) if report.get(r["name"], {}).get("n_runs") else None
+    return {
+        c: [None if pd.isna(v) else float(v) for v in table[c]]
+        for c in [*space.FACTOR_NAMES, *(r["name"] for r in responses)]
+        if c in table
+    }
+
+
+def _factors() -> list[dict[str, Any]]:
+    """The six factors as the page's sliders and boxes read them."""
+    return [
+        {
+            "name": f.name,
+            "unit": f.unit,
+            "label": f.label,
+            "low": float(f.low),
+            "high": float(f.high),
+            "levels": [float(v) for v in f.levels],
+            "categorical": f.categorical,
+            "step": float(f.resolution),
+            "printable_min": PRINTABLE_MIN_MM if f.name in ("width", "height") else None,
+        }
+        for f in space.FACTORS
+    ]
+
+
 def build_profiler(
     surrogate: Surrogate,
     *,
@@ -359,40 +395,14 @@ def build_profiler(
     responses = [
         _response(surrogate, f"{q}_{axis}", info[q]["statement"], targets.get(q)) for q in ("k", "c")
     ]
-    mine, report = None, None
-    if surrogate.calibration is not None:  # the user's prints and the calibrated model's own figures
-        from ..model.calibration import report as calibration_report
-
-        report = calibration_report(surrogate)["responses"]
-        table = surrogate.calibration["table"]
-        mine = {
-            c: [None if pd.isna(v) else float(v) for v in table[c]]
-            for c in [*space.FACTOR_NAMES, *(r["name"] for r in responses)]
-            if c in table
-        }
-        for r in responses:
-            r["calibrated"] = report.get(r["name"]) if report.get(r["name"], {}).get("n_runs") else None
+    mine = _calibrated(surrogate, responses)
     runs = {n: [float(v) for v in surrogate.training[n]] for n in space.FACTOR_NAMES}
     runs |= {r["name"]: [float(v) for v in surrogate.training[r["name"]]] for r in responses}
-    factors = [
-        {
-            "name": f.name,
-            "unit": f.unit,
-            "label": f.label,
-            "low": float(f.low),
-            "high": float(f.high),
-            "levels": [float(v) for v in f.levels],
-            "categorical": f.categorical,
-            "step": float(f.resolution),
-            "printable_min": PRINTABLE_MIN_MM if f.name in ("width", "height") else None,
-        }
-        for f in space.FACTORS
-    ]
     return Profiler(
         {
             "axis": axis,
             "surrogate_id": surrogate.id,
-            "factors": factors,
+            "factors": _factors(),
             "design": start,
             "responses": responses,
             "runs": runs,
