@@ -14,9 +14,34 @@ from typing import Annotated, Any, NamedTuple
 
 import typer
 from rich.console import Console
+from typer.core import TyperCommand
 
 from designer.errors import DesignerError
-from designer.study.space import FACTOR_NAMES
+from designer.study.space import FACTOR_NAMES, FACTORS
+
+
+class Command(TyperCommand):
+    """A command whose usage line names its arguments as click and POSIX usage do (`designer calibrate
+    [OPTIONS] RUNS`), where typer 0.28 writes `{runs}`."""
+
+    def collect_usage_pieces(self, ctx: Any) -> list[str]:
+        return [
+            re.sub(r"^([\[{]?)([a-z][\w-]*)([\]}]?)", _argument_usage, piece)
+            for piece in super().collect_usage_pieces(ctx)
+        ]
+
+
+def _argument_usage(m: re.Match) -> str:
+    optional = m.group(1) == "["
+    return f"[{m.group(2).upper()}]" if optional else m.group(2).upper()
+
+
+class Typer(typer.Typer):
+    """typer.Typer whose commands are `Command`s."""
+
+    def command(self, *args: Any, cls: Any = None, **kwargs: Any) -> Any:
+        return super().command(*args, cls=cls or Command, **kwargs)
+
 
 #: set by `finishing()`, cleared by each `run()`: the command is writing its outputs and a stop signal
 #: no longer interrupts it; LATE_STOP is the signal that came meanwhile (None: none did)
@@ -33,25 +58,25 @@ def finishing() -> None:
 
 
 # the options many commands share, spelled once: -o/--output, --data, --json, --surrogate, --fix
-JsonOpt = Annotated[bool, typer.Option("--json", help="Print machine-readable JSON only.")]
+JsonOpt = Annotated[bool, typer.Option("--json", help="print machine-readable JSON only")]
 DataOpt = Annotated[
     Path | None,
-    typer.Option("--data", help="Coefficient table (CSV or Parquet); default: the bundled 44 study runs."),
+    typer.Option("--data", help="coefficient table (CSV or Parquet); default: the bundled 44 study runs"),
 ]
 SurrogateOpt = Annotated[
     Path | None,
-    typer.Option("--surrogate", help="Surrogate JSON from `designer fit` (default: the shipped one)."),
+    typer.Option("--surrogate", help="surrogate JSON from `designer fit` (default: the shipped one)"),
 ]
 AcceptImplausibleOpt = Annotated[
     bool,
     typer.Option(
         "--accept-implausible",
-        help="Keep a measured k or c no printer can give (refused by default: a unit slip).",
+        help="keep a measured k or c no printer can give (refused by default: a unit slip)",
     ),
 ]
 FixOpt = Annotated[
     list[str] | None,
-    typer.Option("--fix", help="Hold a factor, NAME=VALUE in rig units, e.g. --fix width=4.5 (repeatable)."),
+    typer.Option("--fix", help="hold a factor, NAME=VALUE in rig units, e.g. --fix width=4.5 (repeatable)"),
 ]
 
 
@@ -258,9 +283,15 @@ def flag_message(text: str, options: Collection[str] | None = None) -> str:
     return text
 
 
-AxisOpt = Annotated[str, typer.Option("--axis", help="Axis: x y z theta phi psi.")]
+def design_text(params: dict) -> str:
+    """One design's six settings as every command prints them, with the flags' names and units:
+    "density 60 %, length 24 mm, width 4.5 mm, height 9 mm, layer 0.16 mm, raster 0 deg"."""
+    return ", ".join(f"{f.name} {params[f.name]:g} {f.unit}" for f in FACTORS)
+
+
+AxisOpt = Annotated[str, typer.Option("--axis", help="axis: x y z theta phi psi")]
 ToleranceOpt = Annotated[
-    float, typer.Option("--tolerance", help="Band around a target that counts as met, % (+-).")
+    float, typer.Option("--tolerance", help="band around a target that counts as met, % (+-)")
 ]
 
 

@@ -32,7 +32,7 @@ from .common import (
 
 def fit(
     data: DataOpt = None,
-    out: Annotated[Path | None, output_option("Where to write the surrogate JSON.")] = None,
+    out: Annotated[Path | None, output_option("where to write the surrogate JSON")] = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Fit the response surfaces (form and ridge penalty chosen by leave-one-out) and save them.
@@ -97,15 +97,15 @@ def _print_fit(report: dict, n_runs: int) -> None:
 
 
 def predict(
-    density: Annotated[float | None, typer.Option(help="Infill density, % (20-100).")] = None,
-    length: Annotated[float | None, typer.Option(help="Length l, mm (18-30).")] = None,
-    width: Annotated[float | None, typer.Option(help="Width b, mm (2-7).")] = None,
-    height: Annotated[float | None, typer.Option(help="Height h, mm (4-14).")] = None,
-    layer: Annotated[float | None, typer.Option(help="Layer thickness, mm (0.12, 0.16 or 0.2).")] = None,
-    raster: Annotated[float | None, typer.Option(help="Raster angle, deg (0 or 45).")] = None,
+    density: Annotated[float | None, typer.Option(help="infill density, % (20-100)")] = None,
+    length: Annotated[float | None, typer.Option(help="length, mm (18-30)")] = None,
+    width: Annotated[float | None, typer.Option(help="width, mm (2-7)")] = None,
+    height: Annotated[float | None, typer.Option(help="height, mm (4-14)")] = None,
+    layer: Annotated[float | None, typer.Option(help="layer thickness, mm (0.12, 0.16 or 0.2)")] = None,
+    raster: Annotated[float | None, typer.Option(help="raster angle, deg (0 or 45)")] = None,
     axis: AxisOpt = "x",
     allow_extrapolation: Annotated[
-        bool, typer.Option(help="Accept continuous factors outside the tested ranges.")
+        bool, typer.Option(help="accept continuous factors outside the tested ranges")
     ] = False,
     surrogate: SurrogateOpt = None,
     as_json: JsonOpt = False,
@@ -169,37 +169,37 @@ def predict(
 def suggest(
     k: Annotated[
         str | None,
-        typer.Option("--k", help="Stiffness goal: a target (N/mm; N.mm/rad on rotational axes), min or max."),
+        typer.Option("--k", help="stiffness goal: a target (N/mm; N.mm/rad on rotational axes), min or max"),
     ] = None,
     c: Annotated[
         str | None,
         typer.Option(
-            "--c", help="Damping goal: a target (N.s/mm; N.mm.s/rad on rotational axes), min or max."
+            "--c", help="damping goal: a target (N.s/mm; N.mm.s/rad on rotational axes), min or max"
         ),
     ] = None,
     axis: AxisOpt = "x",
     fix: FixOpt = None,
-    top: Annotated[int, typer.Option("--top", help="How many distinct candidates.")] = 5,
+    top: Annotated[int, typer.Option("--top", help="how many distinct candidates")] = 5,
     tolerance: ToleranceOpt = 10.0,
-    importance_k: Annotated[float, typer.Option("--importance-k", help="Importance of the k goal.")] = 1.0,
-    importance_c: Annotated[float, typer.Option("--importance-c", help="Importance of the c goal.")] = 1.0,
-    weight_k: Annotated[float, typer.Option("--weight-k", help="Desirability shape exponent of k.")] = 1.0,
-    weight_c: Annotated[float, typer.Option("--weight-c", help="Desirability shape exponent of c.")] = 1.0,
+    importance_k: Annotated[float, typer.Option("--importance-k", help="importance of the k goal")] = 1.0,
+    importance_c: Annotated[float, typer.Option("--importance-c", help="importance of the c goal")] = 1.0,
+    weight_k: Annotated[float, typer.Option("--weight-k", help="desirability shape exponent of k")] = 1.0,
+    weight_c: Annotated[float, typer.Option("--weight-c", help="desirability shape exponent of c")] = 1.0,
     k_low: Annotated[
-        float | None, typer.Option(help="Lower desirability bound of k (default: measured min).")
+        float | None, typer.Option(help="lower desirability bound of k (default: measured min)")
     ] = None,
     k_high: Annotated[
-        float | None, typer.Option(help="Upper desirability bound of k (default: measured max).")
+        float | None, typer.Option(help="upper desirability bound of k (default: measured max)")
     ] = None,
     c_low: Annotated[
-        float | None, typer.Option(help="Lower desirability bound of c (default: measured min).")
+        float | None, typer.Option(help="lower desirability bound of c (default: measured min)")
     ] = None,
     c_high: Annotated[
-        float | None, typer.Option(help="Upper desirability bound of c (default: measured max).")
+        float | None, typer.Option(help="upper desirability bound of c (default: measured max)")
     ] = None,
     allow_extrapolation: Annotated[
         bool,
-        typer.Option(help="Search half a range beyond the tested ranges, within printable limits (flagged)."),
+        typer.Option(help="search half a range beyond the tested ranges, within printable limits (flagged)"),
     ] = False,
     surrogate: SurrogateOpt = None,
     as_json: JsonOpt = False,
@@ -209,9 +209,7 @@ def suggest(
     Each goal is a target value, min or max. Candidates are ranked by the probability that a
     printed joint lands within --tolerance of the targets, then by composite desirability D (over
     the predictable responses). Exit 1 when no design's prediction reaches a target within the
-    tolerance (the output is still printed), 2 on bad input.
-
-    Exits 1 when a target is out of reach (the nearest designs are still listed).
+    tolerance (the output is still printed, with the nearest designs), 2 on bad input.
 
     Example: designer suggest --k 0.8 --c 2e-3 --fix raster=0 --top 3
     """
@@ -266,7 +264,7 @@ def _print_suggestion(data: dict) -> None:
         pad_edge=False,
         collapse_padding=True,
     )
-    for col in ("#", "infill\n%", "l\nmm", "b\nmm", "h\nmm", "layer\nmm", "raster\ndeg"):
+    for col in ("#", "density\n%", "length\nmm", "width\nmm", "height\nmm", "layer\nmm", "raster\ndeg"):
         tab.add_column(col, justify="right", no_wrap=True)
     for q in ("k", "c"):
         tab.add_column(f"{q} {u[q]}\n[95 % PI]", justify="right", no_wrap=True)
@@ -283,7 +281,7 @@ def _print_suggestion(data: dict) -> None:
         )
     console.print(tab)
     console.print(
-        f"l, b, h: length, width, height; P: probability that a printed joint meets the predictable targets "
+        f"P: probability that a printed joint meets the predictable targets "
         f"within {band}; D: composite desirability of the predictable responses (1 = every goal met); "
         "any: no effect at this geometry (predicted as solid); *: outside the tested range (extrapolated)"
     )
@@ -297,7 +295,7 @@ def _print_suggestion(data: dict) -> None:
         for note in cand["notes"]:
             console.print(f"- candidate {i}: {note}")
     console.print(
-        "Printability: infill rounded to 1 %, geometry to 0.01 mm, layer and raster at the study's levels; "
+        "Printability: density rounded to 1 %, geometry to 0.01 mm, layer and raster at the study's levels; "
         "walls 0.8 mm, nozzle 0.4 mm, so width and height at least 2.0 mm."
     )
 

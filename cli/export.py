@@ -16,9 +16,9 @@ from rich.markup import escape
 
 from designer.errors import DesignerError
 
-from .common import console, err_console, finishing, flag_message, print_json, progress
+from .common import Typer, console, err_console, finishing, flag_message, print_json, progress
 
-export_app = typer.Typer(
+export_app = Typer(
     help="Export a joint: FMU (FMI 2/3), Modelica, MJCF, URDF, SDF, USD or SSP.", no_args_is_help=True
 )
 
@@ -37,9 +37,9 @@ K = _floats("stiffness k per --axis: N/mm (N.mm/rad rotational)")
 C = _floats("damping c per --axis: N.s/mm (N.mm.s/rad rotational)")
 M = _floats("moving mass m per --axis: kg (kg.m^2 rotational)")
 DENSITY = _number("infill density, % (20-100): predict k and c from the print settings")
-LENGTH = _number("length l, mm (18-30)")
-WIDTH = _number("width b, mm (2-7)")
-HEIGHT = _number("height h, mm (4-14)")
+LENGTH = _number("length, mm (18-30)")
+WIDTH = _number("width, mm (2-7)")
+HEIGHT = _number("height, mm (4-14)")
 LAYER = _number("layer thickness, mm (0.12, 0.16 or 0.2)")
 RASTER = _number("raster angle, deg (0 or 45)")
 

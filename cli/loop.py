@@ -16,6 +16,7 @@ from .common import (
     ToleranceOpt,
     answer,
     console,
+    design_text,
     finishing,
     load_surrogate,
     output_option,
@@ -34,9 +35,9 @@ _FACTOR = "{:.2f}"
 def calibrate(
     runs: Annotated[
         Path,
-        typer.Argument(help="Your measured runs: a coefficient table (CSV or Parquet), e.g. identify's."),
+        typer.Argument(help="your measured runs: a coefficient table (CSV or Parquet), e.g. identify's"),
     ],
-    out: Annotated[Path | None, output_option("Where to write the calibrated surrogate JSON.")] = None,
+    out: Annotated[Path | None, output_option("where to write the calibrated surrogate JSON")] = None,
     surrogate: SurrogateOpt = None,
     accept_implausible: AcceptImplausibleOpt = False,
     as_json: JsonOpt = False,
@@ -47,10 +48,11 @@ def calibrate(
     (a factor per response with its 95 % interval, width and height offsets, infill, layer and raster
     adhesion: those your runs pin down are printed) and a local correction that is strong near the
     designs you printed and fades away from them. The result is a surrogate file every --surrogate
-    option accepts. The report gives the nested leave-one-out accuracy over your runs (each predicted
-    from the others). The runs table designer print writes is read as filled: prints not measured yet
-    are left out. A k or c whose implied printer factor lies far outside its prior (a value in N/m, a
-    load in kN) is refused, naming the likely unit, unless --accept-implausible.
+    option accepts. The report gives a leave-one-out over your runs (each predicted from the others;
+    nothing is refitted, the settings come from the study). The runs table designer print writes is
+    read as filled: prints not measured yet are left out. A k or c whose implied printer factor lies
+    far outside its prior (a value in N/m, a load in kN) is refused, naming the likely unit, unless
+    --accept-implausible.
 
     Example: designer calibrate my_runs.csv -o mine.json
     """
@@ -129,19 +131,17 @@ def _pinned(mechanisms: dict) -> str:
 
 
 def next_(
-    k: Annotated[
-        str | None, typer.Option("--k", help="Stiffness target (N/mm; N.mm/rad rotational).")
-    ] = None,
+    k: Annotated[str | None, typer.Option("--k", help="stiffness target (N/mm; N.mm/rad rotational)")] = None,
     c: Annotated[
-        str | None, typer.Option("--c", help="Damping goal: a target (N.s/mm; N.mm.s/rad), min or max.")
+        str | None, typer.Option("--c", help="damping goal: a target (N.s/mm; N.mm.s/rad), min or max")
     ] = None,
     axis: AxisOpt = "x",
     fix: FixOpt = None,
-    n: Annotated[int, typer.Option("--n", help="How many designs to print now (1-10).")] = 3,
+    n: Annotated[int, typer.Option("--n", help="how many designs to print now (1-10)")] = 3,
     tolerance: ToleranceOpt = 10.0,
     stop: Annotated[
         float,
-        typer.Option("--stop", help="Print the recommendation once it lands with this probability (0-1)."),
+        typer.Option("--stop", help="print the recommendation once it lands with this probability (0-1)"),
     ] = 0.9,
     surrogate: SurrogateOpt = None,
     as_json: JsonOpt = False,
@@ -174,23 +174,16 @@ def next_(
     answer(result.to_dict(), as_json, _print_next)
 
 
-def _design(params: dict) -> str:
-    return (
-        f"infill {params['density']:g} %, l {params['length']:g} mm, b {params['width']:g} mm, "
-        f"h {params['height']:g} mm, layer {params['layer']:g} mm, raster {params['raster']:g} deg"
-    )
-
-
 def _print_next(data: dict) -> None:
     rec = data["recommendation"]
-    console.print(f"Design #1 now: {_design(rec['params'])}")
+    console.print(f"Design #1 now: {design_text(rec['params'])}")
     console.print(
         f"  k {pi_text(rec['predicted']['k'])}, c {pi_text(rec['predicted']['c'])}; "
         f"lands within +-{100 * data['tolerance']:g} % with probability {data['p_now']:.2f}"
     )
     for i, p in enumerate(data["prints"], 1):
         mark = " (design #1 itself)" if p["recommended"] else ""
-        console.print(f"Print {i}{mark}: {_design(p['params'])}")
+        console.print(f"Print {i}{mark}: {design_text(p['params'])}")
         console.print(
             f"  predicted k {pi_text(p['predicted']['k'])}, c {pi_text(p['predicted']['c'])}; {p['reason']}"
         )

@@ -36,7 +36,7 @@ import typer  # noqa: E402
 from designer.errors import DesignerError  # noqa: E402
 
 from . import common, cosim, design, export, loop, plots, printing, rig, sweep  # noqa: E402
-from .common import flag_message  # noqa: E402
+from .common import Typer, flag_message  # noqa: E402
 
 try:  # typer 0.28 vendors click
     from typer._click import exceptions as _click_errors
@@ -54,10 +54,10 @@ SETTINGS = dict(
     add_completion=False,
     rich_markup_mode="rich",
 )
-app = typer.Typer(**SETTINGS)
+app = Typer(**SETTINGS)
 #: typer builds the click tree of every registered command on each call: a design command gets an
 #: app with only fit, predict and suggest (the help of `designer` itself still lists everything)
-design_app = typer.Typer(**SETTINGS)
+design_app = Typer(**SETTINGS)
 
 
 def _version(value: bool) -> None:
@@ -72,14 +72,14 @@ def _version(value: bool) -> None:
 @app.callback()
 def _options(
     version: Annotated[
-        bool, typer.Option("--version", callback=_version, is_eager=True, help="Print the version and exit.")
+        bool, typer.Option("--version", callback=_version, is_eager=True, help="print the version and exit")
     ] = False,
     debug: Annotated[
-        bool, typer.Option("--debug", help="On an internal error, show the traceback (any position).")
+        bool, typer.Option("--debug", help="on an internal error, show the traceback (any position)")
     ] = False,
     quiet: Annotated[
         bool,
-        typer.Option("--quiet", help="No progress bars on stderr (any position; off a terminal always)."),
+        typer.Option("--quiet", help="no progress bars on stderr (any position; off a terminal always)"),
     ] = False,
 ) -> None:
     """Options of the `designer` command itself (--debug is also accepted after a sub-command)."""

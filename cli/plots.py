@@ -7,10 +7,10 @@ from typing import Annotated
 
 import typer
 
-from .common import DataOpt, FixOpt, console, finishing, parse_fix, print_json, quiet_mujoco
+from .common import DataOpt, FixOpt, Typer, console, finishing, parse_fix, print_json, quiet_mujoco
 from .common import progress as progress_bar
 
-plot_app = typer.Typer(
+plot_app = Typer(
     help="Draw the data, the surrogate and the design space (PNG, SVG or PDF; headless).",
     no_args_is_help=True,
 )
@@ -234,7 +234,7 @@ def timeseries_cmd(
 ) -> None:
     """Co-simulation signals against time, one panel each, a reference dashed.
 
-    Example: designer plot timeseries results/timeseries.csv --columns joint.x.s,joint.x.f -o ts.png
+    Example: designer plot timeseries results/arm/timeseries.csv --columns robot.j1.q,robot.j2.q -o ts.png
     """
     from designer.plots import common, timeseries
 

@@ -11,14 +11,14 @@ import typer
 
 from designer.errors import DesignerError
 
-from .common import AxisOpt, JsonOpt, console, finishing, print_json
+from .common import AxisOpt, JsonOpt, console, design_text, finishing, print_json
 
 _FACTOR_HELP = "one design's setting (give all six, or --from)"
 
 
 def print_(
     output: Annotated[
-        Path, typer.Option("-o", "--output", help="Folder for the plate, STLs, .ini files (and runs.csv).")
+        Path, typer.Option("-o", "--output", help="folder for the plate, STLs, .ini files (and runs.csv)")
     ],
     from_: Annotated[
         Path | None, typer.Option("--from", help="designer next --json (its prints) or suggest --json output")
@@ -106,10 +106,7 @@ def _designs(from_: Path | None, candidate: int | None, given: dict) -> list[dic
 def _print_batch(data: dict) -> None:
     for p in data["prints"]:
         v = p["params"]
-        console.print(
-            f"{p['print']}: infill {v['density']:g} %, l {v['length']:g} mm, b {v['width']:g} mm, "
-            f"h {v['height']:g} mm, layer {v['layer']:g} mm, raster {v['raster']:g} deg"
-        )
+        console.print(f"{p['print']}: {design_text(v)}")
     for note in data["notes"]:
         console.print(f"- {note}")
     files = data["files"]

@@ -10,9 +10,18 @@ import typer
 
 from designer.errors import DesignerError
 
-from .common import AcceptImplausibleOpt, JsonOpt, console, err_console, finishing, print_json, progress
+from .common import (
+    AcceptImplausibleOpt,
+    JsonOpt,
+    Typer,
+    console,
+    err_console,
+    finishing,
+    print_json,
+    progress,
+)
 
-rig_app = typer.Typer(help="The virtual rig: simulate the study's experiment.", no_args_is_help=True)
+rig_app = Typer(help="The virtual rig: simulate the study's experiment.", no_args_is_help=True)
 
 _FACTOR_HELP = "specimen factor written to the log's sidecar (give all six, or none)"
 #: identify's runs table of the prints (designer print's)
@@ -325,7 +334,7 @@ def doe(
     ] = None,
     seed: Annotated[int | None, typer.Option(help="random seed of the run order")] = None,
     all_continuous: Annotated[
-        bool, typer.Option(help="Box and Behnken's 1960 six-factor design instead")
+        bool, typer.Option(help="the six-factor design of Box and Behnken (1960) instead")
     ] = False,
     augment: Annotated[
         int | None, typer.Option(help="pick N specimens that most narrow the surrogate's PIs")

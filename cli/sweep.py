@@ -13,13 +13,13 @@ from designer.errors import DesignerError
 
 from .common import console, err_console, finishing, print_json, progress
 
-JsonOpt = Annotated[bool, typer.Option("--json", help="Print the summary as JSON only.")]
+JsonOpt = Annotated[bool, typer.Option("--json", help="print the summary as JSON only")]
 WorkersOpt = Annotated[
     int | None,
-    typer.Option("--workers", min=1, help="Local worker processes (default: one per core; 1: serial)."),
+    typer.Option("--workers", min=1, help="local worker processes (default: one per core; 1: serial)"),
 ]
 SchedulerOpt = Annotated[
-    str | None, typer.Option("--scheduler", help="Run on a Dask scheduler, e.g. tcp://10.0.0.5:8786.")
+    str | None, typer.Option("--scheduler", help="run on a Dask scheduler, e.g. tcp://10.0.0.5:8786")
 ]
 
 
@@ -32,13 +32,13 @@ def sweep(
     scheduler: SchedulerOpt = None,
     path: Annotated[
         str | None,
-        typer.Option("--path", help="fmu (co-simulate every case) or engine (mujoco.rollout fast path)."),
+        typer.Option("--path", help="fmu (co-simulate every case) or engine (mujoco.rollout fast path)"),
     ] = None,
-    plot: Annotated[bool, typer.Option("--plot/--no-plot", help="Draw metrics.png.")] = True,
+    plot: Annotated[bool, typer.Option("--plot/--no-plot", help="draw metrics.png")] = True,
     max_cases: Annotated[
         int | None,
         typer.Option(
-            "--max-cases", min=1, help="Most cases to run (default 1000000); checked before any work."
+            "--max-cases", min=1, help="most cases to run (default 1000000); checked before any work"
         ),
     ] = None,
     json_out: JsonOpt = False,
@@ -165,28 +165,26 @@ def tune(
         str,
         typer.Option(
             "--objective",
-            help="Metric to minimise, summed over the joints: settling_time, "
-            "overshoot, tracking_rms, peak_deflection, energy_dissipated.",
+            help="metric to minimise, summed over the joints: settling_time, "
+            "overshoot, tracking_rms, peak_deflection, energy_dissipated",
         ),
     ] = "settling_time",
     limit: Annotated[
-        list[str] | None, typer.Option("--limit", help='Task limit met at every joint, e.g. "overshoot<=5%".')
+        list[str] | None, typer.Option("--limit", help='task limit met at every joint, e.g. "overshoot<=5%"')
     ] = None,
     bounds: Annotated[
         list[str] | None,
         typer.Option(
             "--bounds",
-            help="JOINT.k=LOW:HIGH or JOINT.c=LOW:HIGH in rig units (default: the surrogate's reach).",
+            help="JOINT.k=LOW:HIGH or JOINT.c=LOW:HIGH in rig units (default: the surrogate's reach)",
         ),
     ] = None,
     out: Annotated[Path | None, typer.Option("-o", "--output", help="write the result as JSON here")] = None,
-    path: Annotated[
-        str, typer.Option("--path", help="engine (fast, FMU-checked optimum) or fmu.")
-    ] = "engine",
+    path: Annotated[str, typer.Option("--path", help="engine (fast, FMU-checked optimum) or fmu")] = "engine",
     robustness: Annotated[
-        int, typer.Option("--robustness", min=0, help="Monte Carlo draws of the designs to print.")
+        int, typer.Option("--robustness", min=0, help="Monte Carlo draws of the designs to print")
     ] = 100,
-    seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the optimiser and the draws.")] = 0,
+    seed: Annotated[int, typer.Option("--seed", min=0, help="seed of the optimiser and the draws")] = 0,
     workers: WorkersOpt = None,
     scheduler: SchedulerOpt = None,
     json_out: JsonOpt = False,

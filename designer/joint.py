@@ -243,7 +243,8 @@ class Joint:
             return self.axes[units.check_axis(name)]
         except KeyError:
             raise DesignerError(
-                f"joint '{self.name}' has no axis '{name}'", f"it has: {', '.join(self.axes)}"
+                f"joint '{self.name}' has no axis '{name}'",
+                f"it has: {', '.join(self.axes)}; use one of those, or build the joint on axis '{name}' too",
             ) from None
 
     def with_masses(self) -> Joint:

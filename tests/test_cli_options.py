@@ -3,6 +3,9 @@ input table, `--json` on every command that produces numbers; `--help` of each s
 
 from __future__ import annotations
 
+import json
+import re
+
 import typer
 from designer_cli.main import app
 
@@ -64,3 +67,68 @@ def test_every_option_and_argument_has_help():
         if not (getattr(param, "help", None) or "").strip() and "--help" not in getattr(param, "opts", [])
     ]
     assert not bare, f"without help: {bare}"
+
+
+def _usage(cmd, path: str) -> str:
+    import click
+
+    ctx = click.Context(cmd, info_name=path)
+    return cmd.get_usage(ctx)
+
+
+def test_usage_lines_name_arguments_in_capitals():
+    """`designer calibrate [OPTIONS] RUNS`, as click and POSIX usage write it, not typer's `{runs}`."""
+    usages = {path: _usage(cmd, path) for path, cmd in COMMANDS.items()}
+    assert usages["designer calibrate"].split() == ["Usage:", "designer", "calibrate", "[OPTIONS]", "RUNS"]
+    assert usages["designer identify"].split()[-1] == "LOGS..."
+    assert not [u for u in usages.values() if re.search(r"[{}]|\b[a-z_]+\.\.\.", u)], usages
+
+
+def test_help_texts_share_one_style():
+    """Every option's and argument's help starts in lower case (unless with a name such as MuJoCo or
+    JSON) and ends without a full stop, as most of them did; `suggest --help` states each exit code once."""
+    odd = []
+    for path, cmd in [*COMMANDS.items(), ("designer", typer.main.get_command(app))]:
+        for p in cmd.params:
+            text = (getattr(p, "help", None) or "").strip()
+            first = text.split()[0] if text else ""
+            named = (
+                re.match(r"[A-Z]{2}", first) or re.search(r"[a-z][A-Z]", first) or first in {"Monte", "Dask"}
+            )
+            if text and ((text[0].isupper() and not named) or text.endswith(".")):
+                odd.append((path, p.name, text))
+    assert not odd, odd
+    suggest = COMMANDS["designer suggest"].help
+    assert len(re.findall(r"\bExits? 1\b", suggest)) == 1
+
+
+def test_designs_are_printed_with_the_flags_names(capsys):
+    """Flags, tables, sentences and JSON say density, length, width, height: never infill, l, b, h."""
+    from clitools import run_inprocess
+
+    code, out, _ = run_inprocess(["suggest", "--k", "0.8", "--top", "2"], capsys)
+    assert code == 0
+    header = " ".join(out.splitlines()[2:4])
+    assert all(word in header for word in ("density", "length", "width", "height", "layer", "raster"))
+    assert not re.search(r"\binfill\b|\bl\b|\bb\b|\bh\b", header) and "l, b, h" not in out
+    assert "Printability: density rounded to 1 %" in " ".join(out.split())
+    code, out, _ = run_inprocess(["next", "--k", "0.8", "--n", "1"], capsys)
+    assert code == 0 and re.search(r"Design #1 now: density \d+ %, length [\d.]+ mm, width ", out)
+    code, out, _ = run_inprocess(["suggest", "--k", "0.8", "--top", "1", "--json"], capsys)
+    assert list(json.loads(out)["candidates"][0]["params"]) == [
+        "density", "length", "width", "height", "layer", "raster"
+    ]  # fmt: skip
+
+
+def test_the_timeseries_example_names_columns_a_robot_run_writes():
+    """`plot timeseries --help`'s example once named rig columns (joint.x.s) no robot run has."""
+    from dataclasses import replace
+    from pathlib import Path
+
+    from designer import cosim
+
+    example = COMMANDS["designer plot timeseries"].help.split("Example: ", 1)[1].split()
+    columns = example[example.index("--columns") + 1].split(",")
+    scenario = cosim.load(Path(__file__).resolve().parents[1] / "examples" / "two_link_arm.toml")
+    frame = cosim.run(replace(scenario, duration=0.01)).to_frame()
+    assert set(columns) <= set(frame.columns), (columns, list(frame.columns))

@@ -305,6 +305,24 @@ def test_joint_source_checks_its_fields():
         JointSource(joint=joint, parameters={"theta.stiffness": 1.0}).check()
 
 
+def test_an_fmu_on_the_wrong_axis_is_refused_with_the_export_that_fixes_it(tmp_path, capsys):
+    """README's first hour once said nothing of the axis: an FMU exported on x given to a hinge was
+    refused with "has no axis theta (it has: x)" and no way out. The refusal names the export line."""
+    from clitools import run_inprocess
+
+    fmu = tmp_path / "joint.fmu"
+    export = ["export", "fmu", "--k", "0.8", "--c", "2e-3", "--platforms", "host", "-o", fmu]
+    assert run_inprocess(export, capsys)[0] == 0
+    scenario = arm(tmp_path, duration=0.1, joint2='fmu = "joint.fmu"')
+    code, _, err = run_inprocess(["cosim", scenario, "-o", tmp_path / "out"], capsys)
+    assert code == 2 and "Traceback" not in err
+    assert "has no axis theta (it has: x; export the joint on axis theta:" in err
+    assert "`designer export fmu ... --axis theta`" in err
+    export[export.index("-o") : export.index("-o")] = ["--axis", "theta"]  # the fix, as stated
+    assert run_inprocess(export, capsys)[0] == 0
+    assert run_inprocess(["cosim", scenario, "-o", tmp_path / "out"], capsys)[0] == 0
+
+
 @pytest.mark.parametrize(
     "old, new, message",
     [

@@ -166,7 +166,7 @@ def _cosim_frame() -> pd.DataFrame:
 
 
 def test_plot_loo_prints_the_figures_it_draws(tmp_path):
-    """The terminal and the figure give the nested leave-one-out Q2 (0.32 for k_x, not the selected
+    """The terminal and the figure give the nested leave-one-out Q2 (0.31 for k_x, not the selected
     form's optimistic 0.43), and the legend sits below the data."""
     from designer.model.surrogate import Surrogate
     from designer.plots import loo

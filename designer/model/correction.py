@@ -13,7 +13,7 @@ response surface gets wrong there. Per response, in log space:
   correlation over the coded factors whose length scale is the longest the study's own nested
   leave-one-out residuals do not reject (`fit_length`), and whose size is the study's predictive spread
   ``s_g(x)^2 = s0(x)^2 - sigma_n^2`` times an amplitude that makes it as large as those residuals
-  show the model errs at a design it did not see (`fit_amplitude`: 1.06 for k; 2.47 for c, whose log
+  show the model errs at a design it did not see (`fit_amplitude`: 1.06 for k; 2.46 for c, whose log
   spread the study's raw-space interval understates);
 - ``e ~ N(0, sigma_n^2)``: print-to-print scatter, from the study's replicated runs (pure error),
   never below 2.5 %.
@@ -178,7 +178,7 @@ def fit_amplitude(base: ResponseSurface, X: Mapping[str, Any], y: np.ndarray, no
     So before any run of the user's, the prior's spread at a design the study did not print is what
     the study's own cross-validation measures there: for k its stated spread is 6 % short (1.06);
     for c, whose surface is a constant in raw space, the log-normal stand-in understates how far its
-    runs spread (2.47).
+    runs spread (2.46).
     """
     held = base.nested_predictions or base.loo_predictions
     if held is None:

@@ -35,9 +35,18 @@ class Folds:
     sees (in table order), so a cached fit is the same numbers a fresh call gives.
     """
 
-    def __init__(self, X: Mapping[str, np.ndarray], y: np.ndarray, forms: tuple[str, ...]) -> None:
+    def __init__(
+        self,
+        X: Mapping[str, np.ndarray],
+        y: np.ndarray,
+        forms: tuple[str, ...],
+        printed: Mapping[str, np.ndarray] | None = None,
+    ) -> None:
         self.y = y
         self.Z = {form: design_matrix(form, X) for form in forms}
+        #: each form's design matrix of the runs as printed (`forms.as_printed`), where `predict`
+        #: evaluates a design: the held-out run of nested leave-one-out is predicted there
+        self.Z_printed = self.Z if printed is None else {form: design_matrix(form, printed) for form in forms}
         self._cache: dict[tuple[str, frozenset[int]], Fit] = {}
 
     def fit(self, form: str, out: frozenset[int]) -> Fit:

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..study import space
 from .folds import Folds, metrics
-from .forms import FORMS, design_matrix
+from .forms import FORMS, as_printed, design_matrix
 from .prediction import Prediction, ResponseSurface
 from .validation import lack_of_fit, nested_loo, select_on
 
@@ -43,12 +43,13 @@ def select(
 
     `loo` holds the chosen form's leave-one-out figures (optimistic: the form was chosen by
     looking at them); with `nested`, `loo_nested` holds those of the whole procedure repeated
-    without each run (form and penalty chosen inside every outer fold), and `influence` the runs
+    without each run (form and penalty chosen inside every outer fold; the run predicted as
+    printed, as `predict` does), and `influence` the runs
     whose removal changes the chosen form or moves the chosen form's Q2 by more than 0.05.
     """
     y = np.asarray(y, dtype=float)
     forms = usable_forms(X, forms)
-    folds = Folds(X, y, forms)
+    folds = Folds(X, y, forms, printed=as_printed(dict(X)))
     rows = np.arange(len(y))
     sel = select_on(folds, rows, forms)
     model = ResponseSurface(response, sel.form).set_fit(sel.fit, y)

@@ -3,7 +3,10 @@
 Leave-one-out of the chosen form is optimistic, because the form was chosen by looking at those
 same errors. Nested leave-one-out repeats the whole procedure (form and ridge penalty chosen
 again) without each run and predicts that run: the accuracy a user can expect of `fit` on data
-like this. With replicated runs (equal factor settings), the pure error they measure splits the
+like this. The held-out run is predicted as `Surrogate.predict` predicts a design, as printed (a
+section the walls fill is solid: 100 % whatever the nominal infill), so the figure is the accuracy of
+what `predict` does: the same numbers as fitting on the other runs and calling `predict` at the run.
+With replicated runs (equal factor settings), the pure error they measure splits the
 residual into pure error and lack of fit, the classic response-surface test (Montgomery, Design
 and Analysis of Experiments, sec. 6.8 / 11.2).
 """
@@ -84,7 +87,7 @@ def nested_loo(
     for i in range(n):
         rows = np.delete(np.arange(n), i)
         sel = select_on(folds, rows, forms, out=frozenset({i}))
-        p = sel.fit.predict(folds.Z[sel.form][i : i + 1])
+        p = sel.fit.predict(folds.Z_printed[sel.form][i : i + 1])
         value[i], low[i], high[i] = p[0][0], p[1][0], p[2][0]
         q2 = point_metrics(y[rows], sel.loo[sel.form])["q2"]
         if sel.form != full.form or abs(q2 - full_q2) > INFLUENCE_Q2:

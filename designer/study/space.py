@@ -43,9 +43,9 @@ class Factor:
 
 FACTORS: tuple[Factor, ...] = (
     Factor("density", "%", 20, 100, (20, 60, 100), label="infill density", resolution=1.0),
-    Factor("length", "mm", 18, 30, (18, 24, 30), label="length l", resolution=0.01),
-    Factor("width", "mm", 2, 7, (2, 4.5, 7), label="width b", resolution=0.01),
-    Factor("height", "mm", 4, 14, (4, 9, 14), label="height h", resolution=0.01),
+    Factor("length", "mm", 18, 30, (18, 24, 30), label="length", resolution=0.01),
+    Factor("width", "mm", 2, 7, (2, 4.5, 7), label="width", resolution=0.01),
+    Factor("height", "mm", 4, 14, (4, 9, 14), label="height", resolution=0.01),
     Factor("layer", "mm", 0.12, 0.2, (0.12, 0.16, 0.2), categorical=True, label="layer thickness"),
     Factor("raster", "deg", 0, 45, (0, 45), categorical=True, label="raster angle"),
 )
