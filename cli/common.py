@@ -267,6 +267,12 @@ FLAGS: tuple[Flag, ...] = (
         r"--package-path \1=DIR",
         "as ROS's package path would: package_paths={'arm': 'DIR'}",
     ),
+    # a quoted command line names the flags of the command it quotes, whichever command is running
+    Flag(
+        r"export_fmu of a Joint with axes=\['(\w+)'\]",
+        r"`designer export fmu ... --axis \1`",
+        "export the joint on axis theta: export_fmu of a Joint with axes=['theta']",
+    ),
     Flag(r"\bmax_cases=(\d+)", r"--max-cases \1", "or pass max_cases=2000000 if that many are meant"),
     Flag(r"\bpackage_paths\['([^']+)'\]=", r"--package-path \1=", "package_paths['arm']='x' is not a folder"),
 )
@@ -276,7 +282,8 @@ def flag_message(text: str, options: Collection[str] | None = None) -> str:
     """A library message with its Python argument names replaced by the CLI's flags; with `options`
     (the running command's), a flag the command lacks is never named (the flag's fallback instead)."""
     for f in FLAGS:
-        if options is None or set(re.findall(r"--[\w-]+", f.flag)) <= set(options):
+        quoted = f.flag.startswith("`designer ")
+        if options is None or quoted or set(re.findall(r"--[\w-]+", f.flag)) <= set(options):
             text = re.sub(f.pattern, f.flag, text)
         elif f.fallback is not None:
             text = re.sub(f.pattern, f.fallback, text)

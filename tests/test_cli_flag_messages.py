@@ -22,6 +22,8 @@ from designer_cli.common import FLAGS, flag_message
 from designer_cli.main import app, command_options
 
 FLAG = re.compile(r"(?<![\w-])--[a-z][\w-]*")
+#: a whole command line quoted in a message, e.g. `designer export fmu ... --axis theta`
+QUOTED = re.compile(r"`designer [^`]*`")
 
 
 def commands(cmd, path=()):
@@ -49,7 +51,11 @@ def test_each_translated_template_names_only_the_commands_own_flags(flag):
     for path, _ in COMMANDS:
         options = command_options(list(path))
         text = flag_message(flag.example, options)
-        wrong = set(FLAG.findall(text)) - options
+        for quoted in QUOTED.findall(text):  # a quoted command line: the flags of the command it quotes
+            words = quoted.split()
+            named = command_options(words[1 : words.index("...") if "..." in words else len(words)])
+            assert set(FLAG.findall(quoted)) <= named, f"{quoted!r} names flags its command lacks"
+        wrong = set(FLAG.findall(QUOTED.sub("", text))) - options
         assert not wrong, f"designer {' '.join(path)} would say {text!r}, naming {wrong} it lacks"
         offered |= set(FLAG.findall(text))
     assert offered, f"no command has the flag of {flag.pattern}: the entry is dead"

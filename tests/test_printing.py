@@ -196,7 +196,7 @@ def test_print_cli_design_and_bad_input(tmp_path, capsys):
     args = ["print", *SIX]
     code, text, err = run_inprocess([*args, "-o", out], capsys)
     assert code == 0, err
-    assert "P1: infill 60 %" in text and sorted(p.name for p in out.iterdir()) == [
+    assert "P1: density 60 %" in text and sorted(p.name for p in out.iterdir()) == [
         "P1.ini",
         "P1.stl",
         "plate.3mf",

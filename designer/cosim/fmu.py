@@ -118,9 +118,8 @@ class FmuDescription:
             want = missing[0]
             raise DesignerError(
                 f"FMU {path} has no axis {', '.join(missing)}",
-                f"it has: {', '.join(self.axes)}; export the joint on axis {want}: "
-                f"`designer export fmu ... --axis {want}`, or in Python export_fmu of a Joint built with "
-                f"axes=['{want}']",
+                f"it has: {', '.join(self.axes)}; export the joint on axis {want}: export_fmu of a Joint "
+                f"with axes=['{want}']",
             )
         self.version = 3 if md.fmiVersion.startswith("3") else 2
         self.refs = {v.name: v.valueReference for v in md.modelVariables}
