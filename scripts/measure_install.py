@@ -146,8 +146,9 @@ def compiler() -> dict:
 
 
 def suite_from_log(text: str) -> dict:
-    """pytest's own summary line of a .ci/run output: the counts and the minutes the tests took."""
-    m = re.findall(r"=+ (.*?) in ([\d.]+)s(?: \([\d:]+\))? =+", text)
+    """pytest's own summary line of a .ci/run output (or of `pytest -q`, which prints it without the
+    rule of equals signs): the counts and the minutes the tests took."""
+    m = re.findall(r"^(?:=+ )?(\d+ \w+.*?) in ([\d.]+)s(?: \([\d:]+\))?(?: =+)?$", text, re.MULTILINE)
     if not m:
         raise SystemExit("no pytest summary line ('... passed ... in N s') in the log")
     counts, seconds = m[-1]

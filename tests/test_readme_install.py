@@ -69,3 +69,7 @@ def test_suite_time_is_read_from_pytests_summary():
     assert _script().suite_from_log(log) == pytest.approx(
         {"tests_min": 563.2 / 60, "summary": "1347 passed, 12 skipped"}
     )
+    quiet = "....\n1797 passed, 1 skipped, 1 warning in 686.47s (0:11:26)\n"  # pytest -q: no rule
+    assert _script().suite_from_log(quiet) == pytest.approx(
+        {"tests_min": 686.47 / 60, "summary": "1797 passed, 1 skipped, 1 warning"}
+    )
