@@ -166,7 +166,7 @@ def printer_statement(surrogate: Surrogate) -> str:
             "printer: the study's own (one Ender 3, one spool of TPU); yours departs from it by a factor "
             "of its own: designer next states P with that unknown, designer calibrate learns it"
         )
-    n = len(surrogate.calibration["table"])
+    n = surrogate.calibration.n_runs
     if not n:
         return "printer: yours, not measured yet: P counts how it may depart from the study's printer"
     return f"printer: yours, the study calibrated on {n} run(s) of yours"

@@ -38,6 +38,7 @@ import numpy as np
 from ..errors import DesignerError, number_argument
 from ..study import space
 from . import mechanisms
+from .calibration_record import CalibrationRecord
 from .forms import as_printed
 from .prediction import Prediction, ResponseSurface
 
@@ -201,15 +202,25 @@ def fit_amplitude(base: ResponseSurface, X: Mapping[str, Any], y: np.ndarray, no
 
 def settings_of(prior: Study, response: str) -> tuple[float, float, float]:
     """(length, amplitude, noise) of `response`'s correction, computed once per study surface (the
-    design loop recalibrates many times)."""
+    design loop recalibrates many times), or as `keep_settings` gave them."""
     base = prior.models[response]
     if "_calibration_settings" not in base.__dict__:
-        X, y = study_runs(prior, response)
-        noise = noise_of(base)
-        length = fit_length(base, X, y, noise)
-        amplitude = fit_amplitude(base, X, y, noise)
-        base.__dict__["_calibration_settings"] = (length, amplitude, noise)
+        keep_settings(base, fit_settings(prior, response))
     return base.__dict__["_calibration_settings"]
+
+
+def fit_settings(prior: Study, response: str) -> tuple[float, float, float]:
+    """(length, amplitude, noise) of `response`'s correction, fitted to the study's runs."""
+    base = prior.models[response]
+    X, y = study_runs(prior, response)
+    noise = noise_of(base)
+    return fit_length(base, X, y, noise), fit_amplitude(base, X, y, noise), noise
+
+
+def keep_settings(base: ResponseSurface, settings: tuple[float, float, float]) -> None:
+    """Take `settings` as `base`'s (length, amplitude, noise): the shipped study surrogate's are
+    stored beside it (`designer.model.study_settings`), so no command fits them again."""
+    base.__dict__["_calibration_settings"] = tuple(settings)
 
 
 @dataclass
@@ -456,8 +467,6 @@ def calibrated(prior: S, runs: Any, printer_sd: float) -> S:
     """`calibrate`'s work once its arguments are checked: `prior` uncalibrated, `runs` the user's
     runs as columns (a DataFrame or a mapping of equal-length arrays, load_table's names; NaN where a
     response was not measured)."""
-    import pandas as pd
-
     wanted = [*space.FACTOR_NAMES, *prior.responses]  # other columns (a log's name, notes) are not data
     cols = {c: np.asarray(runs[c], dtype=float) for c in wanted if c in runs.keys()}
     if not cols or not len(cols[space.FACTOR_NAMES[0]]):
@@ -474,8 +483,7 @@ def calibrated(prior: S, runs: Any, printer_sd: float) -> S:
         settings = settings_of(prior, r)
         models[r] = CalibratedSurface.from_base(base, designs, observed, own, settings, printer_sd)
     keep = {c: cols[c] for c in [*space.FACTOR_NAMES, *(r for r in prior.responses if r in cols)]}
-    calibration = {"table": pd.DataFrame(keep), "columns": keep, "printer_sd": printer_sd}
-    return replace(prior, models=models, prior=prior, calibration=calibration)
+    return replace(prior, models=models, prior=prior, calibration=CalibrationRecord(keep, printer_sd))
 
 
 def check_printer_sd(printer_sd: Any) -> float:
