@@ -24,9 +24,10 @@ import traceback
 import warnings
 from typing import Annotated
 
-#: fit, predict and suggest do small dense algebra: OpenBLAS's thread pool costs more to start
-#: (~50 ms) than it saves; set before numpy loads, and only when the user has not chosen
-DESIGN_COMMANDS = ("fit", "predict", "suggest")
+#: fit, predict, suggest and the loop's calibrate and next do small dense algebra: OpenBLAS's thread
+#: pool costs more to start (~50 ms) than it saves; set before numpy loads, and only when the user has
+#: not chosen
+DESIGN_COMMANDS = ("fit", "predict", "suggest", "calibrate", "next")
 _DESIGN = sys.argv[1:2] != [] and sys.argv[1] in DESIGN_COMMANDS
 if _DESIGN:
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
@@ -56,7 +57,7 @@ SETTINGS = dict(
 )
 app = Typer(**SETTINGS)
 #: typer builds the click tree of every registered command on each call: a design command gets an
-#: app with only fit, predict and suggest (the help of `designer` itself still lists everything)
+#: app with only the design and loop commands (the help of `designer` itself still lists everything)
 design_app = Typer(**SETTINGS)
 
 
@@ -86,6 +87,7 @@ def _options(
 
 
 design.register(design_app)
+loop.register(design_app)
 design.register(app)
 loop.register(app)
 printing.register(app)
