@@ -40,6 +40,7 @@ from ..study import space
 from . import mechanisms
 from .calibration_record import CalibrationRecord
 from .forms import as_printed
+from .memo import array_key, memo_of
 from .prediction import Prediction, ResponseSurface
 
 
@@ -268,7 +269,18 @@ class CalibratedSurface(ResponseSurface):
         return surf
 
     def _prepare(self, base: ResponseSurface) -> None:
+        """The system solved at the runs. What depends on their designs only is kept on the study
+        surface (`designer.model.memo`: the loop recalibrates on the same designs with other
+        imagined values); only the weights of the measured values, alpha, are solved each time."""
         self._base = base
+        settings = (self.length, self.amplitude, self.noise, self.printer_sd, self.local_sd)
+        self._key = array_key(self.runs, self.own, settings)
+        mu0, self._Zu, self._sgu, self._Sb, self._Hu, self._Kinv, self._excess = memo_of(base, "_solved").get(
+            self._key, lambda: self._solve(base)
+        )
+        self._alpha = self._Kinv @ (np.log(self.observed) - mu0)
+
+    def _solve(self, base: ResponseSurface) -> tuple[np.ndarray, ...]:
         X = dict(zip(space.FACTOR_NAMES, self.runs.T, strict=True))
         mu0, s0 = _log_moments(base, X)
         self._Zu = coded(X)
@@ -281,9 +293,9 @@ class CalibratedSurface(ResponseSurface):
         R = _correlation(self._Zu, self._Zu, self.length)
         K = self._cross(R, self._sgu, self._Hu, self.own) + self.noise**2 * np.eye(len(mu0))
         self._Kinv = np.linalg.inv(K) if len(mu0) else np.zeros((0, 0))
-        self._alpha = self._Kinv @ (np.log(self.observed) - mu0)
         #: a run's prior variance as `log_moments` states it at its design, less its diagonal in K
         self._excess = self._prior_var(s0, self._Hu) - np.diag(K)
+        return mu0, self._Zu, self._sgu, self._Sb, self._Hu, self._Kinv, self._excess
 
     def _cross(self, R: np.ndarray, sa: np.ndarray, Ha: np.ndarray, ua: np.ndarray) -> np.ndarray:
         """Prior covariance of log y between designs a (rows) and the runs (columns), given their
@@ -318,6 +330,13 @@ class CalibratedSurface(ResponseSurface):
 
     def log_moments(self, X: Any) -> tuple[np.ndarray, np.ndarray]:
         """Calibrated predictive mean and scale of log y at designs X, arrays of shape (n,)."""
+        key = (self._key, array_key(*(X[n] for n in space.FACTOR_NAMES)))
+        mu0, C, s = memo_of(self._base, "_moments").get(key, lambda: self._moments(X))
+        return mu0 + C @ self._alpha, s
+
+    def _moments(self, X: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """What `log_moments` at X takes from the runs' designs: mu0, the covariance with the runs
+        C, and the scale."""
         mu0, s0 = _log_moments(self._base, X)
         Z = coded(X)
         sg = _local_sd(s0, self.noise)
@@ -327,7 +346,7 @@ class CalibratedSurface(ResponseSurface):
         H = mechanisms.basis(self._base, designs)
         C = self._cross(_correlation(Z, self._Zu, self.length), self.amplitude * sg, H, np.ones(len(Z)))
         var = self._prior_var(s0, H) - np.einsum("ij,jk,ik->i", C, self._Kinv, C)
-        return mu0 + C @ self._alpha, np.sqrt(np.maximum(var, self.noise**2))
+        return mu0, C, np.sqrt(np.maximum(var, self.noise**2))
 
     def predict(self, X: Any) -> Prediction:
         mu, s = self.log_moments(X)
