@@ -37,6 +37,7 @@ from .search import (
     reachable_range,
     search,
     search_box,
+    weighted,
 )
 from .targets import TOLERANCE, Target, make_target, probability_within
 
@@ -136,7 +137,7 @@ def suggest(
     )
     search_fixed = fixed | {"density": 100.0} if thin else fixed
     box = search_box(search_fixed, allow_extrapolation)
-    problem = Problem(surrogate, axis)
+    problem = Problem(surrogate, axis, weighted(targets, info))
     raw = search(problem, box, targets, info, search_fixed)
     ranked = rank(surrogate, axis, raw, targets, info, tolerance)
     judged = judged_targets(targets, info)
