@@ -22,7 +22,7 @@ from ..files import atomic_write
 from ..study import space
 from . import stored, study_settings
 from .calibration_record import CalibrationRecord
-from .correction import calibrated, check_printer_sd, runs_table
+from .correction import calibrated, check_printer_sd
 from .forms import as_printed, check_designs, check_varied
 from .prediction import Prediction, ResponseSurface
 from .ridge import ALPHAS
@@ -282,11 +282,11 @@ def _calibration_payload(surrogate: Surrogate) -> dict[str, Any]:
 
 def _recalibrate(prior: Surrogate, d: Any, path: Path) -> Surrogate:
     """Rebuild a saved calibrated surrogate: its study surfaces updated again by its saved runs."""
-    import pandas as pd
-
     try:
-        table = runs_table(pd.DataFrame(d["runs"], dtype=float), prior)
-        return calibrated(prior, table, check_printer_sd(float(d["printer_sd"])))
+        runs = stored.calibration_runs(d["runs"], prior.responses)
+        return calibrated(prior, runs, check_printer_sd(float(d["printer_sd"])))
+    except DesignerError as exc:
+        raise DesignerError(f"surrogate {path}: {exc.problem}", exc.fix) from None
     except (KeyError, TypeError, ValueError, OverflowError) as exc:
         raise DesignerError(
             f"the calibration block of {path} is incomplete ({exc})",
