@@ -17,19 +17,24 @@ def predictions(surrogate):
     return {r: (q.value, q.low, q.high) for r, q in p.items()}
 
 
-def test_the_same_designs_with_other_values_equal_a_fresh_calibration():
+def test_calibrations_through_the_store_equal_fresh_ones():
+    """The same designs with other values reuse the stored terms, other designs get their own; both
+    give exactly what a calibration with the stores emptied gives."""
     prior = new_printer(designer.Surrogate.load())
-    first = with_runs(prior, [ROW | {"k_x": 0.8, "c_x": 0.002}])
-    predictions(first)
-    again = with_runs(prior, [ROW | {"k_x": 1.6, "c_x": 0.004}])  # the designs' terms from the store
-    kept = predictions(again)
-    for base in prior.models.values():
+    first = predictions(with_runs(prior, [ROW | {"k_x": 0.8, "c_x": 0.002}]))
+    rows = {
+        "other values": [ROW | {"k_x": 1.6, "c_x": 0.004}],
+        "another design": [ROW | {"width": 3.0, "k_x": 0.8, "c_x": 0.002}],
+    }
+    kept = {name: predictions(with_runs(prior, r)) for name, r in rows.items()}
+    for base in prior.prior.models.values():  # the study surfaces, which keep the stores
         base.__dict__.pop("_solved", None), base.__dict__.pop("_moments", None)
-    fresh = predictions(with_runs(prior, [ROW | {"k_x": 1.6, "c_x": 0.004}]))
-    for r in fresh:
-        for got, want in zip(kept[r], fresh[r], strict=True):
-            np.testing.assert_array_equal(got, want)
-    assert not np.array_equal(predictions(first)["k_x"][0], kept["k_x"][0])  # the values count
+    for name, r in rows.items():
+        fresh = predictions(with_runs(prior, r))
+        for response in fresh:
+            for got, want in zip(kept[name][response], fresh[response], strict=True):
+                np.testing.assert_array_equal(got, want, err_msg=f"{name} {response}")
+        assert not np.array_equal(first["k_x"][0], fresh["k_x"][0]), name  # the run counts
 
 
 def test_the_store_keeps_within_its_budget():
@@ -52,3 +57,16 @@ def test_the_store_keeps_within_its_budget():
     for i in range(20):
         store.get(i, make(100))
     assert store.held <= store.budget and len(store.items) <= 16
+
+
+def test_a_copy_of_a_surface_carries_no_store():
+    import copy
+    import pickle
+
+    prior = new_printer(designer.Surrogate.load())
+    predictions(with_runs(prior, [ROW | {"k_x": 0.8, "c_x": 0.002}]))
+    base = prior.prior.models["k_x"]  # the study surface the calibrations are made from
+    assert base.__dict__["_solved"].items
+    for copied in (copy.deepcopy(base), pickle.loads(pickle.dumps(base.__dict__["_solved"]))):
+        store = copied.__dict__["_solved"] if not isinstance(copied, memo.Memo) else copied
+        assert isinstance(store, memo.Memo) and not store.items and store.held == 0

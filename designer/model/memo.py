@@ -26,6 +26,10 @@ class Memo:
         self.items: dict[Hashable, tuple[Any, ...]] = {}
         self.held = 0
 
+    def __reduce__(self) -> tuple[type, tuple[int]]:
+        """A copy (copy, deepcopy, pickle) starts empty: the store is a cache, not the surface's data."""
+        return Memo, (self.budget,)
+
     def get(self, key: Hashable, make: Callable[[], tuple[Any, ...]]) -> tuple[Any, ...]:
         """The result kept for `key`, else `make()` (kept when it fits)."""
         found = self.items.get(key)
