@@ -49,7 +49,7 @@ def test_new_printer_imports_neither_scipy_optimize_nor_pandas():
         "new_printer(designer.Surrogate.load());"
         "print(sorted(m for m in ('scipy.optimize', 'pandas') if m in sys.modules))"
     )
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    done = subprocess.run([sys.executable, "-I", "-c", code], capture_output=True, text=True, check=True)
     assert done.stdout.strip() == "[]"
 
 

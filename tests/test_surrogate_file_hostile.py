@@ -197,5 +197,5 @@ def test_a_calibrated_file_loads_without_pandas(tmp_path):
         f"import sys; from designer.model.surrogate import Surrogate; s = Surrogate.load({str(path)!r});"
         "print(s.calibration.n_runs, 'pandas' in sys.modules)"
     )
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    done = subprocess.run([sys.executable, "-I", "-c", code], capture_output=True, text=True, check=True)
     assert done.stdout.split() == ["2", "False"]
