@@ -151,15 +151,51 @@ def test_the_shipped_and_a_refitted_surrogate_still_load(tmp_path):
     assert 0 < p["k_x"].low < p["k_x"].value < p["k_x"].high
 
 
-def test_a_calibrated_surrogate_with_an_edited_run_is_refused(tmp_path, capsys):
+RUN_EDITS: dict[str, tuple[Callable[[dict], object], str]] = {
+    "a huge width": (lambda r: r["width"].__setitem__(0, 1e308), "width"),
+    "a null k": (lambda r: r["k_x"].__setitem__(0, None), "k_x[0]"),
+    "a text c": (lambda r: r["c_x"].__setitem__(0, "abc"), "c_x[0]"),
+    "a negative k": (lambda r: r["k_x"].__setitem__(0, -1.0), "k_x[0]"),
+    "an untested layer": (lambda r: r["layer"].__setitem__(0, 0.3), "layer"),
+    "a short column": (lambda r: r["height"].pop(), "height"),
+    "no raster": (lambda r: r.pop("raster"), "raster"),
+    "no run": (lambda r: [v.clear() for v in r.values()], "density"),
+    "no response": (lambda r: [r.pop("k_x"), r.pop("c_x")], "responses"),
+}
+
+
+@pytest.mark.parametrize("name", RUN_EDITS)
+def test_a_calibrated_surrogate_with_an_edited_run_is_refused(tmp_path, capsys, name):
+    """The saved runs are checked without pandas (`stored.calibration_runs`, issue 38) as strictly as
+    load_table checked them: each edit ends as exit 2 naming the column and the fix (a file with its
+    runs emptied loaded as the uncalibrated study before)."""
     runs = tmp_path / "runs.csv"
     runs.write_text("density,length,width,height,layer,raster,k_x,c_x\n60,24,4.5,9,0.16,0,0.8,0.002\n")
     out = tmp_path / "cal.json"
     code, _, err = run_inprocess(["calibrate", runs, "-o", out], capsys)
     assert code == 0, err
     d = json.loads(out.read_text())
-    d["calibration"]["runs"]["width"] = [1e308]
+    change, named = RUN_EDITS[name]
+    change(d["calibration"]["runs"])
     out.write_text(json.dumps(d))
     code, _, err = run_inprocess(["predict", *SIX, "--surrogate", out], capsys)
     assert_clean_failure(code, err, allowed=(2,))
-    assert "width" in err
+    assert named in err and "recalibrate it" in err, err
+
+
+def test_a_calibrated_file_loads_without_pandas(tmp_path):
+    """Its runs are read as arrays: next --surrogate imports no pandas (0.4 s, issue 38)."""
+    import subprocess
+    import sys
+
+    import designer
+
+    runs = designer.load_table().iloc[[0, 7]]
+    cal = designer.calibrate(Surrogate.load(), runs)
+    path = cal.save(tmp_path / "cal.json")
+    code = (
+        f"import sys; from designer.model.surrogate import Surrogate; s = Surrogate.load({str(path)!r});"
+        "print(s.calibration.n_runs, 'pandas' in sys.modules)"
+    )
+    done = subprocess.run([sys.executable, "-I", "-c", code], capture_output=True, text=True, check=True)
+    assert done.stdout.split() == ["2", "False"]

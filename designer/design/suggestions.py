@@ -37,6 +37,7 @@ from .search import (
     reachable_range,
     search,
     search_box,
+    weighted,
 )
 from .targets import TOLERANCE, Target, make_target, probability_within
 
@@ -136,7 +137,7 @@ def suggest(
     )
     search_fixed = fixed | {"density": 100.0} if thin else fixed
     box = search_box(search_fixed, allow_extrapolation)
-    problem = Problem(surrogate, axis)
+    problem = Problem(surrogate, axis, weighted(targets, info))
     raw = search(problem, box, targets, info, search_fixed)
     ranked = rank(surrogate, axis, raw, targets, info, tolerance)
     judged = judged_targets(targets, info)
@@ -166,7 +167,7 @@ def printer_statement(surrogate: Surrogate) -> str:
             "printer: the study's own (one Ender 3, one spool of TPU); yours departs from it by a factor "
             "of its own: designer next states P with that unknown, designer calibrate learns it"
         )
-    n = len(surrogate.calibration["table"])
+    n = surrogate.calibration.n_runs
     if not n:
         return "printer: yours, not measured yet: P counts how it may depart from the study's printer"
     return f"printer: yours, the study calibrated on {n} run(s) of yours"

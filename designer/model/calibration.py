@@ -16,6 +16,7 @@ from ..errors import DesignerError
 from ..files import format_bytes
 from ..study import space
 from . import plausibility
+from .calibration_record import CalibrationRecord
 from .correction import (
     PRINTER_SD,
     CalibratedSurface,
@@ -41,8 +42,6 @@ def new_printer(surrogate: Surrogate, *, printer_sd: float = PRINTER_SD) -> Surr
     the user's). What a user's first print should expect; `calibrate` with runs continues from it."""
     if surrogate.calibration is not None:
         return surrogate
-    import pandas as pd
-
     models = {
         r: CalibratedSurface.from_base(
             base,
@@ -58,7 +57,7 @@ def new_printer(surrogate: Surrogate, *, printer_sd: float = PRINTER_SD) -> Surr
         table_hash=surrogate.table_hash,
         training=surrogate.training,
         prior=surrogate,
-        calibration={"table": pd.DataFrame(columns), "columns": columns, "printer_sd": printer_sd},
+        calibration=CalibrationRecord(columns, printer_sd),
     )
 
 
@@ -95,7 +94,7 @@ def calibrate(
     prior = surrogate.prior if surrogate.calibration else surrogate
     table = runs_table(runs, prior)
     plausibility.check_measured(prior, table, accept_implausible=accept_implausible)
-    if prior is not surrogate and len(surrogate.calibration["table"]):
+    if prior is not surrogate and surrogate.calibration.n_runs:
         import pandas as pd
 
         table = pd.concat([surrogate.calibration["table"], table], ignore_index=True)
@@ -171,11 +170,10 @@ def report(surrogate: Surrogate) -> dict[str, Any]:
     """
     if surrogate.calibration is None:
         raise DesignerError("surrogate is not calibrated", "give the result of designer.calibrate(...)")
-    table = surrogate.calibration["table"]
     out: dict[str, Any] = {
         "surrogate_id": surrogate.id,
         "prior_id": surrogate.prior.id,
-        "n_runs": len(table),
+        "n_runs": surrogate.calibration.n_runs,
         "n_study_runs": len(surrogate.prior.training["run"]),
         "printer_sd": surrogate.calibration["printer_sd"],
         "responses": {},

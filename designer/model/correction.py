@@ -38,7 +38,9 @@ import numpy as np
 from ..errors import DesignerError, number_argument
 from ..study import space
 from . import mechanisms
+from .calibration_record import CalibrationRecord
 from .forms import as_printed
+from .memo import array_key, memo_of
 from .prediction import Prediction, ResponseSurface
 
 
@@ -201,15 +203,25 @@ def fit_amplitude(base: ResponseSurface, X: Mapping[str, Any], y: np.ndarray, no
 
 def settings_of(prior: Study, response: str) -> tuple[float, float, float]:
     """(length, amplitude, noise) of `response`'s correction, computed once per study surface (the
-    design loop recalibrates many times)."""
+    design loop recalibrates many times), or as `keep_settings` gave them."""
     base = prior.models[response]
     if "_calibration_settings" not in base.__dict__:
-        X, y = study_runs(prior, response)
-        noise = noise_of(base)
-        length = fit_length(base, X, y, noise)
-        amplitude = fit_amplitude(base, X, y, noise)
-        base.__dict__["_calibration_settings"] = (length, amplitude, noise)
+        keep_settings(base, fit_settings(prior, response))
     return base.__dict__["_calibration_settings"]
+
+
+def fit_settings(prior: Study, response: str) -> tuple[float, float, float]:
+    """(length, amplitude, noise) of `response`'s correction, fitted to the study's runs."""
+    base = prior.models[response]
+    X, y = study_runs(prior, response)
+    noise = noise_of(base)
+    return fit_length(base, X, y, noise), fit_amplitude(base, X, y, noise), noise
+
+
+def keep_settings(base: ResponseSurface, settings: tuple[float, float, float]) -> None:
+    """Take `settings` as `base`'s (length, amplitude, noise): the shipped study surrogate's are
+    stored beside it (`designer.model.study_settings`), so no command fits them again."""
+    base.__dict__["_calibration_settings"] = tuple(settings)
 
 
 @dataclass
@@ -257,7 +269,18 @@ class CalibratedSurface(ResponseSurface):
         return surf
 
     def _prepare(self, base: ResponseSurface) -> None:
+        """The system solved at the runs. What depends on their designs only is kept on the study
+        surface (`designer.model.memo`: the loop recalibrates on the same designs with other
+        imagined values); only the weights of the measured values, alpha, are solved each time."""
         self._base = base
+        settings = (self.length, self.amplitude, self.noise, self.printer_sd, self.local_sd)
+        self._key = array_key(self.runs, self.own, settings)
+        mu0, self._Zu, self._sgu, self._Sb, self._Hu, self._Kinv, self._excess = memo_of(base, "_solved").get(
+            self._key, lambda: self._solve(base)
+        )
+        self._alpha = self._Kinv @ (np.log(self.observed) - mu0)
+
+    def _solve(self, base: ResponseSurface) -> tuple[np.ndarray, ...]:
         X = dict(zip(space.FACTOR_NAMES, self.runs.T, strict=True))
         mu0, s0 = _log_moments(base, X)
         self._Zu = coded(X)
@@ -270,9 +293,9 @@ class CalibratedSurface(ResponseSurface):
         R = _correlation(self._Zu, self._Zu, self.length)
         K = self._cross(R, self._sgu, self._Hu, self.own) + self.noise**2 * np.eye(len(mu0))
         self._Kinv = np.linalg.inv(K) if len(mu0) else np.zeros((0, 0))
-        self._alpha = self._Kinv @ (np.log(self.observed) - mu0)
         #: a run's prior variance as `log_moments` states it at its design, less its diagonal in K
         self._excess = self._prior_var(s0, self._Hu) - np.diag(K)
+        return mu0, self._Zu, self._sgu, self._Sb, self._Hu, self._Kinv, self._excess
 
     def _cross(self, R: np.ndarray, sa: np.ndarray, Ha: np.ndarray, ua: np.ndarray) -> np.ndarray:
         """Prior covariance of log y between designs a (rows) and the runs (columns), given their
@@ -307,6 +330,13 @@ class CalibratedSurface(ResponseSurface):
 
     def log_moments(self, X: Any) -> tuple[np.ndarray, np.ndarray]:
         """Calibrated predictive mean and scale of log y at designs X, arrays of shape (n,)."""
+        key = (self._key, array_key(*(X[n] for n in space.FACTOR_NAMES)))
+        mu0, C, s = memo_of(self._base, "_moments").get(key, lambda: self._moments(X))
+        return mu0 + C @ self._alpha, s
+
+    def _moments(self, X: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """What `log_moments` at X takes from the runs' designs: mu0, the covariance with the runs
+        C, and the scale."""
         mu0, s0 = _log_moments(self._base, X)
         Z = coded(X)
         sg = _local_sd(s0, self.noise)
@@ -316,7 +346,7 @@ class CalibratedSurface(ResponseSurface):
         H = mechanisms.basis(self._base, designs)
         C = self._cross(_correlation(Z, self._Zu, self.length), self.amplitude * sg, H, np.ones(len(Z)))
         var = self._prior_var(s0, H) - np.einsum("ij,jk,ik->i", C, self._Kinv, C)
-        return mu0 + C @ self._alpha, np.sqrt(np.maximum(var, self.noise**2))
+        return mu0, C, np.sqrt(np.maximum(var, self.noise**2))
 
     def predict(self, X: Any) -> Prediction:
         mu, s = self.log_moments(X)
@@ -456,8 +486,6 @@ def calibrated(prior: S, runs: Any, printer_sd: float) -> S:
     """`calibrate`'s work once its arguments are checked: `prior` uncalibrated, `runs` the user's
     runs as columns (a DataFrame or a mapping of equal-length arrays, load_table's names; NaN where a
     response was not measured)."""
-    import pandas as pd
-
     wanted = [*space.FACTOR_NAMES, *prior.responses]  # other columns (a log's name, notes) are not data
     cols = {c: np.asarray(runs[c], dtype=float) for c in wanted if c in runs.keys()}
     if not cols or not len(cols[space.FACTOR_NAMES[0]]):
@@ -474,8 +502,7 @@ def calibrated(prior: S, runs: Any, printer_sd: float) -> S:
         settings = settings_of(prior, r)
         models[r] = CalibratedSurface.from_base(base, designs, observed, own, settings, printer_sd)
     keep = {c: cols[c] for c in [*space.FACTOR_NAMES, *(r for r in prior.responses if r in cols)]}
-    calibration = {"table": pd.DataFrame(keep), "columns": keep, "printer_sd": printer_sd}
-    return replace(prior, models=models, prior=prior, calibration=calibration)
+    return replace(prior, models=models, prior=prior, calibration=CalibrationRecord(keep, printer_sd))
 
 
 def check_printer_sd(printer_sd: Any) -> float:

@@ -202,3 +202,44 @@ def check_predictions(surface: Any, training: Mapping[str, list[float]]) -> None
             f"predict {value[i]:.3g} [{low[i]:.3g}, {high[i]:.3g}] {surface.unit} at training run {i + 1}, "
             f"whose runs span {surface.observed_range[0]:g} to {surface.observed_range[1]:g}",
         )
+
+
+def calibration_runs(runs: Any, responses: list[str]) -> dict[str, np.ndarray]:
+    """A calibrated file's user runs (its "calibration" block's "runs"), checked as `load_table`
+    checks a runs table's values, without pandas (the loop's commands read them on every call):
+    the six factors and the surrogate's responses it holds, equal-length lists of at least one
+    finite number, every factor printable (`space.check_value`, tested levels for layer and raster),
+    k above 0 and c not negative. Returns float arrays by column.
+
+    Raises:
+        DesignerError: naming the column and run, with the fix (recalibrate).
+    """
+    try:
+        return _checked_runs(mapping(runs, "calibration runs"), responses)
+    except DesignerError as exc:
+        raise DesignerError(exc.problem, "recalibrate it with designer calibrate") from None
+
+
+def _checked_runs(runs: Mapping[str, Any], responses: list[str]) -> dict[str, np.ndarray]:
+    measured = [r for r in responses if r in runs]
+    if not measured:
+        raise bad("calibration runs", f"hold none of the responses {', '.join(responses)}")
+    out: dict[str, np.ndarray] = {}
+    for name in [*space.FACTOR_NAMES, *measured]:
+        column = runs.get(name)
+        n = len(out[space.FACTOR_NAMES[0]]) if out else None
+        if column is None:
+            raise bad("calibration runs", f"have no column '{name}'")
+        if not isinstance(column, list) or not column or len(column) != (n or len(column)):
+            raise bad(f"calibration runs {name}", f"is not a list of {n or 'the'} runs' values")
+        low, strict = (0.0, name.startswith("k_")) if name in measured else (-math.inf, False)
+        where = f"calibration runs {name}"
+        out[name] = np.array(
+            [number(v, f"{where}[{i}]", low=low, strict=strict) for i, v in enumerate(column)]
+        )
+        for i, v in enumerate(out[name] if name in space.FACTOR_NAMES else []):
+            try:
+                space.check_value(name, v, allow_extrapolation=True)
+            except DesignerError as exc:
+                raise bad(f"calibration run {i + 1}:", exc.problem) from None
+    return out

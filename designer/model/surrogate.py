@@ -20,8 +20,9 @@ from .. import units
 from ..errors import DesignerError, check_type, names_argument, path_argument
 from ..files import atomic_write
 from ..study import space
-from . import stored
-from .correction import calibrated, check_printer_sd, runs_table
+from . import stored, study_settings
+from .calibration_record import CalibrationRecord
+from .correction import calibrated, check_printer_sd
 from .forms import as_printed, check_designs, check_varied
 from .prediction import Prediction, ResponseSurface
 from .ridge import ALPHAS
@@ -41,8 +42,8 @@ class Surrogate:
     training: dict[str, list[float]] = field(default_factory=dict)
     #: the study surrogate a calibrated one was updated from (`designer.calibrate`), else None
     prior: Surrogate | None = None
-    #: a calibrated surrogate's user runs ("table", a DataFrame) and settings, else None
-    calibration: dict[str, Any] | None = None
+    #: a calibrated surrogate's user runs and settings (`designer.model.calibration_record`), else None
+    calibration: CalibrationRecord | None = None
 
     @property
     def responses(self) -> list[str]:
@@ -241,6 +242,7 @@ class Surrogate:
             surrogate = cls.from_payload(d)
         except DesignerError as exc:
             raise DesignerError(f"surrogate {p}: {exc.problem}", stored.FIX) from None
+        study_settings.attach(surrogate)  # the shipped study's calibration settings, not fitted again
         if "calibration" not in d:
             return surrogate
         return _recalibrate(surrogate, d["calibration"], p)
@@ -270,22 +272,21 @@ class Surrogate:
 def _calibration_payload(surrogate: Surrogate) -> dict[str, Any]:
     """A calibrated surrogate's user runs and settings, as saved beside the study's surfaces."""
     cal = surrogate.calibration or {}
-    table = cal["table"]
     settings = {r: m.settings() for r, m in surrogate.models.items() if hasattr(m, "settings")}
     return {
         "printer_sd": cal["printer_sd"],
-        "runs": {c: [None if v != v else float(v) for v in table[c]] for c in table.columns},
+        "runs": {c: [None if v != v else float(v) for v in column] for c, column in cal["columns"].items()},
         "settings": settings,
     }
 
 
 def _recalibrate(prior: Surrogate, d: Any, path: Path) -> Surrogate:
     """Rebuild a saved calibrated surrogate: its study surfaces updated again by its saved runs."""
-    import pandas as pd
-
     try:
-        table = runs_table(pd.DataFrame(d["runs"], dtype=float), prior)
-        return calibrated(prior, table, check_printer_sd(float(d["printer_sd"])))
+        runs = stored.calibration_runs(d["runs"], prior.responses)
+        return calibrated(prior, runs, check_printer_sd(float(d["printer_sd"])))
+    except DesignerError as exc:
+        raise DesignerError(f"surrogate {path}: {exc.problem}", exc.fix) from None
     except (KeyError, TypeError, ValueError, OverflowError) as exc:
         raise DesignerError(
             f"the calibration block of {path} is incomplete ({exc})",
