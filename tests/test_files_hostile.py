@@ -264,9 +264,10 @@ def small_disk(tmp_path):
 
 
 def _fill(folder: Path, leave: int) -> None:
-    """Fill the disk of `folder` until `leave` bytes are free."""
+    """Fill the disk of `folder` until `leave` bytes are free (appending to `filler` if it exists: a
+    test racing a writer creates it first, as creating a file on a full tmpfs fails too)."""
     free = shutil.disk_usage(folder).free - leave
-    with open(folder / "filler", "wb") as fh:
+    with open(folder / "filler", "ab") as fh:
         try:
             while free > 0:
                 n = min(free, 1 << 20)
@@ -297,6 +298,7 @@ def test_disk_filling_up_while_a_log_is_written_keeps_the_previous_log(small_dis
     args = ["rig", "simulate", "--k", "0.8", "--c", "2e-3", "--duration", "120", *SIX, "-o", "log.csv"]
     previous = b"t,x,Fx\n0,0,0\n"
     (small_disk / "log.csv").write_bytes(previous)
+    (small_disk / "filler").touch()  # the other program's file exists before the race
     proc = _start(args, small_disk)
     deadline = time.monotonic() + 120
     while not [p for p in small_disk.iterdir() if p.name.startswith(".log.csv.")]:
