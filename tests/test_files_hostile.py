@@ -264,16 +264,14 @@ def small_disk(tmp_path):
 
 
 def _fill(folder: Path, leave: int) -> None:
-    """Fill the disk of `folder` until `leave` bytes are free (appending to `filler` if it exists: a
-    test racing a writer creates it first, as creating a file on a full tmpfs fails too)."""
+    """Fill the disk of `folder` until `leave` bytes are free."""
     free = shutil.disk_usage(folder).free - leave
-    with open(folder / "filler", "ab") as fh:
+    # unbuffered: a write the full disk refuses leaves nothing for close() to flush again (a buffered
+    # file raised ENOSPC a second time from close when a writer beside us had taken the rest first)
+    with open(folder / "filler", "wb", buffering=0) as fh:
         try:
             while free > 0:
-                n = min(free, 1 << 20)
-                fh.write(bytes(n))
-                fh.flush()
-                free -= n
+                free -= fh.write(bytes(min(free, 1 << 20)))
         except OSError as exc:  # a writer beside us took the rest: full all the same
             assert exc.errno == errno.ENOSPC
 
@@ -298,7 +296,6 @@ def test_disk_filling_up_while_a_log_is_written_keeps_the_previous_log(small_dis
     args = ["rig", "simulate", "--k", "0.8", "--c", "2e-3", "--duration", "120", *SIX, "-o", "log.csv"]
     previous = b"t,x,Fx\n0,0,0\n"
     (small_disk / "log.csv").write_bytes(previous)
-    (small_disk / "filler").touch()  # the other program's file exists before the race
     proc = _start(args, small_disk)
     deadline = time.monotonic() + 120
     while not [p for p in small_disk.iterdir() if p.name.startswith(".log.csv.")]:
