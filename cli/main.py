@@ -38,7 +38,7 @@ import typer  # noqa: E402
 
 from designer.errors import DesignerError  # noqa: E402
 
-from . import common, cosim, design, export, loop, plots, printing, rig, sweep  # noqa: E402
+from . import common, design, loop  # noqa: E402
 from .common import Typer, flag_message  # noqa: E402
 
 try:  # typer 0.28 vendors click
@@ -57,9 +57,9 @@ SETTINGS = dict(
     add_completion=False,
     rich_markup_mode="rich",
 )
-app = Typer(**SETTINGS)
 #: typer builds the click tree of every registered command on each call: a design command gets an
-#: app with only the design and loop commands (the help of `designer` itself still lists everything)
+#: app with only the design and loop commands (the help of `designer` itself still lists everything),
+#: and the other commands' modules (and the library modules they import) are not loaded for it
 design_app = Typer(**SETTINGS)
 
 
@@ -72,7 +72,6 @@ def _version(value: bool) -> None:
 
 
 @design_app.callback()
-@app.callback()
 def _options(
     version: Annotated[
         bool, typer.Option("--version", callback=_version, is_eager=True, help="print the version and exit")
@@ -90,14 +89,27 @@ def _options(
 
 design.register(design_app)
 loop.register(design_app)
-design.register(app)
-loop.register(app)
-printing.register(app)
-rig.register(app)
-export.register(app)
-cosim.register(app)
-plots.register(app)
-sweep.register(app)
+_FULL: list[Typer] = []
+
+
+def full_app() -> Typer:
+    """The app with every command (built once, on first use): the design commands run on `design_app`."""
+    if not _FULL:
+        from . import cosim, export, plots, printing, rig, sweep
+
+        app = Typer(**SETTINGS)
+        app.callback()(_options)
+        for module in (design, loop, printing, rig, export, cosim, plots, sweep):
+            module.register(app)
+        _FULL.append(app)
+    return _FULL[0]
+
+
+def __getattr__(name: str) -> Typer:
+    """`designer_cli.main.app`, the app with every command, built when first asked for."""
+    if name == "app":
+        return full_app()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 class Stopped(BaseException):
@@ -243,7 +255,7 @@ def _run(args: list[str], debug: bool) -> int:
     try:
         _check_tmpdir()
         _check_address_space(args)
-        chosen = design_app if args[:1] and args[0] in DESIGN_COMMANDS else app
+        chosen = design_app if args[:1] and args[0] in DESIGN_COMMANDS else full_app()
         code = chosen(args=args, prog_name="designer", standalone_mode=False)
         if RECEIVED or code == 130:
             return _swallowed()
@@ -284,7 +296,7 @@ def _run(args: list[str], debug: bool) -> int:
 def command_options(args: list[str]) -> set[str]:
     """The option names (e.g. --fix) of the command the command line `args` invokes, with those of
     `designer` itself: a message must not offer a flag the command lacks."""
-    cmd = typer.main.get_command(design_app if args[:1] and args[0] in DESIGN_COMMANDS else app)
+    cmd = typer.main.get_command(design_app if args[:1] and args[0] in DESIGN_COMMANDS else full_app())
     names = {o for p in cmd.params for o in (*p.opts, *p.secondary_opts)}
     for token in args:
         commands = getattr(cmd, "commands", None)

@@ -39,7 +39,7 @@ from .search import (
     search_box,
     weighted,
 )
-from .targets import TOLERANCE, Target, make_target, probability_within
+from .targets import TOLERANCE, Target, make_target, prefetch_t_distribution, probability_within
 
 N_NEAREST_RUNS = 3
 
@@ -117,6 +117,7 @@ def suggest(
     """
     surrogate = with_axis(surrogate, axis)  # a rotational goal through the PRB relation
     check_request(surrogate, axis, k is None and c is None, top, tolerance)
+    prefetch_t_distribution()  # P's t distribution loads while IPOPT searches
     for name, value in (("fixed", fixed), ("importance", importance), ("bounds", bounds), ("weight", weight)):
         if value is not None:
             fix = f"give {name} as a dict, e.g. {name}={MAPPING_EXAMPLES[name]}"

@@ -7,6 +7,8 @@ response a goal with Derringer-Suich desirability bounds, weight and importance.
 from __future__ import annotations
 
 import math
+import sys
+import threading
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,6 +24,33 @@ TOLERANCE = 0.10
 #: weight of the (normalised) squared PI width in the objective: a tie-breaker only
 #: which way each kind of goal prefers a response to go
 SENSE = {"target": 0.0, "min": -1.0, "max": 1.0}
+#: the thread importing the t distribution's module ahead of its first use (`prefetch_t_distribution`)
+_PREFETCH: list[threading.Thread] = []
+
+
+def prefetch_t_distribution() -> None:
+    """Start importing scipy's `special` (the t distribution of P) in a background thread, once.
+
+    Its import is about 0.15-0.2 s of Python (its array-API layer clones numpy's namespace, which
+    loads numpy's f2py, testing and ma; it rewrites its functions' docstrings), about as long as
+    `import casadi` itself, while P is needed only after IPOPT has searched. CasADi releases the
+    interpreter lock while it builds and runs IPOPT, so on a second core the import is done by the
+    time `probability_between` asks for it (Python's import lock makes that call wait for the
+    thread otherwise). The same functions are imported: P does not change. Not a daemon thread: the
+    interpreter's exit waits for the import rather than stopping it halfway.
+    """
+    if "scipy.special" in sys.modules or _PREFETCH:
+        return
+    thread = threading.Thread(target=_import_t_distribution, name="prefetch scipy.special")
+    _PREFETCH.append(thread)
+    thread.start()
+
+
+def _import_t_distribution() -> None:
+    try:
+        import scipy.special  # noqa: F401
+    except Exception:  # noqa: BLE001 - the caller's own import raises it where it is needed
+        pass
 
 
 def probability_within(

@@ -137,6 +137,26 @@ def check_designs(designs: Any, allow_extrapolation: bool) -> dict[str, np.ndarr
     if len({len(v) for v in X.values()}) != 1:
         raise DesignerError("the factor columns of designs differ in length", "give one value per design")
     for n, v in X.items():
-        for value in v:
-            space.check_value(n, float(value), allow_extrapolation)
+        if not _all_valid(space.BY_NAME[n], v, allow_extrapolation):  # find and name the first bad one
+            for value in v:
+                space.check_value(n, float(value), allow_extrapolation)
     return X
+
+
+def _all_valid(f: space.Factor, v: np.ndarray, allow_extrapolation: bool) -> bool:
+    """Whether `space.check_value` accepts every value of `v`, by its own comparisons on the whole
+    column at once (the loop's hundreds of predictions checked each value in Python: 10 000 calls
+    of `next`); False sends the column through `check_value`, which raises on the first bad one."""
+    if not np.all(np.isfinite(v)):
+        return False
+    if f.categorical:  # math.isclose(v, level, rel_tol=1e-9, abs_tol=1e-9) for some level
+        close = [
+            np.abs(v - level) <= np.maximum(1e-9 * np.maximum(np.abs(v), abs(level)), 1e-9)
+            for level in f.levels
+        ]
+        return bool(np.all(np.logical_or.reduce(close)))
+    lo, hi = space.printable_limits(f)
+    ok = (v >= lo - 1e-9) & (v <= hi + 1e-9)
+    if not allow_extrapolation:
+        ok &= (v >= f.low - 1e-9) & (v <= f.high + 1e-9)
+    return bool(np.all(ok))
