@@ -78,6 +78,15 @@ def predictability(surrogate: Surrogate, axis: str) -> dict[str, dict[str, Any]]
     return out
 
 
+def distinct(ranked: list[Candidate], top: int, spans: Mapping[str, float]) -> list[Candidate]:
+    """The first `top` of `ranked` lying more than DISTINCT apart (distances scaled by `spans`)."""
+    picked: list[Candidate] = []
+    for cand in ranked:
+        if len(picked) < top and all(distance(cand.params, o.params, spans) > DISTINCT for o in picked):
+            picked.append(cand)
+    return picked
+
+
 def suggest(
     surrogate: Surrogate,
     *,
@@ -146,11 +155,9 @@ def suggest(
         near = grid_nearest(surrogate, axis, box, targets, judged, search_fixed)
         raw += near + polish(problem, box, targets, info, near, search_fixed)
         ranked = rank(surrogate, axis, raw, targets, info, tolerance)
-    spans = {f.name: float(s) for f, s in zip(space.CONTINUOUS, box.spans, strict=True)}
-    picked: list[Candidate] = []
-    for cand in ranked:
-        if len(picked) < top and all(distance(cand.params, o.params, spans) > DISTINCT for o in picked):
-            picked.append(cand)
+    picked = distinct(
+        ranked, top, {f.name: float(s) for f, s in zip(space.CONTINUOUS, box.spans, strict=True)}
+    )
     sug = Suggestion(axis, targets, picked, True, [], info, surrogate.id, fixed, tolerance)
     assess(sug, surrogate, problem, box, ranked)
     if len(picked) < top:
