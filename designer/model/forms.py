@@ -136,6 +136,8 @@ def check_designs(designs: Any, allow_extrapolation: bool) -> dict[str, np.ndarr
         raise DesignerError(f"designs hold a value that is not a number ({exc})", "give numbers") from None
     if len({len(v) for v in X.values()}) != 1:
         raise DesignerError("the factor columns of designs differ in length", "give one value per design")
+    if _block_valid(X, allow_extrapolation):
+        return X
     for n, v in X.items():
         if not _all_valid(space.BY_NAME[n], v, allow_extrapolation):  # find and name the first bad one
             for value in v:
@@ -143,20 +145,54 @@ def check_designs(designs: Any, allow_extrapolation: bool) -> dict[str, np.ndarr
     return X
 
 
-def _all_valid(f: space.Factor, v: np.ndarray, allow_extrapolation: bool) -> bool:
-    """Whether `space.check_value` accepts every value of `v`, by its own comparisons on the whole
-    column at once (the loop's hundreds of predictions checked each value in Python: 10 000 calls
-    of `next`); False sends the column through `check_value`, which raises on the first bad one."""
-    if not np.all(np.isfinite(v)):
+def _bounds(allow_extrapolation: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Per continuous factor (rows, CONTINUOUS order) the lowest and highest value `space.check_value`
+    accepts, as columns: its thresholds (bound -+ 1e-9), the printable limits and, unless
+    extrapolating, the tested range (a value passes both bounds exactly when it passes the tighter)."""
+    lows, highs = [], []
+    for f in space.CONTINUOUS:
+        lo, hi = space.printable_limits(f)
+        lows.append([lo - 1e-9] + ([] if allow_extrapolation else [f.low - 1e-9]))
+        highs.append([hi + 1e-9] + ([] if allow_extrapolation else [f.high + 1e-9]))
+    return np.array([max(v) for v in lows])[:, None], np.array([min(v) for v in highs])[:, None]
+
+
+#: `_bounds` for allow_extrapolation False and True
+BOUNDS = {flag: _bounds(flag) for flag in (False, True)}
+#: each categorical factor's levels as a column
+LEVELS = {f.name: np.array(f.levels, dtype=float)[:, None] for f in space.CATEGORICAL}
+
+
+def _in_bounds(block: np.ndarray, lows: np.ndarray, highs: np.ndarray) -> bool:
+    """Whether every value of `block` (factors x designs) is finite and within its row's bounds."""
+    return bool(np.isfinite(block).all() and (block >= lows).all() and (block <= highs).all())
+
+
+def _at_levels(v: np.ndarray, levels: np.ndarray) -> bool:
+    """Whether every value of `v` is finite and a level: math.isclose(v, level, rel_tol=1e-9,
+    abs_tol=1e-9), as `space.check_value` asks, for some level of the column `levels`."""
+    if not np.isfinite(v).all():
         return False
-    if f.categorical:  # math.isclose(v, level, rel_tol=1e-9, abs_tol=1e-9) for some level
-        close = [
-            np.abs(v - level) <= np.maximum(1e-9 * np.maximum(np.abs(v), abs(level)), 1e-9)
-            for level in f.levels
-        ]
-        return bool(np.all(np.logical_or.reduce(close)))
-    lo, hi = space.printable_limits(f)
-    ok = (v >= lo - 1e-9) & (v <= hi + 1e-9)
-    if not allow_extrapolation:
-        ok &= (v >= f.low - 1e-9) & (v <= f.high + 1e-9)
-    return bool(np.all(ok))
+    close = np.abs(v - levels) <= np.maximum(1e-9 * np.maximum(np.abs(v), np.abs(levels)), 1e-9)
+    return bool(close.any(axis=0).all())
+
+
+def _block_valid(X: Mapping[str, np.ndarray], allow_extrapolation: bool) -> bool:
+    """Whether `space.check_value` accepts every value of X, by its own comparisons on whole blocks:
+    the continuous factors at once, each categorical factor's levels at once (the loop predicts
+    hundreds of times: `next` checked 10 440 values one by one, then 6 columns a call at 55 us)."""
+    cont = np.array([X[n] for n in CONTINUOUS_NAMES])
+    if cont.ndim != 2 or not _in_bounds(cont, *BOUNDS[bool(allow_extrapolation)]):
+        return False
+    return all(_at_levels(X[name], levels) for name, levels in LEVELS.items())
+
+
+def _all_valid(f: space.Factor, v: np.ndarray, allow_extrapolation: bool) -> bool:
+    """Whether `space.check_value` accepts every value of one factor's column `v`; False sends the
+    column through `check_value`, which raises on the first bad one."""
+    v = v.reshape(1, -1)
+    if f.categorical:
+        return _at_levels(v, LEVELS[f.name])
+    i = CONTINUOUS_NAMES.index(f.name)
+    lows, highs = BOUNDS[bool(allow_extrapolation)]
+    return _in_bounds(v, lows[i : i + 1], highs[i : i + 1])
