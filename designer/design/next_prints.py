@@ -142,15 +142,20 @@ def _run(design: Mapping[str, float], values: Mapping[str, float]) -> dict[str, 
 
 
 def _expected_best(
-    surrogate: Surrogate, scorer: _Scorer, design: dict[str, float], known: list[dict[str, float]], pool: Any
+    surrogate: Surrogate,
+    scorer: _Scorer,
+    design: dict[str, float],
+    known: list[dict[str, float]],
+    base: Surrogate,
+    pool: Any,
 ) -> float:
     """Chance of holding a joint that lands after printing `design` and then the best recommendation
-    (after the `known`, fantasised, runs): P(design lands) + P(it misses) E[best P | it missed].
+    (after the `known`, fantasised, runs; `base` is `surrogate` calibrated on them, shared by every
+    candidate of a step): P(design lands) + P(it misses) E[best P | it missed].
 
     The measurement is integrated by Gauss-Hermite quadrature in log space; the nodes where the
     print lands are left out of the second term's average (renormalised over the missing nodes).
     """
-    base = with_runs(surrogate, known)
     p_lands = scorer.best(base, {n: np.array([design[n]]) for n in space.FACTOR_NAMES})
     nodes, weights = np.polynomial.hermite_e.hermegauss(NODES)
     weights = weights / weights.sum()
@@ -170,8 +175,10 @@ def _expected_best(
 
 def _batch_p(surrogate: Surrogate, scorer: _Scorer, designs: list[dict[str, float]], pool: Any) -> float:
     """Expected best P once every design of the batch is measured: joint draws, each conditioned on
-    the draws before it (seeded, so the answer is repeatable)."""
+    the draws before it (seeded, so the answer is repeatable). The first design has no draw before
+    it: its predictive distribution is the same in every draw, computed once."""
     rng = np.random.default_rng(20261125)
+    first = {r: _log_predictive(surrogate, r, designs[0]) for r in scorer.measured} if designs else {}
     total = 0.0
     for _ in range(DRAWS):
         runs: list[dict[str, float]] = []
@@ -179,7 +186,7 @@ def _batch_p(surrogate: Surrogate, scorer: _Scorer, designs: list[dict[str, floa
             current = with_runs(surrogate, runs)
             values = {}
             for r in scorer.measured:
-                mu, s = _log_predictive(current, r, d)
+                mu, s = _log_predictive(current, r, d) if runs else first[r]
                 values[r] = float(np.exp(mu + s * rng.standard_normal()))
             runs.append(_run(d, values))
         total += scorer.best(with_runs(surrogate, runs), pool)
@@ -256,8 +263,9 @@ def _greedy_batch(
     for step in range(n):
         if progress is not None:
             progress(step / (n + 1))
+        base = with_runs(surrogate, known)
         if step == 0:
-            pick, score = best, _expected_best(surrogate, scorer, best.params, known, pool)
+            pick, score = best, _expected_best(surrogate, scorer, best.params, known, base, pool)
             reason = "the current recommendation, the design most likely to land now; measuring it tests it"
         else:
             free = [
@@ -265,12 +273,11 @@ def _greedy_batch(
             ]
             if not free:
                 break
-            scores = [_expected_best(surrogate, scorer, c.params, known, pool) for c in free]
+            scores = [_expected_best(surrogate, scorer, c.params, known, base, pool) for c in free]
             i = int(np.argmax(scores))
             pick, score = free[i], scores[i]
             reason = "tests the model where another near-target design may do better than the current one"
         chosen.append(NextPrint(pick.params, pick.predicted, float(score), pick is best, reason))
-        base = with_runs(surrogate, known)
         predicted = {r: float(np.exp(_log_predictive(base, r, pick.params)[0])) for r in scorer.measured}
         known.append(_run(pick.params, predicted))
     return chosen
