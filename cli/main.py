@@ -57,9 +57,9 @@ SETTINGS = dict(
     add_completion=False,
     rich_markup_mode="rich",
 )
-#: typer builds the click tree of every registered command on each call: a design command gets an
-#: app with only the design and loop commands (the help of `designer` itself still lists everything),
-#: and the other commands' modules (and the library modules they import) are not loaded for it
+#: the design and loop commands: a design command runs on an app of its own (`command_app`; the help
+#: of `designer` itself still lists everything), and the other commands' modules (and the library
+#: modules they import) are not loaded for it
 design_app = Typer(**SETTINGS)
 
 
@@ -92,8 +92,25 @@ loop.register(design_app)
 _FULL: list[Typer] = []
 
 
+def command_app(name: str) -> Typer:
+    """An app holding the design command `name` alone, with `designer`'s own options: typer turns
+    each registered command's signature into click's on every call (16 ms for the five design
+    commands, most of it for the four that do not run); the command parses, helps and fails the same."""
+    app = Typer(**SETTINGS)
+    app.callback()(_options)
+    app.registered_commands = [
+        c for c in design_app.registered_commands if (c.name or c.callback.__name__) == name
+    ]
+    return app
+
+
+def chosen_app(args: list[str]) -> Typer:
+    """The app a command line `args` runs on: a design command's own, else the full one."""
+    return command_app(args[0]) if args[:1] and args[0] in DESIGN_COMMANDS else full_app()
+
+
 def full_app() -> Typer:
-    """The app with every command (built once, on first use): the design commands run on `design_app`."""
+    """The app with every command (built once, on first use): a design command runs on `command_app`'s."""
     if not _FULL:
         from . import cosim, export, plots, printing, rig, sweep
 
@@ -255,8 +272,7 @@ def _run(args: list[str], debug: bool) -> int:
     try:
         _check_tmpdir()
         _check_address_space(args)
-        chosen = design_app if args[:1] and args[0] in DESIGN_COMMANDS else full_app()
-        code = chosen(args=args, prog_name="designer", standalone_mode=False)
+        code = chosen_app(args)(args=args, prog_name="designer", standalone_mode=False)
         if RECEIVED or code == 130:
             return _swallowed()
         _late_stop()
@@ -296,7 +312,7 @@ def _run(args: list[str], debug: bool) -> int:
 def command_options(args: list[str]) -> set[str]:
     """The option names (e.g. --fix) of the command the command line `args` invokes, with those of
     `designer` itself: a message must not offer a flag the command lacks."""
-    cmd = typer.main.get_command(design_app if args[:1] and args[0] in DESIGN_COMMANDS else full_app())
+    cmd = typer.main.get_command(chosen_app(args))
     names = {o for p in cmd.params for o in (*p.opts, *p.secondary_opts)}
     for token in args:
         commands = getattr(cmd, "commands", None)
