@@ -123,7 +123,12 @@ def with_runs(surrogate: Surrogate, rows: list[dict[str, float]]) -> Surrogate:
     old = surrogate.calibration["columns"]
     n_old = len(old[space.FACTOR_NAMES[0]])
     both = {
-        c: np.concatenate([old.get(c, np.full(n_old, np.nan)), new.get(c, np.full(len(rows), np.nan))])
+        c: np.concatenate(
+            [
+                old[c] if c in old else np.full(n_old, np.nan),
+                new[c] if c in new else np.full(len(rows), np.nan),
+            ]
+        )
         for c in dict.fromkeys([*old, *new])
     }
     return calibrated(surrogate.prior, both, surrogate.calibration["printer_sd"])
