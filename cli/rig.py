@@ -32,6 +32,16 @@ RunsOpt = Annotated[
     ),
 ]
 
+#: identify's print id of one log whose sidecar names none
+PrintOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--print",
+        help="with --runs and one log: the print it measured (its id in the runs table, e.g. P1), "
+        "for a log whose sidecar names none",
+    ),
+]
+
 
 def identify(
     logs: Annotated[
@@ -55,6 +65,7 @@ def identify(
         ),
     ] = None,
     runs: RunsOpt = None,
+    print_id: PrintOpt = None,
     accept_implausible: AcceptImplausibleOpt = False,
     json_out: JsonOpt = False,
 ) -> None:
@@ -63,21 +74,18 @@ def identify(
     A force sensor's own low-pass lags the load like a delay and biases c (a 2nd-order Butterworth
     at 200 Hz: about -45 % of c at 0.8 N/mm); give it with --load-filter.
 
-    With --runs, each log's k and c go into the row of the print its sidecar names ({"print": "P1"}).
+    With --runs, each log's k and c go into the row of the print its sidecar names ({"print": "P1"}),
+    or, for one log, the print --print names.
 
     Example: designer identify run1.csv run2.parquet --load-delay 0.002 -o table.csv
+
+    Example: designer identify p1_run.csv --runs batch1/runs.csv --print P1
     """
-    from designer.files import check_output
     from designer.rig.axis_fit import ESTIMATOR
     from designer.rig.identify import identify as run
     from designer.rig.identify import results_table
 
-    if output is not None:
-        check_output(output, suffixes=TABLE_SUFFIXES, inputs=logs)
-    if runs is not None:
-        check_output(runs, suffixes=TABLE_SUFFIXES, inputs=logs)
-    if load_delay is not None and load_delay != load_delay:
-        raise DesignerError("--load-delay is NaN", "give the delay in seconds, e.g. --load-delay 0.002")
+    _check_identify(logs, output, runs, print_id, load_delay)
     with progress("identifying") as bar:
         results = run(logs, load_delay_s=load_delay, load_filter=load_filter, progress=bar)
     finishing()
@@ -87,7 +95,7 @@ def identify(
         from designer.study.data import write_frame
 
         write_frame(results_table(passed), output)
-    filled = _fill_runs(runs, passed, accept_implausible)
+    filled = _fill_runs(runs, passed, print_id, accept_implausible)
     if json_out:
         print_json(
             {
@@ -112,13 +120,30 @@ def identify(
         raise typer.Exit(1)
 
 
-def _fill_runs(runs: Path | None, passed: list, accept_implausible: bool) -> dict | None:
+def _check_identify(
+    logs: list[Path], output: Path | None, runs: Path | None, print_id: str | None, load_delay: float | None
+) -> None:
+    """identify's arguments, before any log is read: the outputs writable, --print with --runs."""
+    from designer.files import check_output
+
+    for path in (output, runs):
+        if path is not None:
+            check_output(path, suffixes=TABLE_SUFFIXES, inputs=logs)
+    if print_id is not None and runs is None:
+        raise DesignerError("--print names the row of a runs table to fill", "give the table with --runs")
+    if load_delay is not None and load_delay != load_delay:
+        raise DesignerError("--load-delay is NaN", "give the delay in seconds, e.g. --load-delay 0.002")
+
+
+def _fill_runs(
+    runs: Path | None, passed: list, print_id: str | None, accept_implausible: bool
+) -> dict | None:
     """Fill the runs table from the logs that passed; None without --runs or a passed log."""
     if runs is None or not passed:
         return None
     from designer.printing.runs import fill_file
 
-    return fill_file(runs, passed, accept_implausible=accept_implausible)
+    return fill_file(runs, passed, print_id=print_id, accept_implausible=accept_implausible)
 
 
 def _print_filled(filled: dict | None, runs: Path | None) -> None:

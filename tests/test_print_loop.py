@@ -174,3 +174,29 @@ def test_mixed_up_prints_are_caught(tmp_path, capsys):
     code, _, err = run_inprocess(["identify", log, "--runs", runs], capsys)
     assert_clean_failure(code, err, allowed=(2,))
     assert "density 30" in err and "mixed up" in err, err
+
+
+def test_a_log_without_a_sidecar_is_named_on_the_command_line(tmp_path, capsys):
+    """A rig whose software writes no sidecar: the print's id is typed (--print), as engraved."""
+    runs = _template(tmp_path, capsys)
+    design = dict(zip(FACTORS, [60.0, 24.0, 4.5, 9.0, 0.16, 0.0], strict=True))
+    log = rig_log(tmp_path, "P1", design, 0.9, 2.2e-3)
+    log.with_suffix(".json").unlink()
+    code, _, err = run_inprocess(["identify", log, "--runs", runs], capsys)
+    assert_clean_failure(code, err, allowed=(2,))
+    assert "names no print" in err and "--print P1" in err and "print_id" not in err, err
+    code, _, err = run_inprocess(["identify", log, "--print", "P1"], capsys)  # no table to fill
+    assert_clean_failure(code, err, allowed=(2,))
+    assert "--runs" in err, err
+    assert pd.read_csv(runs)["k_x [N/mm]"].isna().all()
+    code, out, err = run_inprocess(["identify", log, "--runs", runs, "--print", "p1"], capsys)
+    assert code == 0, err
+    assert np.isclose(pd.read_csv(runs)["k_x [N/mm]"].iloc[0], 0.9, rtol=0.02)
+    # two logs cannot share one --print; a sidecar that names another print is not overridden
+    code, _, err = run_inprocess(["identify", log, log, "--runs", runs, "--print", "P1"], capsys)
+    assert_clean_failure(code, err, allowed=(2,))
+    assert "one log" in err, err
+    log.with_suffix(".json").write_text(json.dumps({"print": "P2"}))
+    code, _, err = run_inprocess(["identify", log, "--runs", runs, "--print", "P1"], capsys)
+    assert_clean_failure(code, err, allowed=(2,))
+    assert "names print P2, --print P1" in " ".join(err.split()), err

@@ -21,6 +21,7 @@ import numpy as np
 
 from .. import units
 from ..errors import DesignerError, check_type, number_argument
+from ..model.plausibility import unit_slip
 from ..model.prediction import Prediction
 from ..model.rotational import PRBSurface, derived_statement, with_axis
 from ..model.surrogate import Surrogate, check_surrogate
@@ -362,7 +363,7 @@ def assess(
         else:
             sug.statements.append(
                 f"{q} = {t.value:g} {unit} lies outside the measured range of {q}_{sug.axis}: "
-                "the data does not support it"
+                f"the data does not support it{slip_hint(q, sug.axis, t.value, (obs_lo, obs_hi))}"
             )
 
     if len(best.probability) > 1:
@@ -375,6 +376,13 @@ def assess(
     sug.statements += [printer_statement(surrogate), *derived_statement(surrogate, sug.axis)]
 
 
+def slip_hint(q: str, axis: str, value: float, measured: tuple[float, float]) -> str:
+    """' (a value in N/m rather than N/mm? that is k=0.8 N/mm)' when a target lies about a unit's
+    thousand from the `measured` range (its geometric middle), else ''."""
+    slip = unit_slip(q, axis, value / float(np.sqrt(measured[0] * measured[1])), logged=False)
+    return f" ({slip[0]}? that is {q}={value * slip[1]:g} {units.rig_unit(q, axis)})" if slip else ""
+
+
 def unpredictable_statement(sug: Suggestion, q: str, t: Target, p: Prediction, unit: str) -> str:
     """What the data can and cannot tell about a goal on a response no form predicts."""
     head = f"{sug.predictability[q]['statement']}: {pi_text(p, unit)} for any design"
@@ -382,9 +390,10 @@ def unpredictable_statement(sug: Suggestion, q: str, t: Target, p: Prediction, u
         verb = "raises" if t.sense > 0 else "lowers"
         return f"{head}; '{t.kind}' cannot be acted on: the data shows no setting that {verb} it"
     inside = "inside" if p.low <= t.value <= p.high else "outside"
+    hint = "" if inside == "inside" else slip_hint(q, sug.axis, t.value, (p.low, p.high))
     chance = probability_within(p, t.value, sug.tolerance, sug.predictability[q]["dof"], log=False)
     return (
-        f"{head}; the target {q} = {t.value:g} {unit} lies {inside} that interval and any design meets "
+        f"{head}; the target {q} = {t.value:g} {unit} lies {inside} that interval{hint} and any design meets "
         f"it within +-{100 * sug.tolerance:.0f} % with probability {chance:.2f}: no setting can be chosen "
         "for it from this data"
     )

@@ -31,18 +31,36 @@ FACTOR_RANGE = (math.exp(-1.96 * PRINTER_SD), math.exp(1.96 * PRINTER_SD))
 SLIP_TOLERANCE = 8.0
 
 
-def likely_slip(quantity: str, axis: str, ratio: float) -> str:
-    """The unit mistake a measured/expected `ratio` of about 1000 or 1/1000 suggests, or ''."""
-    unit = units.rig_unit(quantity, axis)
-    si = units.si_unit(quantity, axis)
-    if abs(math.log10(ratio) - 3) < math.log10(SLIP_TOLERANCE):
-        return f"x1000: a value in {si} rather than {unit}? divide by 1000"
-    if abs(math.log10(ratio) + 3) < math.log10(SLIP_TOLERANCE):
-        return (
-            f"x1/1000: a value in {unit.replace('N', 'kN', 1)} (a load logged in kN) rather than {unit}? "
-            "multiply by 1000"
-        )
-    return "check its unit and the identification of that run"
+def unit_slip(quantity: str, axis: str, ratio: float, *, logged: bool = True) -> tuple[str, float] | None:
+    """The unit mistake that a value `ratio` times the expected one suggests: (its cause in words,
+    the multiplier that corrects the value), or None.
+
+    A value in SI typed where the rig's unit is expected is `units.to_si`'s factor times too large
+    (N/m for N/mm: 1000; N.m/rad for N.mm/rad: 1/1000). With `logged` (a value identified from a
+    rig log) a load channel logged in kN also gives 1/1000.
+    """
+    unit, si = units.rig_unit(quantity, axis), units.si_unit(quantity, axis)
+    factor = units.to_si(quantity, axis, 1.0)
+    for sign in (1, -1):
+        if abs(math.log10(ratio) - 3 * sign) >= math.log10(SLIP_TOLERANCE):
+            continue
+        causes = [f"a value in {si} rather than {unit}"] if math.log10(factor) == 3 * sign else []
+        if logged and sign < 0:
+            causes.append("a load logged in kN rather than N")
+        if causes:
+            return " or ".join(causes), 10.0 ** (-3 * sign)
+    return None
+
+
+def likely_slip(quantity: str, axis: str, ratio: float, *, logged: bool = True) -> str:
+    """`unit_slip` in words, e.g. 'x1000: a value in N/m rather than N/mm? divide by 1000', or ''."""
+    slip = unit_slip(quantity, axis, ratio, logged=logged)
+    if slip is None:
+        return ""
+    cause, multiplier = slip
+    return f"x{'1000' if multiplier < 1 else '1/1000'}: {cause}? " + (
+        "divide by 1000" if multiplier < 1 else "multiply by 1000"
+    )
 
 
 def check_measured(surrogate: Surrogate, table: Any, *, accept_implausible: bool = False) -> None:
@@ -84,5 +102,6 @@ def check_measured(surrogate: Surrogate, table: Any, *, accept_implausible: bool
             f"runs: {r} of {where} is {measured[i]:.4g} {unit}, {ratio:.3g} times the study's "
             f"prediction there ({pi}): "
             f"a printer factor far outside its prior ({low_f:.2f}-{high_f:.2f} at 95 %)",
-            f"{likely_slip(q, axis, ratio)}; if the value is right, pass accept_implausible=True",
+            f"{likely_slip(q, axis, ratio) or 'check its unit and the identification of that run'}; "
+            "if the value is right, pass accept_implausible=True",
         )

@@ -135,19 +135,31 @@ def sidecar_print(log: str | Path) -> str | None:
     return None if value is None else str(value).strip().upper()
 
 
-def fill(runs: pd.DataFrame, results: Sequence[Any], axis: str = "x") -> tuple[pd.DataFrame, list[str]]:
+def fill(
+    runs: pd.DataFrame, results: Sequence[Any], axis: str = "x", print_id: str | None = None
+) -> tuple[pd.DataFrame, list[str]]:
     """`runs` with each passed log's k and c of `axis` written into the row of the print its sidecar
     names, and the ids filled.
 
     Args:
         runs: a runs table as `read_runs` gives it.
         results: `designer.rig.identify.Identification`s of the prints' logs (failed ones skipped).
+        print_id: the print of the one log in `results`, for a log without a sidecar naming it (a
+            rig's software that writes none); a sidecar that names another print is refused.
 
     Raises:
-        DesignerError: a log whose sidecar names no print or a print not in the table, two logs of
-            one print, a log whose sidecar factors differ from its print's row (prints mixed up), or
-            a log without `axis`.
+        DesignerError: a log whose sidecar names no print (and no `print_id`) or a print not in the
+            table, `print_id` with several logs or against its sidecar, two logs of one print, a log
+            whose sidecar factors differ from its print's row (prints mixed up), or a log without
+            `axis`.
     """
+    if print_id is not None:
+        print_id = str(print_id).strip().upper()
+        if len(results) != 1:
+            raise DesignerError(
+                f"print_id='{print_id}' names the print of one log, and {len(results)} logs were given",
+                "identify one log at a time with print_id=, or name each log's print in its sidecar",
+            )
     out = runs.copy()
     factors = canonical_columns(runs.drop(columns=[PRINT]), source="runs")
     k_col, c_col = coefficient_header("k", axis), coefficient_header("c", axis)
@@ -159,20 +171,27 @@ def fill(runs: pd.DataFrame, results: Sequence[Any], axis: str = "x") -> tuple[p
     for res in results:
         if not res.ok:
             continue
-        print_id = sidecar_print(res.path) if res.path is not None else None
-        if print_id is None:
+        named = sidecar_print(res.path) if res.path is not None else None
+        if print_id is not None and named not in (None, print_id):
+            raise DesignerError(
+                f"{res.path}: its sidecar names print {named}, print_id='{print_id}'",
+                "the prints may be mixed up: check the id engraved on the specimen",
+            )
+        pid = print_id or named
+        if pid is None:
             raise DesignerError(
                 f"{res.path}: its sidecar names no print",
-                f'write the print id into {Path(str(res.path)).with_suffix(".json").name}: {{"print": "P1"}}',
+                f"give print_id='P1' (the id engraved on the specimen), or write it into "
+                f'{Path(str(res.path)).with_suffix(".json").name}: {{"print": "P1"}}',
             )
-        rows = np.flatnonzero(out[PRINT].to_numpy() == print_id)
+        rows = np.flatnonzero(out[PRINT].to_numpy() == pid)
         if not rows.size:
             raise DesignerError(
-                f"{res.path}: print {print_id} is not in the runs table ({', '.join(out[PRINT])})",
-                "give the runs table of that batch, or fix the print id in the log's sidecar",
+                f"{res.path}: print {pid} is not in the runs table ({', '.join(out[PRINT])})",
+                "give the runs table of that batch, or fix the print id",
             )
-        if print_id in filled:
-            raise DesignerError(f"two logs of print {print_id}", "identify one log per print")
+        if pid in filled:
+            raise DesignerError(f"two logs of print {pid}", "identify one log per print")
         i = int(rows[0])
         if res.factors is not None:
             table_row = {n: float(factors[n].iloc[i]) for n in space.FACTOR_NAMES}
@@ -180,17 +199,17 @@ def fill(runs: pd.DataFrame, results: Sequence[Any], axis: str = "x") -> tuple[p
             if off:
                 logged = ", ".join(f"{n} {res.factors[n]:g}" for n in off)
                 raise DesignerError(
-                    f"{res.path}: print {print_id}'s sidecar gives {logged}, "
+                    f"{res.path}: print {pid}'s sidecar gives {logged}, "
                     f"the runs table {', '.join(f'{n} {table_row[n]:g}' for n in off)}",
                     "the prints may be mixed up: check the id engraved on the specimen",
                 )
         if axis not in res.axes:
             raise DesignerError(
-                f"{res.path}: no {axis} axis identified", f"log the {axis} axis of print {print_id}"
+                f"{res.path}: no {axis} axis identified", f"log the {axis} axis of print {pid}"
             )
         fit = res.axes[axis]
         out.loc[i, k_col], out.loc[i, c_col], out.loc[i, LOG] = fit.k, fit.c, str(res.path)
-        filled.append(print_id)
+        filled.append(pid)
     return out, filled
 
 
@@ -201,11 +220,16 @@ def table_axis(table: pd.DataFrame) -> str:
 
 
 def fill_file(
-    path: str | Path, results: Sequence[Any], *, surrogate: Any = None, accept_implausible: bool = False
+    path: str | Path,
+    results: Sequence[Any],
+    *,
+    print_id: str | None = None,
+    surrogate: Any = None,
+    accept_implausible: bool = False,
 ) -> dict[str, list[str]]:
-    """Fill the runs table at `path` (atomically) from identified logs (see `fill`), after checking
-    each value against what a printer can give (`designer.model.plausibility`, with the study's
-    surrogate unless `surrogate` is given).
+    """Fill the runs table at `path` (atomically) from identified logs (see `fill`, and its
+    `print_id`), after checking each value against what a printer can give
+    (`designer.model.plausibility`, with the study's surrogate unless `surrogate` is given).
 
     Returns:
         {"filled": ids filled now, "waiting": ids of the table still without a measurement}.
@@ -215,7 +239,7 @@ def fill_file(
     from ..study.data import write_frame
 
     table = read_runs(path)
-    out, filled = fill(table, results, axis=table_axis(table))
+    out, filled = fill(table, results, axis=table_axis(table), print_id=print_id)
     done = out[PRINT].isin(filled).to_numpy()
     if done.any():
         check_measured(
