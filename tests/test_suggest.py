@@ -173,7 +173,8 @@ def test_min_max_goals_and_unpredictable_c(sur):
         (dict(k=0.8, top=0), "at least 1"),
         (dict(k=0.8, tolerance=0), "tolerance"),
         (dict(k=0.8, weight={"k": -1}), "weight of k"),
-        (dict(k=float("nan")), "must be positive"),
+        (dict(k=float("nan")), "k = nan is not a finite number"),
+        (dict(k=float("inf")), "k = inf is not a finite number"),
     ],
 )
 def test_bad_requests(sur, kwargs, message):

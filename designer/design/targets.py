@@ -179,7 +179,12 @@ def make_target(
         lo, hi = (obs_lo if low is None else low), (obs_hi if high is None else high)
     else:
         kind, value = "target", number_argument(goal, quantity)
-        if not np.isfinite(value) or value <= 0:
+        if not np.isfinite(value):
+            raise DesignerError(
+                f"target {quantity} = {value:g} is not a finite number",
+                f"give a value in {unit}, e.g. {np.sqrt(obs_lo * obs_hi):.3g} (mid measured range)",
+            )
+        if value <= 0:
             raise DesignerError(f"target {quantity} = {value:g} {unit} must be positive", "give a value > 0")
         if value > 1e6 * obs_hi:  # the desirability scale (bounds squared) would overflow
             raise DesignerError(
