@@ -244,7 +244,7 @@ FLAGS: tuple[Flag, ...] = (
     ),
     Flag(r"\bfrom fixed=", "from --fix", "drop width from fixed="),
     # export mjcf/urdf/sdf/modelica/ssp
-    Flag(r"\binto=", "--into ", "give the file that defines the joint as into="),
+    Flag(r"\binto=", "--into ", "then export with into='robot_flat.xml'"),
     Flag(
         r"\bjoint_name=", "--joint ", "joint_name='knee': the robot has no hinge or slide joint of that name"
     ),

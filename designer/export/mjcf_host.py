@@ -67,6 +67,33 @@ class Host:
         return data + b"\n" if raw.endswith(b"\n") else data
 
 
+#: how to write a model with its <include>s merged, beside it (its meshes are found relative to it)
+FLATTEN = (
+    "in its folder, python -c \"import mujoco; open('{flat}', 'w').write(mujoco.MjSpec.from_file("
+    "'{main}').to_xml())\", then export with into='{flat}'"
+)
+
+
+def defining_include(host: Path, joint_name: str) -> str | None:
+    """The path (as the model writes it) of the file among `host`'s <include>s, followed
+    recursively, that writes the joint `joint_name`; None if none does. MuJoCo resolves every
+    include relative to the main file's folder."""
+    from lxml import etree
+
+    todo, seen = [host], {host.resolve()}
+    while todo:
+        for inc in etree.parse(str(todo.pop())).getroot().iter("include"):
+            name = inc.get("file") or ""
+            path = host.parent / name
+            if not path.is_file() or path.resolve() in seen:
+                continue
+            seen.add(path.resolve())
+            if etree.parse(str(path)).getroot().xpath("//joint[@name=$n]", n=joint_name):
+                return name
+            todo.append(path)
+    return None
+
+
 def open_host(host: str | Path, joint_name: str) -> Host:
     """Load the host robot and find its hinge or slide joint `joint_name` in the file itself.
 
@@ -86,12 +113,19 @@ def open_host(host: str | Path, joint_name: str) -> Host:
         raise DesignerError(f"MuJoCo cannot load into={str(host)!r}: {exc}", "give an MJCF file") from None
     kinds = (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)
     have = [j.name for j in spec.joints if j.type in kinds and j.name]
+    tree = etree.parse(str(host))
     if joint_name not in have:
+        if tree.getroot().xpath("//body/joint[@name=$n]", n=joint_name):  # written, yet not compiled
+            raise DesignerError(
+                f"joint '{joint_name}' is written in {host.name} outside any <worldbody>: the file is a "
+                "fragment that another model includes, and compiles to no body alone",
+                "flatten the model that includes it: "
+                + FLATTEN.format(main="MAIN.xml", flat="MAIN_flat.xml"),
+            )
         raise DesignerError(
             f"joint_name={joint_name!r}: the robot has no hinge or slide joint of that name",
             f"its hinge and slide joints are: {', '.join(have) or 'none'}",
         )
-    tree = etree.parse(str(host))
     if tree.getroot().tag == "robot":
         raise DesignerError(
             f"into={str(host)!r} is a URDF: MuJoCo reads it, but designer writes MJCF into MJCF files only",
@@ -100,9 +134,12 @@ def open_host(host: str | Path, joint_name: str) -> Host:
         )
     found = tree.getroot().xpath("//worldbody//body/joint[@name=$n]", n=joint_name)
     if len(found) != 1:
+        where = defining_include(host, joint_name)
+        flat = f"{host.stem}_flat.xml"
         raise DesignerError(
-            f"joint '{joint_name}' is not written in {host} itself (it comes from an <include>d file)",
-            "give the file that defines the joint as into=",
+            f"joint '{joint_name}' is not written in {host.name} itself but in "
+            f"{where or 'a file it includes'}: designer edits the file that writes the joint",
+            f"flatten the model first: {FLATTEN.format(main=host.name, flat=flat)}",
         )
     hinge = spec.joint(joint_name).type == mujoco.mjtJoint.mjJNT_HINGE
     return Host(host, model, spec, tree, found[0], hinge)
