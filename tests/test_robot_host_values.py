@@ -232,6 +232,14 @@ def test_mjcf_into_a_urdf_says_what_to_do(tmp_path):
         f'<robot name="arm"><link name="a">{inertial}</link><link name="b">{inertial}</link>'
         '<joint name="j" type="continuous"><parent link="a"/><child link="b"/></joint></robot>'
     )
-    with pytest.raises(DesignerError, match="is a URDF: .*export urdf with into= this file") as refused:
+    with pytest.raises(DesignerError, match="is a URDF: .*export urdf with into='arm.urdf'") as refused:
         export_mjcf(JOINT, tmp_path / "out.xml", into=host, joint_name="j")
     assert "\n" not in str(refused.value) and not (tmp_path / "out.xml").exists()
+
+
+def test_mjcf_into_a_ros_urdf_is_refused_as_a_urdf_not_for_its_meshes():
+    """A ROS URDF's meshes are package:// URIs MuJoCo cannot open: the refusal must still be the one
+    that says what to do (it was 'MuJoCo cannot load ... package:/...stl', give an MJCF file)."""
+    host = example_robot_data() / "robots/ur_description/urdf/ur5_robot.urdf"
+    with pytest.raises(DesignerError, match="is a URDF: .*export urdf with into='ur5_robot.urdf'"):
+        export_mjcf(JOINT, Path("/nonexistent/out.xml"), into=host, joint_name="elbow_joint")

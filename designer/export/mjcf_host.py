@@ -107,13 +107,22 @@ def open_host(host: str | Path, joint_name: str) -> Host:
     if not host.is_file():
         raise DesignerError(f"into={str(host)!r} does not exist", "give the path of the robot's MJCF file")
     try:
+        tree = etree.parse(str(host))
+    except etree.XMLSyntaxError as exc:
+        raise DesignerError(f"into={str(host)!r} is not XML ({exc})", "give the robot's MJCF file") from None
+    if tree.getroot().tag == "robot":  # before MuJoCo, which may not find a URDF's package:// meshes
+        raise DesignerError(
+            f"into={str(host)!r} is a URDF: MuJoCo reads it, but designer writes MJCF into MJCF files only",
+            f"export urdf with into={host.name!r}, or save it as MJCF first (MuJoCo's compile tool, or "
+            "mujoco.MjSpec.from_file(...).to_xml())",
+        )
+    try:
         model = mujoco.MjModel.from_xml_path(str(host))
         spec = mujoco.MjSpec.from_file(str(host))
     except ValueError as exc:
         raise DesignerError(f"MuJoCo cannot load into={str(host)!r}: {exc}", "give an MJCF file") from None
     kinds = (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)
     have = [j.name for j in spec.joints if j.type in kinds and j.name]
-    tree = etree.parse(str(host))
     if joint_name not in have:
         if tree.getroot().xpath("//body/joint[@name=$n]", n=joint_name):  # written, yet not compiled
             raise DesignerError(
@@ -125,12 +134,6 @@ def open_host(host: str | Path, joint_name: str) -> Host:
         raise DesignerError(
             f"joint_name={joint_name!r}: the robot has no hinge or slide joint of that name",
             f"its hinge and slide joints are: {', '.join(have) or 'none'}",
-        )
-    if tree.getroot().tag == "robot":
-        raise DesignerError(
-            f"into={str(host)!r} is a URDF: MuJoCo reads it, but designer writes MJCF into MJCF files only",
-            "export urdf with into= this file, or save it as MJCF first (MuJoCo's compile tool, or "
-            "mujoco.MjSpec.from_file(...).to_xml())",
         )
     found = tree.getroot().xpath("//worldbody//body/joint[@name=$n]", n=joint_name)
     if len(found) != 1:
