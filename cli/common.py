@@ -289,7 +289,9 @@ def flag_message(text: str, options: Collection[str] | None = None) -> str:
             text = re.sub(f.pattern, f.flag, text)
         elif f.fallback is not None:
             text = re.sub(f.pattern, f.fallback, text)
-    return text
+    # a flag that takes a value ("--into ") where the Python words named the argument alone
+    # ("into= needs joint_name=") keeps no space before a space, a comma or a bracket
+    return re.sub(r"(--[\w-]+) (?=[\s,;:)]|$)", r"\1", text)
 
 
 def design_text(params: dict) -> str:

@@ -133,3 +133,16 @@ def test_a_cosim_reference_csv_names_its_problem(content, words, tmp_path, monke
     assert_clean_failure(code, err, allowed=(2,))
     assert words in err and "ref.csv" in err, err
     assert not (tmp_path / "res").exists()
+
+
+@pytest.mark.parametrize(
+    ("message", "said"),
+    [
+        ("into= needs joint_name=", "--into needs --joint"),
+        ("give k= a target value", "give --k a target value"),
+        ("use fmi_version=2 or 3", "use --fmi 2 or 3"),
+        ("(give into=, or none)", "(give --into, or none)"),
+    ],
+)
+def test_a_translated_flag_leaves_no_stray_space(message, said):
+    assert flag_message(message) == said
