@@ -354,8 +354,9 @@ def next_prints(
     if progress is not None:
         progress(1.0)
     statements += [
-        f"the best design now: {chance}, {_doubt_text(surrogate)}; after printing and measuring these "
-        f"{len(chosen)}, the best is expected to land with {p_after:.2f}",
+        f"the best design now: {chance}, {_doubt_text(surrogate)}; after printing and measuring "
+        f"{'it' if len(chosen) == 1 else f'these {len(chosen)}'}, the best is expected to land with "
+        f"{p_after:.2f}",
         "then: designer print makes them (a 3MF plate, each object with its settings, and the runs table); "
         "measure each, designer identify fills the table from the rig logs, designer calibrate, "
         "designer next again",
