@@ -234,6 +234,11 @@ def _doubt_text(surrogate: Surrogate) -> str:
     )
 
 
+def _them(n: int) -> str:
+    """The prints of a batch of `n` in a sentence: "it" or "these 3"."""
+    return "it" if n == 1 else f"these {n}"
+
+
 def _check_arguments(n: int, stop: float) -> None:
     if not 1 <= number_argument(n, "n", example="3") <= 10 or int(n) != n:
         raise DesignerError(f"n={n} is not a whole number from 1 to 10", "give a whole number such as 3")
@@ -355,8 +360,7 @@ def next_prints(
         progress(1.0)
     statements += [
         f"the best design now: {chance}, {_doubt_text(surrogate)}; after printing and measuring "
-        f"{'it' if len(chosen) == 1 else f'these {len(chosen)}'}, the best is expected to land with "
-        f"{p_after:.2f}",
+        f"{_them(len(chosen))}, the best is expected to land with {p_after:.2f}",
         "then: designer print makes them (a 3MF plate, each object with its settings, and the runs table); "
         "measure each, designer identify fills the table from the rig logs, designer calibrate, "
         "designer next again",

@@ -124,7 +124,8 @@ def open_host(host: str | Path, joint_name: str) -> Host:
     kinds = (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)
     have = [j.name for j in spec.joints if j.type in kinds and j.name]
     if joint_name not in have:
-        if tree.getroot().xpath("//body/joint[@name=$n]", n=joint_name):  # written, yet not compiled
+        written = [j for j in tree.getroot().iter("joint") if j.get("name") == joint_name]
+        if any(j.getparent().tag == "body" for j in written):  # written, yet compiled to no joint
             raise DesignerError(
                 f"joint '{joint_name}' is written in {host.name} outside any <worldbody>: the file is a "
                 "fragment that another model includes, and compiles to no body alone",
