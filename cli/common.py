@@ -327,9 +327,11 @@ def parse_goal(text: str | None, flag: str) -> float | str | None:
         ) from None
 
 
-def pi_text(p: dict) -> str:
-    """A prediction's to_dict() as 'value [low, high]': three significant digits, bounds two."""
-    return f"{p['value']:.3g} [{p['low']:.2g}, {p['high']:.2g}]"
+def pi_text(p: dict, unit: str = "") -> str:
+    """A prediction's to_dict() as 'value [low, high] unit' (`designer.model.prediction.Prediction.text`)."""
+    from designer.model.prediction import Prediction
+
+    return Prediction.from_dict(p).text(unit)
 
 
 def answer(data: dict, as_json: bool, show: Callable[[dict], None]) -> None:

@@ -175,18 +175,21 @@ def next_(
 
 
 def _print_next(data: dict) -> None:
+    from designer.units import rig_unit
+
+    def both(predicted: dict) -> str:  # k and c with their units on the goals' axis
+        return ", ".join(f"{q} {pi_text(predicted[q], rig_unit(q, data['axis']))}" for q in ("k", "c"))
+
     rec = data["recommendation"]
     console.print(f"Design #1 now: {design_text(rec['params'])}")
     console.print(
-        f"  k {pi_text(rec['predicted']['k'])}, c {pi_text(rec['predicted']['c'])}; "
+        f"  {both(rec['predicted'])}; "
         f"lands within +-{100 * data['tolerance']:g} % with probability {data['p_now']:.2f}"
     )
     for i, p in enumerate(data["prints"], 1):
         mark = " (design #1 itself)" if p["recommended"] else ""
         console.print(f"Print {i}{mark}: {design_text(p['params'])}")
-        console.print(
-            f"  predicted k {pi_text(p['predicted']['k'])}, c {pi_text(p['predicted']['c'])}; {p['reason']}"
-        )
+        console.print(f"  predicted {both(p['predicted'])}; {p['reason']}")
     for s in data["statements"]:
         console.print(f"- {s}")
 

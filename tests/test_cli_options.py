@@ -115,6 +115,7 @@ def test_designs_are_printed_with_the_flags_names(capsys):
     code, out, _ = run_inprocess(["next", "--k", "0.8", "--n", "1"], capsys)
     assert code == 0 and re.search(r"Design #1 now: density \d+ %, length [\d.]+ mm, width ", out)
     assert "after printing and measuring it, the best" in " ".join(out.split()), out  # not "these 1"
+    assert re.search(r"k [\d.]+ \[[\d.]+, [\d.]+\] N/mm, c [\d.]+ \[[\d.]+, [\d.]+\] N\.s/mm;", out), out
     code, out, _ = run_inprocess(["suggest", "--k", "0.8", "--top", "1", "--json"], capsys)
     assert list(json.loads(out)["candidates"][0]["params"]) == [
         "density", "length", "width", "height", "layer", "raster"

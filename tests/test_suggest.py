@@ -215,3 +215,18 @@ def test_suggestion_json_round_trip(sur):
     r = suggest(sur, k=0.8, c="max", top=2)
     back = Suggestion.from_dict(r.to_dict())
     assert back.to_dict() == r.to_dict()
+
+
+@pytest.mark.parametrize(
+    ("value", "low", "high", "text"),
+    [
+        (0.7994, 0.4123, 1.567, "0.799 [0.41, 1.6] N/mm"),
+        (300.4, 214.0, 433.0, "300 [210, 430] N/mm"),  # written out, not 2.1e+02
+        (1234.0, 987.0, 15678.0, "1230 [990, 16000] N/mm"),
+        (0.002234, 0.000351, 0.0042, "0.00223 [0.00035, 0.0042] N/mm"),
+        (2e-05, 1.04e-05, 3.9e-05, "2e-05 [1e-05, 3.9e-05] N/mm"),
+    ],
+)
+def test_a_prediction_reads_with_its_digits_and_unit(value, low, high, text):
+    assert Prediction(value, low, high).text("N/mm") == text
+    assert Prediction(value, low, high).text() == text.removesuffix(" N/mm")

@@ -267,8 +267,8 @@ def rank(
 
 
 def pi_text(p: Prediction, unit: str) -> str:
-    """A prediction as '1.27 [0.81, 2.0] N/mm': three significant digits, bounds two."""
-    return f"{p.value:.3g} [{p.low:.2g}, {p.high:.2g}] {unit}"
+    """A prediction as '1.27 [0.81, 2] N/mm' (`Prediction.text`)."""
+    return p.text(unit)
 
 
 def judged_targets(targets: Mapping[str, Target], info: Mapping[str, Mapping[str, Any]]) -> list[str]:

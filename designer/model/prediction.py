@@ -37,6 +37,14 @@ class Prediction:
         """The same prediction in other units: every bound times `factor` (> 0)."""
         return Prediction(self.value * factor, self.low * factor, self.high * factor)
 
+    def text(self, unit: str = "") -> str:
+        """One design's prediction for people, '1.27 [0.81, 2] N/mm': the value to three significant
+        digits, the bounds to two, written out below a million ('300 [210, 430] N.mm/rad', not
+        '2.1e+02')."""
+        return f"{_digits(self.value, 3)} [{_digits(self.low, 2)}, {_digits(self.high, 2)}]" + (
+            f" {unit}" if unit else ""
+        )
+
     def to_dict(self) -> dict[str, Any]:
         """{"value", "low", "high"}: floats, or lists for several designs."""
 
@@ -208,3 +216,8 @@ class ResponseSurface:
             lack_of_fit=d.get("lack_of_fit"),
             **values,
         )
+
+
+def _digits(v: float, n: int) -> str:
+    """`v` rounded to `n` significant digits, in `g` format (an exponent only beyond 1e6 or 1e-4)."""
+    return f"{float(f'{v:.{n}g}'):g}"
