@@ -266,11 +266,6 @@ def rank(
     return sorted(out, key=key)
 
 
-def pi_text(p: Prediction, unit: str) -> str:
-    """A prediction as '1.27 [0.81, 2] N/mm' (`Prediction.text`)."""
-    return p.text(unit)
-
-
 def judged_targets(targets: Mapping[str, Target], info: Mapping[str, Mapping[str, Any]]) -> list[str]:
     """The goals reachability is judged on: the predictable target values, else every target value."""
     scored = [q for q, t in targets.items() if t.has_value and info[q]["predictable"]]
@@ -325,7 +320,7 @@ def assess(
         if not t.has_value:
             word = "largest" if t.sense > 0 else "smallest"
             sug.statements.append(
-                f"{q} {t.kind}imised: the best design is predicted at {pi_text(p, unit)}, the {word} the "
+                f"{q} {t.kind}imised: the best design is predicted at {p.text(unit)}, the {word} the "
                 f"surrogate predicts within the {'extended' if box.extrapolate else 'tested'} ranges "
                 f"(measured runs span {model.observed_range[0]:.3g} to {model.observed_range[1]:.3g} {unit})"
             )
@@ -334,14 +329,14 @@ def assess(
         prob = f"a printed joint lands within {band} of it with probability {best.probability[q]:.2f}"
         if abs(best.rel_error[q]) <= tol:
             sug.statements.append(
-                f"{q} = {t.value:g} {unit} is reached within {band}: predicted {pi_text(p, unit)}; {prob}"
+                f"{q} = {t.value:g} {unit} is reached within {band}: predicted {p.text(unit)}; {prob}"
             )
             continue
         reached = [c for c in ranked if abs(c.rel_error[q]) <= tol]
         if reached:
             sug.statements.append(
                 f"{q} = {t.value:g} {unit} is reached within {band} (a design is predicted at "
-                f"{pi_text(reached[0].predicted[q], unit)}); design #1, predicted at {pi_text(p, unit)} "
+                f"{reached[0].predicted[q].text(unit)}); design #1, predicted at {p.text(unit)} "
                 f"({100 * best.rel_error[q]:+.0f} %), ranks first by its chance: {prob}"
             )
             continue
@@ -354,7 +349,7 @@ def assess(
             f"{q} = {t.value:g} {unit} is out of reach within {band}: over the "
             f"{'extended' if box.extrapolate else 'tested'} ranges the surrogate predicts "
             f"{q}_{sug.axis} from {lo_r:.3g} to {hi_r:.3g} {unit}, the runs measured {obs_lo:.3g} to "
-            f"{obs_hi:.3g} {unit}; the nearest design is predicted at {pi_text(p, unit)} "
+            f"{obs_hi:.3g} {unit}; the nearest design is predicted at {p.text(unit)} "
             f"({100 * best.rel_error[q]:+.0f} %) and {prob}"
         )
         if obs_lo <= t.value <= obs_hi:
@@ -385,7 +380,7 @@ def slip_hint(q: str, axis: str, value: float, measured: tuple[float, float]) ->
 
 def unpredictable_statement(sug: Suggestion, q: str, t: Target, p: Prediction, unit: str) -> str:
     """What the data can and cannot tell about a goal on a response no form predicts."""
-    head = f"{sug.predictability[q]['statement']}: {pi_text(p, unit)} for any design"
+    head = f"{sug.predictability[q]['statement']}: {p.text(unit)} for any design"
     if not t.has_value:
         verb = "raises" if t.sense > 0 else "lowers"
         return f"{head}; '{t.kind}' cannot be acted on: the data shows no setting that {verb} it"
@@ -419,7 +414,7 @@ def nearest_runs(surrogate: Surrogate, q: str, axis: str, target: float) -> list
                 "measured": float(y[i]),
                 "predicted": p.to_dict(),
                 "statement": f"run {run} measured {y[i]:.3g} {unit} at {where}; the surrogate predicts "
-                f"{pi_text(p, unit)} there",
+                f"{p.text(unit)} there",
             }
         )
     return out

@@ -120,6 +120,11 @@ def settings_and_coefficients(table: pd.DataFrame) -> list[str]:
     return list(space.FACTOR_NAMES) + coefficient_columns(table)
 
 
+def print_key(value: Any) -> str:
+    """A print id as the runs table holds it, whoever typed it: 'p1 ' is 'P1'."""
+    return str(value).strip().upper()
+
+
 def sidecar_print(log: str | Path) -> str | None:
     """The print id a rig log's JSON sidecar names (`"print"`), or None."""
     from ..rig.logs import sidecar_path
@@ -132,7 +137,7 @@ def sidecar_print(log: str | Path) -> str | None:
     except (OSError, ValueError):
         return None  # read_log reports an unreadable sidecar
     value = doc.get("print") if isinstance(doc, dict) else None
-    return None if value is None else str(value).strip().upper()
+    return None if value is None else print_key(value)
 
 
 def fill(
@@ -154,7 +159,7 @@ def fill(
             `axis`.
     """
     if print_id is not None:
-        print_id = str(print_id).strip().upper()
+        print_id = print_key(print_id)
         if len(results) != 1:
             raise DesignerError(
                 f"print_id='{print_id}' names the print of one log, and {len(results)} logs were given",
