@@ -204,7 +204,7 @@ def _print_identification(res) -> None:
 def _as_flags(text: str) -> str:
     """The library's argument names in a warning or reason, as this command's flags."""
     text = re.sub(r"load_filter='([^']+)'", r"--load-filter \1", text)
-    return text.replace("load_delay_s", "--load-delay")
+    return text.replace("load_filter", "--load-filter").replace("load_delay_s", "--load-delay")
 
 
 TABLE_SUFFIXES = (".csv", ".parquet", ".pq")

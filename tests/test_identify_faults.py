@@ -148,3 +148,50 @@ def test_a_2_khz_log_on_a_1_ms_clock_is_rebuilt_from_the_sample_index_with_a_not
     make_log({"x": X}, duration=30, rate=2000, seed=2, time_resolution=1e-3).to_csv(path, index=False)
     out = subprocess.run(CLI + ["identify", str(path)], capture_output=True, text=True)
     assert out.returncode == 0 and "note: t is on a 0.001 s clock" in " ".join(out.stdout.split()), out.stderr
+
+
+def _number_after(text: str, key: str) -> float:
+    """The number that follows `key` in a sentence (e.g. 'k = ')."""
+    import re
+
+    return float(re.search(re.escape(key) + r"(-?[0-9.]+(?:e-?[0-9]+)?)", text).group(1))
+
+
+@pytest.mark.parametrize("column", ["x", "Fx"])
+def test_a_flipped_sign_is_named_with_the_fit_it_would_give(column):
+    """A sensor counting the other way used to be only "physically impossible fit: k = -0.8" (k and
+    c negative, R2 1): the reason now names the opposite directions and the fit with one negated."""
+    df = make_log({"x": X}, duration=60, rate=1000, seed=1)
+    df[column] = -df[column]
+    reason = identify(df)[0].failures["x"]
+    assert "x and Fx count in opposite directions" in reason and "negate that column" in reason
+    told = reason.split("with one of them negated the fit gives ")[1]
+    assert _number_after(told, "k = ") == pytest.approx(X["k"], rel=0.01)
+    assert _number_after(told, "c = ") == pytest.approx(X["c"], rel=0.02)
+    assert "unit error" not in reason
+
+
+def test_a_flipped_load_in_kn_is_named_as_both():
+    df = make_log({"x": X}, duration=60, rate=1000, seed=1, load_unit=1e-3)
+    df["Fx"] = -df["Fx"]
+    reason = identify(df)[0].failures["x"]
+    assert "count in opposite directions" in reason
+    assert "negated, it is still an implausible scale, a unit error" in reason and "Fx in kN" in reason
+
+
+def test_swapped_position_and_load_columns_are_named_with_the_fit_exchanged(tmp_path):
+    """x holding the load and Fx the position used to be only "physically impossible fit: k = 1.25,
+    c = -0.0031": a negative c is a lagging load or swapped columns, and the reason says both, with
+    the fit the columns exchanged would give (and, from the CLI, the flags that give a delay)."""
+    df = make_log({"x": X}, duration=60, rate=1000, seed=1).rename(columns={"x": "Fx", "Fx": "x"})
+    reason = identify(df)[0].failures["x"]
+    assert "the load lags the position by at least" in reason and "the columns are swapped" in reason
+    told = reason.split("exchanged, the fit would give about ")[1]
+    assert _number_after(told, "k = ") == pytest.approx(X["k"], rel=0.01)
+    assert _number_after(told, "c = ") == pytest.approx(X["c"], rel=0.05)
+    path = tmp_path / "swapped.csv"
+    df.to_csv(path, index=False)
+    out = subprocess.run(CLI + ["identify", str(path)], capture_output=True, text=True)
+    text = " ".join(out.stdout.split())
+    assert out.returncode == 1 and "give it as --load-delay or --load-filter" in text, out.stdout
+    assert "load_filter" not in text and "load_delay_s" not in text

@@ -277,11 +277,44 @@ def _checked(log: RigLog, axis: str, load_delay_s: float, load_filter: channel.L
             f"physically impossible fit: k = {k:.4g} {units.rig_unit('k', axis)}, c = {c:.4g} {cu}, "
             f"R2 = {main.r2:.3g} (needs k > 0, c >= 0, R2 >= {MIN_R2:g})"
             + ("" if lag is None else "; " + _lag_text(lag.to_dict(), k * lag.delay_s, cu))
+            + ("" if main.r2 < MIN_R2 else _impossible_cause(log, axis, k, c, spec))
         )
     unit_error = plausibility.scale_failure(axis, k, spec.scale_r, spec.scale_f, log.factors)
     if unit_error is not None:
         raise AxisFailed(unit_error)
     return spec, ch, main, correct, lag
+
+
+def _impossible_cause(log: RigLog, axis: str, k: float, c: float, spec: bandlib.Spectra) -> str:
+    """The log faults a well-fitting (R2 >= MIN_R2) but impossible k or c points to, in words.
+
+    k < 0: the two channels count in opposite directions (a sensor mounted or calibrated the other
+    way round): negated, the fit is -k, -c (whose scale is checked too: a flipped load in kN is
+    both). k > 0 with c < 0: either the load lags the position
+    (c shifts by about -k x delay) or the columns are swapped: the swapped fit is the inverse of the
+    transfer k + i w c, i.e. about 1/k and -c/k^2 where w c << k, as at the rig's frequencies.
+    """
+    ru, fu = units.rig_unit("r", axis), units.rig_unit("F", axis)
+    ku, cu = units.rig_unit("k", axis), units.rig_unit("c", axis)
+    load = LOAD[axis]
+    if k < 0:
+        scale = plausibility.scale_failure(axis, -k, spec.scale_r, spec.scale_f, log.factors)
+        return (
+            f"; with R2 that high, {axis} and {load} count in opposite directions (a sensor mounted or "
+            f"calibrated the other way round): with one of them negated the fit gives k = {-k:.4g} {ku}, "
+            f"c = {-c:.4g} {cu}; negate that column (or the sensor's calibration factor) and identify again"
+            + ("" if scale is None else f"; negated, it is still an {scale}")
+        )
+    if k == 0 or c >= 0:
+        return ""
+    delay = -c / k
+    return (
+        f"; a negative c is no material's: either the load lags the position by at least "
+        f"{1e3 * delay:.3g} ms ({delay * log.rate:.3g} samples: the logger's skew or the load sensor's "
+        f"filter; give it as load_delay_s or load_filter), or the columns are swapped ({load} holding the "
+        f"position in {ru}, {axis} the load in {fu}: exchanged, the fit would give about "
+        f"k = {1 / k:.4g} {ku}, c = {-c / k**2:.4g} {cu}); check which column is which"
+    )
 
 
 def _masses(spec: bandlib.Spectra, ch, sol, correct, axis: str) -> tuple[list[dict], bool, bandlib.Channels]:
