@@ -452,11 +452,13 @@ def check_table_file(path: str | Path, *, parquet: bool) -> None:
         )
     if parquet:
         return
-    line = head.splitlines()[0] if head.splitlines() else head
+    # up to the header row: the first line that is not a comment (a logger's '# rate: 1000 Hz' above it)
+    lines = head.splitlines() or [head]
+    row = next((i for i, x in enumerate(lines) if not x.lstrip(b"\xef\xbb\xbf \t").startswith(b"#")), 0)
     if head.startswith((b"\xff\xfe", b"\xfe\xff")):
         raise DesignerError(f"cannot read {p}: it is UTF-16 text", "save it as UTF-8 comma-separated CSV")
     try:
-        text = line.decode("utf-8-sig")
+        text = b"\n".join(lines[: row + 1]).decode("utf-8-sig").split("\n")[-1]
     except UnicodeDecodeError:
         text = "\0" if b"\0" in head else ""
         if not text:

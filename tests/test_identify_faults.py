@@ -195,3 +195,44 @@ def test_swapped_position_and_load_columns_are_named_with_the_fit_exchanged(tmp_
     text = " ".join(out.stdout.split())
     assert out.returncode == 1 and "give it as --load-delay or --load-filter" in text, out.stdout
     assert "load_filter" not in text and "load_delay_s" not in text
+
+
+def _with_header(path, header: str, df) -> None:
+    path.write_text(header + df.to_csv(index=False))
+
+
+def test_a_logger_header_is_read_and_a_rate_it_states_checked_against_t(tmp_path):
+    """A logger's '#' lines above the header row used to be taken for the header ("missing column
+    't'"); a sampling rate stated there that the time column does not have is refused (exit 2) naming
+    both, since c scales with the time base; a header that agrees, or states no sampling rate, is
+    read and the log identified as without it."""
+    df = make_log({"x": X}, duration=30, rate=1000, seed=3)
+    plain = identify(df)[0].axes["x"]
+    for name, header in [
+        ("agrees", "# logger: bench-2\n# Sampling rate (Hz): 1000\n"),
+        ("khz", "# fs = 1 kHz\n"),
+        ("other_rate", "# strain rate: 0.5, operator: A\n"),
+    ]:
+        path = tmp_path / f"{name}.csv"
+        _with_header(path, header, df)
+        fit = _one(path).axes["x"]
+        assert fit.k == pytest.approx(plain.k, rel=1e-9) and fit.c == pytest.approx(plain.c, rel=1e-9), name
+    path = tmp_path / "disagrees.csv"
+    _with_header(path, "# rig: bench-2, sample_rate_hz: 500\n", df)
+    out = subprocess.run(
+        CLI + ["identify", str(path), "-o", str(tmp_path / "t.csv")], capture_output=True, text=True
+    )
+    assert out.returncode == 2 and not (tmp_path / "t.csv").exists(), out.stderr
+    text = " ".join(out.stderr.split())
+    assert "the header states 500 Hz ('# rig: bench-2, sample_rate_hz: 500')" in text
+    assert "sampled at 1000 Hz" in text and "Traceback" not in text
+
+
+def test_a_log_under_other_column_names_is_told_the_names_it_has(tmp_path):
+    """Parquet from another tool ('time', 'disp', 'force') used to get only "missing column 't'"."""
+    path = tmp_path / "other.parquet"
+    make_log({"x": X}, duration=10, rate=500, seed=1).rename(
+        columns={"t": "time", "x": "disp", "Fx": "force"}
+    ).to_parquet(path)
+    with pytest.raises(Exception, match=r"missing column 't' \(its columns are 'time', 'disp', 'force'\)"):
+        identify(path)
