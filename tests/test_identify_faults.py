@@ -236,3 +236,46 @@ def test_a_log_under_other_column_names_is_told_the_names_it_has(tmp_path):
     ).to_parquet(path)
     with pytest.raises(Exception, match=r"missing column 't' \(its columns are 'time', 'disp', 'force'\)"):
         identify(path)
+
+
+def _encoder_log(step: float, seed: int = 1):
+    """The README log with its position read by an encoder of `step` mm (no noise below a step: an
+    optical encoder's error is its rounding)."""
+    df = make_log({"x": X}, duration=60, rate=1000, seed=seed, position_noise=0.0)
+    df["x"] = np.round(df["x"] / step) * step
+    return df
+
+
+def test_a_coarse_encoder_reading_zero_is_no_dropout_but_a_stuck_one_is():
+    """A 0.1 mm encoder reads 0 for 5 or more samples each time the motion crosses its middle count:
+    those runs used to be flagged as a sensor stuck at zero (2 % of a 1 kHz log; at 0.2 mm the log
+    failed on "dropouts ... fix the sensor or its wiring"). A run that jumps to 0 from afar still is."""
+    df = _encoder_log(0.1)
+    assert validate_frame(df).dropouts["x"].mean() == 0.0
+    moving = int(np.argmax(np.abs(df["x"].to_numpy()) > 1.0))  # a row far from zero
+    df.loc[moving : moving + 49, "x"] = 0.0
+    flagged = validate_frame(df).dropouts["x"]
+    assert flagged[moving : moving + 50].all() and flagged.sum() == 50
+
+
+@pytest.mark.parametrize("step", [0.1, 0.05])
+def test_a_coarse_encoder_is_named_not_taken_for_a_spring_and_its_bias_is_in_the_errors(step):
+    """A linear joint read in 0.1 mm steps (20 to the 2 mm peak) used to be named a softening spring
+    with k some 6-9 standard errors off; the quantizer's describing function sizes what the steps do.
+    (Seeds 2 and 3: on seed 1 the load's noise alone puts c 3.3 standard errors off, unquantized.)"""
+    for seed in (2, 3):
+        res = _one(_encoder_log(step, seed))
+        fit = res.axes["x"]
+        assert fit.departure is None, fit.departure["text"]
+        assert any(w.startswith(f"x: x is read in steps of {step:g} mm") for w in res.warnings), res.warnings
+        assert not any("spring:" in w for w in res.warnings)
+        assert abs(fit.k - X["k"]) < 2 * fit.k_se and abs(fit.c - X["c"]) < 2 * fit.c_se, (seed, fit.k, fit.c)
+
+
+def test_an_encoder_of_a_few_steps_to_the_peak_is_refused_naming_it():
+    reason = identify(_encoder_log(0.25))[0].failures["x"]
+    assert reason.startswith("x is read in steps of 0.25 mm, only 8 to the motion's peak of 2 mm")
+
+
+def test_an_analogue_position_has_no_encoder():
+    assert _one(make_log({"x": X}, duration=60, rate=1000, seed=1)).axes["x"].encoder is None

@@ -36,7 +36,7 @@ import numpy as np
 from .. import units
 from ..mass import specimen_mass
 from . import band as bandlib
-from . import channel, departures, plausibility, saturation
+from . import channel, departures, plausibility, quantization, saturation
 from .logs import LOAD, UNITS, RigLog, missing
 from .nonlinear import amplitude_table, frequency_table
 from .regress import solve
@@ -117,6 +117,9 @@ class AxisFit:
     departures: dict
     #: the departure the data supports, named, with its size and the linear fit's c and k, or None
     departure: dict | None
+    #: a coarse position encoder's share of the fit (`quantization.Effect.to_dict()`), or None; k_se
+    #: and c_se include its shifts, and the departures are tested net of it
+    encoder: dict | None
     warnings: list[str] = field(default_factory=list)
 
     def mass(self) -> float | None:
@@ -168,6 +171,9 @@ def _spectra(log: RigLog, axis: str) -> bandlib.Spectra:
             + ": the fit is refused (a fit through clipped peaks reads them as a softening spring); "
             "record with a sensor range above the peak, or a smaller amplitude"
         )
+    encoder = quantization.effect(r)
+    if encoder is not None and (coarse := quantization.too_coarse(encoder, axis)) is not None:
+        raise AxisFailed(coarse)
     valid = 1.0 - log.missing_fraction.get(LOAD[axis], float(missing(f).mean()))
     if valid < MIN_VALID:
         raise AxisFailed(
@@ -345,11 +351,14 @@ def fit_axis(
     scale = spec.scale_f / spec.scale_r
     x, noise = _design(ch)
     tests = departures.test(spec, ch, x, noise, _lags(ch), scale)
-    found = departures.supported(tests)
+    encoder = quantization.effect(log.data[axis].to_numpy())
+    k_lin = float(main.beta[2]) * scale
+    faked = [] if encoder is None else [d for d in tests.values() if encoder.fakes(d, k_lin)]
+    found = departures.supported(_genuine(tests, faked))
     if found is not None:  # something departs: is it another axis's load?
         others = _other_loads(log, axis, spec, ch, correct)
         tests |= departures.crosstalk(spec, ch, x, noise, _lags(ch), others)
-        found = departures.supported(tests)
+        found = departures.supported(_genuine(tests, faked))
     sol = found.solution if found is not None and found.name in departures.ADOPTED else main
     if found is not None and found.name == "friction" and lag is not None:
         lag = _unknown_lowpass(log, axis, spec, load_delay_s, load_filter, friction=found.value)
@@ -357,6 +366,7 @@ def fit_axis(
     c_se, k_se = (float(v) * scale for v in sol.se[1:3])
     c_channel = 0.0 if lag is None else k * lag.delay_s
     c_skew = float(main.also_beta[1]) * scale - float(main.beta[1]) * scale
+    bias = 0.0 if encoder is None else encoder.bias  # k's and c's relative error from the encoder
     m_rows, stable, widest = _masses(spec, ch, sol, correct, axis)
     m, m_se = m_rows[0]["m"], m_rows[0]["m_se"]
     identified = bool(m > 0 and m_se <= M_REL_SE * m and stable)
@@ -372,8 +382,8 @@ def fit_axis(
         c=c,
         k=k,
         m_se=m_se,
-        c_se=float(np.hypot(c_se, c_channel)),
-        k_se=k_se,
+        c_se=float(np.hypot(np.hypot(c_se, c_channel), c * bias)),
+        k_se=float(np.hypot(k_se, k * bias)),
         r2=sol.r2,
         nrmse=float(np.sqrt(sol.rss / sol.rows) / max(float(y.max() - y.min()), 1e-300)),
         samples=sol.rows,
@@ -393,14 +403,24 @@ def fit_axis(
         c_frequency=freq.to_dict(),
         departures={name: d.to_dict() for name, d in tests.items()},
         departure=None if found is None else departures.describe(found, main, scale, spec, axis, freq.rows),
+        encoder=None if encoder is None else encoder.to_dict(),
     )
     fit.warnings.extend(plausibility.range_warnings(axis, spec.scale_r, spec.scale_f))
+    faked = [d for d in faked if abs(d.z) > departures.Z_CRIT]
+    named = encoder is not None and (bool(faked) or k * bias > k_se or c * bias > c_se)
+    if named:  # the encoder's steps also vary k and c over the bands: its sentence says so
+        fit.warnings.append(quantization.describe(encoder, axis, faked, k_lin))
     fit.warnings.extend(
         saturation.describe(col, UNITS[col], found) + ": those samples are left out of the fit"
         for col, found in _saturated(log, axis)
     )
-    fit.warnings.extend(_warnings(fit, stable, amp.varies, freq.varies, log.rate))
+    fit.warnings.extend(_warnings(fit, stable, amp.varies and not named, freq.varies and not named, log.rate))
     return fit
+
+
+def _genuine(tests: dict[str, departures.Departure], faked: list) -> dict[str, departures.Departure]:
+    """The departure tests less those a coarse encoder's steps alone can make (`faked`)."""
+    return {name: d for name, d in tests.items() if d not in faked}
 
 
 def _other_loads(

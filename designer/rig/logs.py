@@ -139,30 +139,66 @@ def _first_bad_row(bad: np.ndarray) -> int:
     return int(np.flatnonzero(bad)[0]) + 1
 
 
-def _runs(mask: np.ndarray, min_len: int) -> np.ndarray:
-    """Rows inside runs of True at least `min_len` long (work in proportion to the True rows)."""
+def _run_bounds(mask: np.ndarray, min_len: int) -> tuple[np.ndarray, np.ndarray]:
+    """First and one-past-last rows of the runs of True at least `min_len` long (work in proportion
+    to the True rows)."""
     rows = np.flatnonzero(mask)
-    out = np.zeros(mask.shape, dtype=bool)
     if rows.size < min_len:
-        return out
+        return np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)
     breaks = np.flatnonzero(np.diff(rows) > 1)
     starts = rows[np.concatenate(([0], breaks + 1))]
     ends = rows[np.concatenate((breaks, [rows.size - 1]))] + 1
-    for a, b in zip(starts, ends, strict=True):
-        if b - a >= min_len:
-            out[a:b] = True
+    long = ends - starts >= min_len
+    return starts[long], ends[long]
+
+
+def _runs(mask: np.ndarray, min_len: int) -> np.ndarray:
+    """Rows inside runs of True at least `min_len` long."""
+    out = np.zeros(mask.shape, dtype=bool)
+    for a, b in zip(*_run_bounds(mask, min_len), strict=True):
+        out[a:b] = True
     return out
 
 
 def missing(values: np.ndarray) -> np.ndarray:
     """Samples a sensor did not deliver: NaN or infinite, inside a run stuck at exactly zero, or an
     exact zero in a channel that is not quantized (a noisy analogue reading is never exactly 0.0, so
-    a single zero is a glitch; on an ADC's integer counts a zero is a reading like any other)."""
+    a single zero is a glitch; on an ADC's integer counts a zero is a reading like any other).
+
+    On a quantized channel a run of zeros entered and left from one step either side is a reading
+    too: a coarse encoder reads 0 while the position crosses its middle count (a 0.1 mm encoder on a
+    1.85 Hz, 1.5 mm motion for 6 ms, longer at lower frequencies); a stuck sensor jumps to 0.
+    """
     zero = values == 0.0
-    out = ~np.isfinite(values) | _runs(zero, STUCK_SAMPLES)
-    if zero.any() and not _quantized(values):
+    quantized = bool(zero.any()) and _quantized(values)
+    out = ~np.isfinite(values)
+    starts, ends = _run_bounds(zero, STUCK_SAMPLES)
+    if quantized and starts.size:
+        keep = ~_crossing_zero(values, starts, ends)
+        starts, ends = starts[keep], ends[keep]
+    for a, b in zip(starts, ends, strict=True):
+        out[a:b] = True
+    if zero.any() and not quantized:
         out |= zero
     return out
+
+
+def _crossing_zero(values: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """Per zero run of a quantized channel, whether it is entered and left within one quantization
+    step of zero (a reading as the signal passes), not from further away (a sensor dropping to 0).
+    A run at either end of the log is judged by its one neighbour; NaN neighbours tell nothing."""
+    sample = values[:: max(values.size // 2000, 1)]
+    levels = np.unique(sample[np.isfinite(sample)])
+    steps = np.diff(levels)
+    step = float(steps.min()) if steps.size else 0.0
+    n = values.size
+    before = np.where(starts > 0, values[np.maximum(starts - 1, 0)], np.nan)
+    after = np.where(ends < n, values[np.minimum(ends, n - 1)], np.nan)
+    near = 1.5 * step
+    with np.errstate(invalid="ignore"):
+        ok_before = np.isnan(before) | (np.abs(before) <= near)
+        ok_after = np.isnan(after) | (np.abs(after) <= near)
+    return ok_before & ok_after & ~(np.isnan(before) & np.isnan(after)) & (step > 0)
 
 
 def _quantized(values: np.ndarray, probe: int = 2000) -> bool:
