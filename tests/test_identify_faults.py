@@ -279,3 +279,13 @@ def test_an_encoder_of_a_few_steps_to_the_peak_is_refused_naming_it():
 
 def test_an_analogue_position_has_no_encoder():
     assert _one(make_log({"x": X}, duration=60, rate=1000, seed=1)).axes["x"].encoder is None
+
+
+def test_backlash_read_by_a_coarse_encoder_is_still_backlash():
+    """A dead band about one step wide is no artefact of the steps (the encoder alone makes one of
+    under a tenth of a step): named, and k within 1 %."""
+    df = make_log({"x": dict(X, backlash=0.1)}, duration=60, rate=1000, seed=2, position_noise=0.0)
+    df["x"] = np.round(df["x"] / 0.1) * 0.1
+    fit = _one(df).axes["x"]
+    assert fit.departure["name"] == "backlash" and fit.departure["play"] == pytest.approx(0.1, rel=0.15)
+    assert fit.k == pytest.approx(X["k"], rel=0.01)

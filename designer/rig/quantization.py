@@ -12,7 +12,7 @@ as N varies with the amplitude, k seems to depend on the deflection: a "spring".
 N(A) swings with where the peak falls between two steps, which the reading itself cannot tell
 within half a step; so k and c get the largest |1/N - 1| over peaks within half a step of the
 motion's in their standard errors, and a spring whose secant change lies within the span of
-1/N - 1 over amplitudes from half the peak up, or a dead band under two steps, is the encoder's.
+1/N - 1 over amplitudes from half the peak up, or a dead band under half a step, is the encoder's.
 """
 
 from __future__ import annotations
@@ -65,11 +65,12 @@ class Effect:
 
     def fakes(self, dep: Departure, k: float) -> bool:
         """Whether the encoder's steps alone can make this departure: a spring whose secant change at
-        the peak lies within the span, or a dead band under two steps."""
+        the peak lies within the span, or a dead band under half a step (a 0.1 mm encoder alone made
+        one of 0.008 mm; a real one of 0.1 mm read by it is backlash, k within 0.7 %)."""
         if dep.name == "spring":
             return abs(dep.value) * self.peak**2 / k <= max(abs(self.span[0]), abs(self.span[1]))
         if dep.name == "backlash":
-            return 2 * abs(dep.value) / k < 2 * self.step
+            return 2 * abs(dep.value) / k < self.step / 2
         return False
 
 
