@@ -289,3 +289,35 @@ def test_backlash_read_by_a_coarse_encoder_is_still_backlash():
     fit = _one(df).axes["x"]
     assert fit.departure["name"] == "backlash" and fit.departure["play"] == pytest.approx(0.1, rel=0.15)
     assert fit.k == pytest.approx(X["k"], rel=0.01)
+
+
+@pytest.mark.parametrize(
+    "column, course, size",
+    [
+        ("x", lambda t: 1.0 * (1 - np.exp(-t / 10)), 1.0),  # a displacement sensor warming up: 1 mm
+        ("x", lambda t: 0.5 * np.sin(2 * np.pi * t / 45) + 0.3 * np.sin(2 * np.pi * t / 17), 1.0),
+        ("Fx", lambda t: 0.5 * (1 - np.exp(-t / 10)), 0.5),  # a load cell's zero creeping: 0.5 N
+    ],
+)
+def test_a_sensor_offset_drifting_below_the_band_is_named_and_filtered_out(column, course, size):
+    """An offset that drifts along a curve (the fit models a constant and a straight line) stays in
+    one channel: it gave k 4-45 % low with no warning, or "k drifts as a warm-up" (a material's
+    name). Now the column is named and both channels are high-passed alike below the band."""
+    df = make_log({"x": X}, duration=60, rate=1000, seed=2)
+    df[column] = df[column] + course(df["t"].to_numpy())
+    res = _one(df)
+    fit = res.axes["x"]
+    assert fit.sensor_drift["column"] == column and fit.departure is None
+    assert any(
+        w.startswith(f"x: the offset of '{column}' drifts below the excitation band") for w in res.warnings
+    )
+    assert not any("k drifts" in w for w in res.warnings)
+    assert abs(fit.k - X["k"]) < 2 * fit.k_se and fit.k == pytest.approx(X["k"], rel=0.01)
+    assert abs(fit.c - X["c"]) < 2 * fit.c_se and fit.c == pytest.approx(X["c"], rel=0.05)
+    assert 0.2 * size < fit.sensor_drift["span"] < 2 * size
+
+
+def test_a_k_warming_up_is_no_sensor_drift():
+    """A drift of the joint's own k leaves its residual at the motion's frequencies, not below."""
+    res = _one(make_log({"x": dict(X, drift=-0.05, drift_tau=12.0)}, duration=60, rate=1000, seed=1))
+    assert res.axes["x"].sensor_drift is None and res.axes["x"].departure["name"] == "drift"

@@ -36,7 +36,7 @@ import numpy as np
 from .. import units
 from ..mass import specimen_mass
 from . import band as bandlib
-from . import channel, departures, plausibility, quantization, saturation
+from . import channel, departures, plausibility, quantization, saturation, sensor_drift
 from .logs import LOAD, UNITS, RigLog, missing
 from .nonlinear import amplitude_table, frequency_table
 from .regress import solve
@@ -120,6 +120,8 @@ class AxisFit:
     #: a coarse position encoder's share of the fit (`quantization.Effect.to_dict()`), or None; k_se
     #: and c_se include its shifts, and the departures are tested net of it
     encoder: dict | None
+    #: a sensor offset drifting below the band (`sensor_drift.Drift.to_dict()`), filtered out, or None
+    sensor_drift: dict | None
     warnings: list[str] = field(default_factory=list)
 
     def mass(self) -> float | None:
@@ -261,13 +263,19 @@ def _fit(spec: bandlib.Spectra, pass_edge: float, correct, *, skew_s: float | No
 
 
 def _checked(log: RigLog, axis: str, load_delay_s: float, load_filter: channel.LoadFilter | None):
-    """Spectra, the main filtered channels and fit, the load correction and any unknown low-pass of
-    one axis; raise AxisFailed when the sampling is too slow or the fit impossible."""
+    """Spectra, the main filtered channels and fit, the load correction, any unknown low-pass of
+    one axis and a drifting sensor offset (`sensor_drift`: both channels then high-passed and fitted
+    again); raise AxisFailed when the sampling is too slow or the fit impossible."""
     spec = _spectra(log, axis)
     top = spec.band.high
     scale = spec.scale_f / spec.scale_r
     correct = channel.correction(load_delay_s, load_filter)
     ch, main = _fit(spec, PASS_EDGES[0] * top, correct, skew_s=1.0 / log.rate)
+    drift = None
+    ratio = sensor_drift.residual_ratio(ch, _design(ch)[0], main.beta, top)
+    if ratio > sensor_drift.RATIO:
+        spec, drift = sensor_drift.remove(spec, ratio, axis, float(main.beta[2]) * scale)
+        ch, main = _fit(spec, PASS_EDGES[0] * top, correct, skew_s=1.0 / log.rate)
     if log.rate < MIN_RATE_OVER_BAND * top:
         raise AxisFailed(
             f"sampling rate {log.rate:.4g} Hz is under {MIN_RATE_OVER_BAND:g} x the highest excitation "
@@ -288,7 +296,7 @@ def _checked(log: RigLog, axis: str, load_delay_s: float, load_filter: channel.L
     unit_error = plausibility.scale_failure(axis, k, spec.scale_r, spec.scale_f, log.factors)
     if unit_error is not None:
         raise AxisFailed(unit_error)
-    return spec, ch, main, correct, lag
+    return spec, ch, main, correct, lag, drift
 
 
 def _impossible_cause(log: RigLog, axis: str, k: float, c: float, spec: bandlib.Spectra) -> str:
@@ -347,7 +355,7 @@ def fit_axis(
     `load_delay_s` and `load_filter`: the load channel's known delay and low-pass, undone exactly.
     When friction or a drift of k is detected (`departures`), m, c, k come from the model with it.
     """
-    spec, ch, main, correct, lag = _checked(log, axis, load_delay_s, load_filter)
+    spec, ch, main, correct, lag, drift = _checked(log, axis, load_delay_s, load_filter)
     scale = spec.scale_f / spec.scale_r
     x, noise = _design(ch)
     tests = departures.test(spec, ch, x, noise, _lags(ch), scale)
@@ -404,8 +412,11 @@ def fit_axis(
         departures={name: d.to_dict() for name, d in tests.items()},
         departure=None if found is None else departures.describe(found, main, scale, spec, axis, freq.rows),
         encoder=None if encoder is None else encoder.to_dict(),
+        sensor_drift=None if drift is None else drift.to_dict(),
     )
     fit.warnings.extend(plausibility.range_warnings(axis, spec.scale_r, spec.scale_f))
+    if drift is not None:
+        fit.warnings.append(sensor_drift.describe(drift, axis))
     faked = [d for d in faked if abs(d.z) > departures.Z_CRIT]
     named = encoder is not None and (bool(faked) or k * bias > k_se or c * bias > c_se)
     if named:  # the encoder's steps also vary k and c over the bands: its sentence says so
