@@ -321,3 +321,10 @@ def test_a_k_warming_up_is_no_sensor_drift():
     """A drift of the joint's own k leaves its residual at the motion's frequencies, not below."""
     res = _one(make_log({"x": dict(X, drift=-0.05, drift_tau=12.0)}, duration=60, rate=1000, seed=1))
     assert res.axes["x"].sensor_drift is None and res.axes["x"].departure["name"] == "drift"
+
+
+def test_a_still_axis_on_an_encoder_flickering_by_a_count_is_still_not_too_coarse():
+    df = make_log({"x": X, "y": dict(X, still=True)}, duration=30, rate=500, seed=1)
+    df["y"] = np.round(np.random.default_rng(0).normal(0, 0.004, len(df)) / 0.01) * 0.01
+    res = _one(df)
+    assert list(res.axes) == ["x"] and "y" in res.still and not res.failures

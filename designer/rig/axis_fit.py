@@ -173,9 +173,6 @@ def _spectra(log: RigLog, axis: str) -> bandlib.Spectra:
             + ": the fit is refused (a fit through clipped peaks reads them as a softening spring); "
             "record with a sensor range above the peak, or a smaller amplitude"
         )
-    encoder = quantization.effect(r)
-    if encoder is not None and (coarse := quantization.too_coarse(encoder, axis)) is not None:
-        raise AxisFailed(coarse)
     valid = 1.0 - log.missing_fraction.get(LOAD[axis], float(missing(f).mean()))
     if valid < MIN_VALID:
         raise AxisFailed(
@@ -195,6 +192,9 @@ def _spectra(log: RigLog, axis: str) -> bandlib.Spectra:
         spec = bandlib.spectra(r, f, log.dropouts[axis], log.rate, 1)
     if spec.band is None or not np.isfinite([spec.scale_r, spec.scale_f]).all():
         raise StillAxis(f"no motion on {axis}: the position is constant, only noise, or not finite")
+    encoder = quantization.effect(r)  # after the still test: an encoder flickering by a count is still
+    if encoder is not None and (coarse := quantization.too_coarse(encoder, axis)) is not None:
+        raise AxisFailed(coarse)
     return spec
 
 
