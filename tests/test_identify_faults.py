@@ -328,3 +328,15 @@ def test_a_still_axis_on_an_encoder_flickering_by_a_count_is_still_not_too_coars
     df["y"] = np.round(np.random.default_rng(0).normal(0, 0.004, len(df)) / 0.01) * 0.01
     res = _one(df)
     assert list(res.axes) == ["x"] and "y" in res.still and not res.failures
+
+
+def test_rows_a_logger_dropped_are_noted_with_where_and_how_many():
+    """300 ms of rows missing used to pass without a word (k and c right, the user never told)."""
+    df = make_log({"x": X}, duration=60, rate=1000, seed=1)
+    t = df["t"].to_numpy()
+    res = _one(df[(t < 20.0) | (t >= 20.3)].reset_index(drop=True))
+    assert res.notes == [
+        "t has 1 gap (the longest 0.301 s, after row 20000; about 300 samples missing): the rows around "
+        "each are left out of the fit"
+    ]
+    assert res.warnings == [] and res.axes["x"].k == pytest.approx(X["k"], rel=0.01)

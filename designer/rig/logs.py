@@ -411,7 +411,20 @@ def _time_step(cols: dict[str, np.ndarray], source: str, notes: list[str]) -> tu
             f"(interval {dt[row - 2]:g} s against {step:g} s)",
             "resample the log to a constant rate",
         )
+    if gaps.any():
+        notes.append(_gaps_note(dt, gaps, step))
     return step, gaps
+
+
+def _gaps_note(dt: np.ndarray, gaps: np.ndarray, step: float) -> str:
+    """The note on time gaps: how many, the longest with its row, and the samples missing."""
+    rows = np.flatnonzero(gaps)
+    longest = int(rows[np.argmax(dt[rows])])
+    lost = int(np.round(dt[rows] / step).sum()) - rows.size
+    return (
+        f"t has {rows.size} gap{'s' if rows.size > 1 else ''} (the longest {dt[longest]:.3g} s, after row "
+        f"{longest + 1}; about {lost} samples missing): the rows around each are left out of the fit"
+    )
 
 
 #: timestamps count as a coarse clock's when they spread at most this many resolutions about a
