@@ -25,7 +25,7 @@ from ..files import atomic_path, atomic_write
 from ..keys import check_keys
 from ..study import space
 from ..study.data import is_parquet
-from . import channel, saturation
+from . import channel, log_header, saturation
 
 #: the load column of each axis
 LOAD: dict[str, str] = {
@@ -506,62 +506,12 @@ def _read_frame(p: Path) -> tuple[pd.DataFrame, list[str]]:
 
     check_table_file(p, parquet=is_parquet(p))
     if not is_parquet(p):  # by path: from an open file pandas decodes through Python, at 1.35x the CPU
-        comments = _comment_lines(p)
+        comments = log_header.comment_lines(p)
         return pd.read_csv(p, engine="c", skiprows=len(comments)), comments
     # opened here: pyarrow refuses a path with bytes that are not UTF-8 (log\xff.csv), a file it reads
     with open(p, "rb") as fh:
         table = pq.read_table(fh)
     return table.to_pandas(split_blocks=True, self_destruct=True), []
-
-
-#: the most comment lines read above a CSV log's header row
-MAX_COMMENT_LINES = 200
-#: a sampling rate stated in a comment: "sample_rate: 1000 Hz", "Sampling rate (Hz) = 1000", "fs=1 kHz",
-#: "rate_hz: 500" (a bare "rate" only with Hz, as a strain rate is a rate too)
-_RATE_RE = re.compile(
-    r"(?i)\b(?P<key>sampl(?:e|ing)[ _-]?(?:rate|frequency)|fs|rate)(?:[ _-]?\(?(?P<u1>k?hz)\)?)?"
-    r"\s*[:=]?\s*(?P<value>[0-9]+(?:\.[0-9]*)?(?:e[+-]?[0-9]+)?)\s*(?P<u2>k?hz\b)?"
-)
-#: the stated and the logged rate may differ by this fraction (a clock's error is ppm; rounding of t)
-RATE_TOLERANCE = 0.01
-
-
-def _comment_lines(p: Path) -> list[str]:
-    """The lines starting with '#' above a CSV log's header row (a logger's metadata), as text."""
-    out = []
-    with open(p, encoding="utf-8-sig", errors="replace") as fh:
-        for line in fh:
-            if not line.lstrip().startswith("#") or len(out) >= MAX_COMMENT_LINES:
-                break
-            out.append(line.rstrip("\r\n"))
-    return out
-
-
-def stated_rate(comments: list[str]) -> tuple[float, str] | None:
-    """The sampling rate (Hz) a log's comment lines state, with the line that states it; None if none."""
-    for line in comments:
-        for m in _RATE_RE.finditer(line):
-            unit = (m["u1"] or m["u2"] or "").lower()
-            if m["key"].lower() == "rate" and not unit:
-                continue
-            value = float(m["value"]) * (1e3 if unit == "khz" else 1.0)
-            if value > 0:
-                return value, line.strip()
-    return None
-
-
-def _check_stated_rate(log: RigLog, comments: list[str], source: str) -> None:
-    """Refuse a log whose header states a sampling rate its time column does not have: one of them
-    is wrong, and c scales with the time base (k does not), so no fit can be trusted."""
-    stated = stated_rate(comments)
-    if stated is None or abs(stated[0] / log.rate - 1.0) <= RATE_TOLERANCE:
-        return
-    rate, line = stated
-    raise DesignerError(
-        f"{source}: the header states {rate:.6g} Hz ('{line[:80]}') but the time column 't' is sampled at "
-        f"{log.rate:.6g} Hz; one of them is wrong, and c scales with the time base (k does not)",
-        "correct the header or the t column (t = row index / the true rate), then identify again",
-    )
 
 
 def read_log(path: str | Path) -> RigLog:
@@ -578,7 +528,7 @@ def read_log(path: str | Path) -> RigLog:
         raise DesignerError(f"cannot read {p}: {first}", "give a CSV or Parquet rig log") from None
     factors, delay, lowpass = _read_sidecar(p)
     log = validate_frame(raw, source=p.name, factors=factors, path=p)
-    _check_stated_rate(log, comments, p.name)
+    log_header.check_stated_rate(log.rate, comments, p.name)
     log.load_delay_s, log.load_filter = delay, lowpass
     return log
 
