@@ -111,3 +111,38 @@ def test_calibrated_page_shows_your_prints_and_the_calibrated_figures(calibrated
         # at the design of the first print, that print is drawn in every panel of k
         assert page.js("document.querySelectorAll('#panels-k_x path.mine').length") >= 6
         _check_k(page, sur, ("k_x", "c_x"))
+
+
+def test_command_lines_of_a_calibrated_page_answer_from_its_surrogate(calibrated):
+    """The remembered design's export command and maximize's suggest command name the page's
+    surrogate: without `--surrogate mine.json` they answered from the study's (export gave k 0.633
+    N/mm at the opening design where the page showed 0.494, and had no such flag)."""
+    import json
+    import shlex
+
+    exe = cdp.find_browser()
+    if exe is None:
+        pytest.skip("no headless Chromium on this machine")
+    cli = str(Path(sys.executable).with_name("designer"))
+    with cdp.Browser(exe) as browser:
+        page = browser.new_page()
+        page.goto((calibrated / "p.html").resolve().as_uri())
+        shown = float(page.js("document.getElementById('pred-k_x').dataset.value"))
+        page.click("#remember")
+        page.click("#copy-cmd-1")
+        export = shlex.split(page.js("document.getElementById('export-text').value"))
+        page.click("#lock-height")
+        page.click("#maximize")
+        status = page.js("Object.assign({}, document.getElementById('max-status').dataset)")
+        said = page.js("document.getElementById('max-status').textContent")
+    assert export[:3] == ["designer", "export", "fmu"] and "--surrogate" in export
+    run = subprocess.run([cli, *export[1:], "--json"], capture_output=True, text=True, cwd=calibrated)
+    assert run.returncode == 0, run.stderr
+    assert json.loads(run.stdout)["joint"]["axes"]["x"]["rig"]["k"] == pytest.approx(shown, rel=1e-9)
+    suggest = shlex.split(said.split("the same search as: ")[1])
+    assert suggest[:2] == ["designer", "suggest"] and "--surrogate" in suggest
+    run = subprocess.run([cli, *suggest[1:], "--json"], capture_output=True, text=True, cwd=calibrated)
+    assert run.returncode in (0, 1), run.stderr
+    best = json.loads(run.stdout)["candidates"][0]
+    assert best["params"] == pytest.approx(json.loads(status["design"]), abs=1e-9)
+    assert best["p_within"] == pytest.approx(float(status["p"]), rel=1e-9)

@@ -21,6 +21,7 @@ from __future__ import annotations
 import html
 import json
 import math
+import shlex
 from collections.abc import Mapping
 from dataclasses import dataclass
 from importlib import resources
@@ -35,7 +36,7 @@ from ..errors import DesignerError
 from ..files import atomic_write
 from ..model.forms import columns
 from ..model.prediction import ResponseSurface
-from ..model.surrogate import Surrogate
+from ..model.surrogate import Surrogate, default_path
 from ..study import space
 
 #: the design the page opens at unless told otherwise (the study's centre, layer 0.16 mm, raster 0 deg)
@@ -324,6 +325,17 @@ def _calibrated(surrogate: Surrogate, responses: list[dict[str, Any]]) -> dict[s
     }
 
 
+def _surrogate_flag(surrogate: Surrogate, surrogate_file: str | Path | None) -> str:
+    """The `--surrogate FILE` the page's command lines (suggest, export) carry, "" for the shipped
+    surrogate: without it they would answer from the study's surrogate, not the page's. A surrogate
+    of no known file is named by its id in a form no shell runs unchanged."""
+    if surrogate_file is not None:
+        return "--surrogate " + shlex.quote(str(surrogate_file))
+    if surrogate.id == json.loads(default_path().read_text(encoding="utf-8")).get("id"):
+        return ""
+    return f"--surrogate <the file of surrogate {surrogate.id}>"
+
+
 def _factors() -> list[dict[str, Any]]:
     """The six factors as the page's sliders and boxes read them."""
     return [
@@ -350,6 +362,7 @@ def build_profiler(
     tolerance: float | None = None,
     suggestion: Any = None,
     design: Mapping[str, float] | None = None,
+    surrogate_file: str | Path | None = None,
 ) -> Profiler:
     """Gather what the profiler page needs for k and c of one axis.
 
@@ -362,6 +375,8 @@ def build_profiler(
         suggestion: a `Suggestion`, its `to_dict()` or the path of a JSON file of it (what the
             suggest command writes with its JSON option).
         design: factors the page opens at (the rest from `DEFAULT_DESIGN`), within the tested ranges.
+        surrogate_file: the file `surrogate` was read from, as a shell in the user's folder reaches
+            it: the page's suggest and export command lines carry `--surrogate` with it.
 
     Raises:
         DesignerError: unknown axis, quantity or factor; a value outside the tested ranges; a
@@ -402,6 +417,7 @@ def build_profiler(
         {
             "axis": axis,
             "surrogate_id": surrogate.id,
+            "surrogate_flag": _surrogate_flag(surrogate, surrogate_file),
             "factors": _factors(),
             "design": start,
             "responses": responses,

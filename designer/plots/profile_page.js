@@ -182,7 +182,7 @@ function suggestCommand() {
   const set = R.filter((r) => goals[r.name]);
   if (set.some((r) => goals[r.name].kind === "limits")) return "no designer suggest command: it takes a target \u00b1 --tolerance, not low and high limits (the search aimed at the limits' midpoint)";
   return "the same search as: designer suggest " + set.map((r) => "--" + r.quantity + " " + (goals[r.name].kind === "target" ? sig(goals[r.name].value, 6) : goals[r.name].kind)).join(" ") +
-    (D.axis === "x" ? "" : " --axis " + D.axis) + F.filter((f) => locked[f.name]).map((f) => " --fix " + f.name + "=" + sig(state[f.name], 6)).join("") +
+    (D.axis === "x" ? "" : " --axis " + D.axis) + surrogateFlag() + F.filter((f) => locked[f.name]).map((f) => " --fix " + f.name + "=" + sig(state[f.name], 6)).join("") +
     (Math.abs(tolerance - 0.1) > 1e-12 ? " --tolerance " + sig(100 * tolerance, 4) : "");
 }
 function runMaximize() {

@@ -94,8 +94,10 @@ function remember() {
   saveMemory();
 }
 function saveMemory() { try { localStorage.setItem(KEY, JSON.stringify(memory)); } catch (e) { /* a private window: this page only */ } renderMemory(); }
+// the page's surrogate on a command line (" --surrogate mine.json"), "" for the shipped one
+function surrogateFlag() { return D.surrogate_flag ? " " + D.surrogate_flag : ""; }
 function commandLine(m, i) {
-  return "designer export fmu " + F.map((f) => "--" + f.name + " " + sig(m.params[f.name], 6)).join(" ") + (D.axis === "x" ? "" : " --axis " + D.axis) + " -o joint" + (i + 1) + ".fmu";
+  return "designer export fmu " + F.map((f) => "--" + f.name + " " + sig(m.params[f.name], 6)).join(" ") + (D.axis === "x" ? "" : " --axis " + D.axis) + surrogateFlag() + " -o joint" + (i + 1) + ".fmu";
 }
 function suggestionJson() {
   const goal = (q) => { const r = R.find((x) => x.quantity === q), g = r && goals[r.name]; return !g ? null : g.value !== null ? g.value : g.kind; };
