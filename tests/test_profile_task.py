@@ -261,6 +261,28 @@ def test_a_bad_goal_is_an_error_beside_its_box(page, typed, said):
     assert "fix the goal of k_x" in page.js("document.getElementById('max-why').textContent")
 
 
+def test_a_goal_typed_in_si_units_is_named_as_suggest_names_it(page):
+    """k 800 and c 2 typed where N/mm and N.s/mm are asked (values in N/m, N.s/m): the page said
+    only "out of reach" and "probability 0.00", where `designer suggest` names the slip and the
+    value meant; the page now says suggest's words."""
+    said = {}
+    for response, value, flag in (("k_x", "800", "--k"), ("c_x", "2", "--c")):
+        page.js(
+            f"(() => {{ const s = document.getElementById('goal-kind-{response}');"
+            " s.value = 'target'; s.dispatchEvent(new Event('change')); })()"
+        )
+        page.js(f"document.getElementById('goal-value-{response}').focus()")
+        type_keys(page, value)
+        said[response] = page.js(f"document.getElementById('tgt-{response}').textContent")
+        _, want = _suggest(*(["--k", "0.8"] if flag == "--c" else []), flag, value)
+        hint = [s for s in want["statements"] if "rather than" in s]
+        assert hint, want["statements"]
+        named = hint[0][hint[0].index(" (a value in") : hint[0].index(")", hint[0].index(" (a value in")) + 1]
+        assert named in said[response], (named, said[response])
+    assert "(a value in N/m rather than N/mm? that is k=0.8 N/mm)" in said["k_x"]
+    assert "(a value in N.s/m rather than N.s/mm? that is c=0.002 N.s/mm)" in said["c_x"]
+
+
 def test_k_3_is_out_of_reach_as_suggest_says_and_old_suggestions_grey(browser, folder):
     page = _open(browser, folder / "s.html")
     assert page.js(

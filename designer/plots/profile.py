@@ -35,6 +35,7 @@ from .. import units
 from ..errors import DesignerError
 from ..files import atomic_write
 from ..model.forms import columns
+from ..model.plausibility import SLIP_TOLERANCE, unit_slip
 from ..model.prediction import ResponseSurface
 from ..model.surrogate import Surrogate, default_path
 from ..study import space
@@ -160,6 +161,18 @@ def _value_range(model: ResponseSurface, observed: np.ndarray, target: float | N
     return [max(lo - pad, 0.0) if lo >= 0 else lo - pad, hi + pad]
 
 
+def _slips(quantity: str, axis: str) -> list[dict[str, Any]]:
+    """The unit slips a typed goal may carry (a value in N/m typed for N/mm), as `designer suggest`
+    names them: each with the ratio to the measured range it shows as, its cause and the multiplier
+    that corrects it; a goal within `SLIP_TOLERANCE` of that ratio is named on the page as by suggest."""
+    out = []
+    for ratio in (1e3, 1e-3):
+        slip = unit_slip(quantity, axis, ratio, logged=False)
+        if slip:
+            out.append({"ratio": ratio, "cause": slip[0], "multiplier": slip[1], "within": SLIP_TOLERANCE})
+    return out
+
+
 def _target(surrogate: Surrogate, quantity: str, axis: str, goal: float | str) -> dict[str, Any]:
     """A goal (a target value, "min" or "max") with its desirability bounds, as `designer suggest`
     sets them."""
@@ -190,6 +203,7 @@ def _response(surrogate: Surrogate, name: str, statement: str, target: float | s
         "accuracy": _accuracy(model),
         "range": _value_range(model, observed, target if isinstance(target, float | int) else None),
         "observed": [float(v) for v in model.observed_range],
+        "slips": _slips(model.quantity, model.axis),
         "target": None if target is None else _target(surrogate, model.quantity, model.axis, target),
     }
 

@@ -73,6 +73,16 @@ function reachRange(r) {
   if (!c || c.key !== key) reachCache[r.name] = { key: key, range: predictedRange(r) };
   return reachCache[r.name].range;
 }
+// designer suggest's hint when a target lies about a unit's thousand from a range (its geometric
+// middle): " (a value in N/m rather than N/mm? that is k=0.8 N/mm)", else ""
+function slipHint(r, value, range) {
+  const ratio = value / Math.sqrt(range[0] * range[1]);
+  for (const s of r.slips) {
+    if (Math.abs(Math.log10(ratio) - Math.log10(s.ratio)) < Math.log10(s.within))
+      return " (" + s.cause + "? that is " + r.quantity + "=" + sig(value * s.multiplier, 6) + " " + r.unit + ")";
+  }
+  return "";
+}
 // designer suggest's statement when no design reaches a goal, or null when one does
 function outOfReach(r, g) {
   const l = limitsOf(g);
@@ -82,7 +92,8 @@ function outOfReach(r, g) {
   const held = Object.keys(searchBox().fixed);
   const what = g.kind === "target" ? r.quantity + " = " + sig(g.value, 6) + " " + r.unit + " is out of reach within \u00b1" + sig(100 * tolerance, 3) + " %"
     : r.quantity + " between " + sig(g.lsl, 6) + " and " + sig(g.usl, 6) + " " + r.unit + " is out of reach";
-  return what + ": over the tested ranges" + (held.length ? " (holding " + held.join(", ") + ")" : "") + " the surrogate predicts " + r.name + " from " + sig(lo, 3) + " to " + sig(hi, 3) + " " + r.unit;
+  return what + ": over the tested ranges" + (held.length ? " (holding " + held.join(", ") + ")" : "") + " the surrogate predicts " + r.name + " from " + sig(lo, 3) + " to " + sig(hi, 3) + " " + r.unit +
+    (g.kind === "target" ? slipHint(r, g.value, r.observed) : "");
 }
 function goalText(r, p, prob) {
   const g = goals[r.name];
@@ -92,7 +103,8 @@ function goalText(r, p, prob) {
     return "P(" + limitsText(r, g) + ") = " + pct(prob) + " here: your prints pin " + r.name + " down near the designs you printed (not predictable from the six factors elsewhere; maximize does not act on it)";
   if (!r.predictable) {
     if (!limitsOf(g)) return "goal " + g.kind + ": cannot be acted on, no setting changes it";
-    return r.name + " is not predictable: any design lands within " + limitsText(r, g) + " with probability " + prob.toFixed(2) + "; no setting can be chosen for it from this data";
+    const hint = g.kind === "target" && (g.value < p.low || g.value > p.high) ? slipHint(r, g.value, [p.low, p.high]) : "";
+    return r.name + " is not predictable: any design lands within " + limitsText(r, g) + hint + " with probability " + prob.toFixed(2) + "; no setting can be chosen for it from this data";
   }
   const d = desirability(g, p.value);
   if (!limitsOf(g)) return g.kind + " (desirability bounds " + sig(g.low, 3) + " to " + sig(g.high, 3) + " " + r.unit + "): desirability " + d.toFixed(2);
