@@ -3,6 +3,7 @@ evaluates the calibration itself and must print what the library predicts, to 1e
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -146,3 +147,35 @@ def test_command_lines_of_a_calibrated_page_answer_from_its_surrogate(calibrated
     best = json.loads(run.stdout)["candidates"][0]
     assert best["params"] == pytest.approx(json.loads(status["design"]), abs=1e-9)
     assert best["p_within"] == pytest.approx(float(status["p"]), rel=1e-9)
+
+
+def test_suggestion_of_another_surrogate_is_greyed(calibrated):
+    """A calibrated page opened with the study's suggestion showed its buttons live ("#1, P 37 %")
+    while the page, at that very design, computed P for the calibrated model; they are greyed and
+    say which surrogate found them."""
+    exe = cdp.find_browser()
+    if exe is None:
+        pytest.skip("no headless Chromium on this machine")
+    cli = str(Path(sys.executable).with_name("designer"))
+    run = subprocess.run(
+        [cli, "suggest", "--k", "0.8", "--json"], capture_output=True, text=True, cwd=calibrated
+    )
+    assert run.returncode == 0, run.stderr
+    (calibrated / "study.json").write_text(run.stdout)
+    args = ["profile", "--surrogate", "mine.json", "--suggestion", "study.json", "-o", "mixed.html"]
+    run = subprocess.run([cli, *args], capture_output=True, text=True, cwd=calibrated)
+    assert run.returncode == 0, run.stderr
+    study, mine = Surrogate.load().id, Surrogate.load(calibrated / "mine.json").id
+    with cdp.Browser(exe) as browser:
+        page = browser.new_page()
+        page.goto((calibrated / "mixed.html").resolve().as_uri())
+        buttons = page.js(
+            "[...document.querySelectorAll('#suggestions button')].map(b => [b.dataset.stale,"
+            " b.querySelector('.stale-why').textContent])"
+        )
+        p_page = float(page.js("document.getElementById('tgt-k_x').dataset.probability"))
+    assert buttons and all(
+        s == "true" and f"found with surrogate {study}, not this page's {mine}" in t for s, t in buttons
+    )
+    p_button = json.loads((calibrated / "study.json").read_text())["candidates"][0]["p_within"]
+    assert abs(p_page - p_button) > 0.01  # the button's P was never this page's

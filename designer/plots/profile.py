@@ -269,8 +269,9 @@ def _suggestions(suggestion: Any) -> list[dict[str, Any]]:
 
 
 def _suggestion_goals(suggestion: Any) -> dict[str, Any] | None:
-    """The goals and tolerance a suggestion was found for (its buttons grey out once the page's
-    goals differ), or None when it does not record them."""
+    """The goals, tolerance and surrogate id a suggestion was found for (its buttons grey out once
+    the page's goals differ, or when the page shows another surrogate), or None when it does not
+    record goals and tolerance."""
     if suggestion is None:
         return None
     data = _suggestion_dict(suggestion)
@@ -282,7 +283,12 @@ def _suggestion_goals(suggestion: Any) -> dict[str, Any] | None:
     for q in ("k", "c"):
         v = targets.get(q)
         goals[q] = float(v) if isinstance(v, int | float) else v if v in ("min", "max") else None
-    return {"targets": goals, "tolerance": float(tol)}
+    found_with = data.get("surrogate_id")
+    return {
+        "targets": goals,
+        "tolerance": float(tol),
+        "surrogate_id": found_with if isinstance(found_with, str) else None,
+    }
 
 
 def _within(f: space.Factor, v: float) -> bool:

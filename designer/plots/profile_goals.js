@@ -115,10 +115,13 @@ function goalText(r, p, prob) {
 function pct(p) { return (100 * p).toFixed(p < 0.1 ? 1 : 0) + " %"; }
 // the goal as the suggestion file records it: a number, "min", "max", "limits" or null
 function goalKey(g) { return !g ? null : g.kind === "target" ? g.value : g.kind; }
-// a suggestion found for other goals (or another tolerance) than the page's now: greyed, and says so
+// a suggestion found with another surrogate, or for other goals (or another tolerance) than the
+// page's now: greyed, and says so
 function suggestionStale() {
   const sg = D.suggestion_goals;
   if (!sg) return null;
+  if (sg.surrogate_id && sg.surrogate_id !== D.surrogate_id)
+    return "found with surrogate " + sg.surrogate_id + ", not this page's " + D.surrogate_id + ": its P is not this surrogate's";
   const diff = [];
   for (const r of R) {
     if (!r.predictable) continue;
