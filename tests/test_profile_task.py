@@ -261,6 +261,48 @@ def test_a_bad_goal_is_an_error_beside_its_box(page, typed, said):
     assert "fix the goal of k_x" in page.js("document.getElementById('max-why').textContent")
 
 
+@pytest.mark.parametrize(
+    ("typed", "said"),
+    [
+        ("5,5", "has a comma: write the decimal point as '.' (5.5)"),
+        ("", "empty"),
+        ("0", "between 0 and 100 %"),
+    ],
+)
+def test_a_bad_tolerance_computes_nothing_for_the_old_one(page, typed, said):
+    """The tolerance box showed its error but P, the band, the defect rate and Maximize went on with
+    the old tolerance (5 %: "P(k_x +-5 % ...) 19 %" beside a box saying "5,5"); as a bad goal does,
+    it now leaves the targets without a P and Maximize greyed with the reason."""
+    page.js("document.getElementById('goal-kind-k_x').focus()")
+    choose(page, "goal-kind-k_x", "target")
+    press(page, "Tab")
+    type_keys(page, "0.8")
+    page.js("document.getElementById('tolerance').focus()")
+    type_keys(page, "5")
+    assert float(page.js("document.getElementById('tgt-k_x').dataset.probability")) > 0
+    assert page.js("document.querySelectorAll('rect.band').length") == 6
+    type_keys(page, typed)
+    if not typed:  # emptied: selected, then Backspace
+        for kind in ("rawKeyDown", "keyUp"):
+            page.call(
+                "Input.dispatchKeyEvent",
+                type=kind,
+                key="Backspace",
+                code="Backspace",
+                windowsVirtualKeyCode=8,
+            )
+    assert said in page.js("document.getElementById('tol-err').textContent")
+    assert page.js("document.getElementById('tolerance').getAttribute('aria-invalid')") == "true"
+    assert page.js("document.getElementById('tgt-k_x').dataset.probability") is None
+    assert said in page.js("document.getElementById('tgt-k_x').textContent")
+    assert page.js("document.getElementById('overall').dataset.probability") is None
+    assert page.js("document.querySelectorAll('rect.band').length") == 0
+    assert page.js("document.querySelectorAll('#sim [data-defect]').length") == 0
+    assert page.js("document.getElementById('maximize').disabled")
+    assert "fix the tolerance" in page.js("document.getElementById('max-why').textContent")
+    assert "tolerance error" in page.js("document.getElementById('readout').textContent")
+
+
 def test_a_goal_typed_in_si_units_is_named_as_suggest_names_it(page):
     """k 800 and c 2 typed where N/mm and N.s/mm are asked (values in N/m, N.s/m): the page said
     only "out of reach" and "probability 0.00", where `designer suggest` names the slip and the

@@ -1,12 +1,13 @@
 // ---- goals set on the page: typed numbers read strictly, errors shown beside their box ----
 const goalError = {}; // response name -> the message shown beside its goal, or absent
 const reachCache = {}; // response name -> { key, range }: the predicted range over the search box
-// a number as typed: digits with a decimal point and an optional exponent; a comma is named, never misread
-function parseTyped(text) {
+// a number as typed: digits with a decimal point and an optional exponent; a comma is named, never misread;
+// `example` is a number the box takes, for the message
+function parseTyped(text, example = "0.8") {
   const t = String(text).trim();
   if (t === "") return { error: "empty: type a number" };
   if (/^[+-]?\d*,\d+$/.test(t)) return { error: "'" + t + "' has a comma: write the decimal point as '.' (" + t.replace(",", ".") + ")" };
-  if (!/^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$/.test(t)) return { error: "'" + t + "' is not a number: type e.g. 0.8" };
+  if (!/^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$/.test(t)) return { error: "'" + t + "' is not a number: type e.g. " + example };
   return { value: parseFloat(t) };
 }
 // a goal number of response r as designer.design.targets.make_target accepts it: positive (a low limit
@@ -99,6 +100,7 @@ function goalText(r, p, prob) {
   const g = goals[r.name];
   if (goalError[r.name]) return "no goal: " + goalError[r.name];
   if (!g) return "";
+  if (g.kind === "target" && toleranceError) return "no P: " + toleranceError;
   if (!r.predictable && r.calibrated && limitsOf(g))
     return "P(" + limitsText(r, g) + ") = " + pct(prob) + " here: your prints pin " + r.name + " down near the designs you printed (not predictable from the six factors elsewhere; maximize does not act on it)";
   if (!r.predictable) {

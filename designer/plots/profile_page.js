@@ -61,7 +61,7 @@ function buildControls() {
 // a factor value typed into its box: read strictly, rounded to the printable step and clamped to the
 // tested range; what was changed is said beside the box
 function typeValue(f, box) {
-  const msg = document.getElementById("e-" + f.name), n = parseTyped(box.value);
+  const msg = document.getElementById("e-" + f.name), n = parseTyped(box.value, sig(f.low + 0.5 * (f.high - f.low), 3));
   if (n.error) { msg.textContent = f.name + ": " + n.error; box.setAttribute("aria-invalid", "true"); return; }
   const v = Number((Math.round(n.value / f.step) * f.step).toFixed(6)), clamped = Math.min(f.high, Math.max(f.low, v));
   msg.textContent = clamped !== v ? f.name + " " + sig(n.value, 6) + " " + f.unit + " is outside the tested range " + sig(f.low, 4) + " to " + sig(f.high, 4) + " " + f.unit + ": set to " + sig(clamped, 6) + " " + f.unit :
@@ -113,12 +113,14 @@ function renderReadout(sc) {
   if (out.length) parts.push('<span class="out">' + esc(out.map((t) => t.split(":")[0]).join("; ")) + "</span>");
   const bad = Object.keys(goalError);
   if (bad.length) parts.push('<span class="out">goal error: ' + esc(bad.join(", ")) + "</span>");
+  if (toleranceError) parts.push('<span class="out">tolerance error</span>');
   document.getElementById("readout").innerHTML = parts.join(" ");
 }
 // why maximize cannot run now, or "" when it can
 function maximizeBlocked() {
   const bad = Object.keys(goalError);
   if (bad.length) return "fix the goal of " + bad.join(" and ") + " first";
+  if (toleranceError) return "fix the tolerance first";
   if (!Object.keys(weights()).length) return "set a goal (target, limits, min or max) on a predictable response first";
   return "";
 }
@@ -202,10 +204,12 @@ const tolEl = document.getElementById("tolerance");
 tolEl.value = sig(100 * tolerance, 4);
 tolEl.setAttribute("aria-label", "tolerance around a target, \u00b1 %");
 tolEl.oninput = () => {
-  const n = parseTyped(tolEl.value), err = document.getElementById("tol-err");
+  const n = parseTyped(tolEl.value, "10"), err = document.getElementById("tol-err");
   const bad = n.error ? "tolerance: " + n.error : !(n.value > 0 && n.value < 100) ? "tolerance " + sig(n.value, 6) + " % must lie between 0 and 100 %" : "";
   err.textContent = bad; tolEl.setAttribute("aria-invalid", bad ? "true" : "false");
-  if (!bad) { tolerance = n.value / 100; render(); }
+  toleranceError = bad || null;
+  if (!bad) tolerance = n.value / 100;
+  render();
 };
 document.getElementById("maximize").onclick = runMaximize;
 document.getElementById("remember").onclick = remember;

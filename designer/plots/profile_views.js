@@ -75,7 +75,7 @@ function mcText(o) {
 function renderSim() {
   const el = document.getElementById("sim"), s = simulate(asShown());
   const names = Object.keys(s.responses);
-  if (!names.length) { el.textContent = "set a target on a predictable response to get a defect rate"; return; }
+  if (!names.length) { el.textContent = toleranceError ? "no defect rate: " + toleranceError : "set a target on a predictable response to get a defect rate"; return; }
   el.innerHTML = names.map((n) => {
     const o = s.responses[n];
     return '<div id="sim-' + n + '" data-defect="' + o.defect + '" data-se="' + o.se + '" data-noiseless="' + o.noiseless + '">' + esc(n) + ": defect rate (outside " + limitsText(R.find((r) => r.name === n), goals[n]) + ") " +
