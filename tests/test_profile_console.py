@@ -230,6 +230,26 @@ def test_layout_fits_the_screen(browser, url, tmp_path, width, height):
     page.call("Page.close")
 
 
+@pytest.mark.parametrize("width", [640, 720, 900, 1024, 1140])
+def test_panels_stay_readable_in_a_narrow_window(browser, url, width):
+    """Between the phone layout (600 px) and a wide screen the six panels stayed in one row beside
+    the summary and shrank with the window: 58 px wide at 640 px, 101 px at 900, their 11-unit labels
+    drawn at 3.6 and 6.3 px. A panel is now never narrower than 140 px (labels 8.8 px or more)."""
+    page = browser.new_page()
+    page.viewport(width, 800)
+    page.goto(url)
+    page.js("document.querySelector('details.flat').open = true")
+    _set_goal(page, "k_x", "target", 0.8)  # the P trace's row too
+    widths = page.js(
+        "[...document.querySelectorAll('svg[data-response], svg[data-trace]')]"
+        ".map(s => s.getBoundingClientRect().width)"
+    )
+    assert len(widths) == 18 and min(widths) >= 140, (width, widths)
+    sizes = page.js("[document.documentElement.scrollWidth, document.documentElement.clientWidth]")
+    assert sizes[0] <= sizes[1], f"horizontal overflow at {width} px: {sizes}"
+    page.call("Page.close")
+
+
 CONTROL_ROLES = ("slider", "button", "checkbox", "combobox", "spinbutton", "textbox", "image", "group")
 
 
