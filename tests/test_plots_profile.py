@@ -131,6 +131,10 @@ def test_cli_profile(sur, tmp_path):
     for bad, message in (
         (["--design", "width=3", "--design", "width=4"], "twice"),
         (["--target", "k"], "is not NAME=VALUE"),
+        # suggest and export take --axis theta (derived from x); the page said "the surrogate has no
+        # response 'k_theta' ... fit one on a table with that axis: Surrogate().fit(table)", a Python
+        # call and a fit the study's table cannot give
+        (["--axis", "theta"], "the profiler shows the axes the surrogate has (x), and theta is not one"),
     ):
         run = designer("profile", *bad, cwd=tmp_path)
         assert run.returncode == 2 and message in run.stderr and "Traceback" not in run.stderr, (

@@ -403,6 +403,20 @@ def build_profiler(
             target that is not positive; a tolerance outside (0, 1); an unreadable suggestion.
     """
     units.check_axis(axis)
+    if axis not in surrogate.axes:
+        has = ", ".join(surrogate.axes) or "none"
+        derived = units.is_rotational(axis) and "x" in surrogate.axes
+        raise DesignerError(
+            f"the profiler shows the axes the surrogate has ({has}), and {axis} is not one of them"
+            + (
+                "; suggest, next and export derive a rotational axis from x, the page does not"
+                if derived
+                else ""
+            ),
+            f"profile the {surrogate.axes[0]} axis"
+            if surrogate.axes
+            else "fit a surrogate with k and c of an axis",
+        )
     suggestion = None if suggestion is None else _suggestion_dict(suggestion)
     found = _suggestion_goals(suggestion)
     # opened from a suggestion: its goals and tolerance unless given, its first candidate unless a
