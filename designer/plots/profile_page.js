@@ -159,7 +159,14 @@ function render() {
   if (sc.joint !== null) texts.push("P(every stated goal met: " + named.map((r) => r.name + " " + limitsText(r, goals[r.name])).join(" and ") + ") = " + pct(sc.joint) +
     (named.length > 1 ? " (" + named.map((r) => r.name + " " + pct(sc.prob[r.name])).join(" \u00d7 ") + ": given the model the responses scatter independently)" : ""));
   const blind = named.filter((r) => !r.predictable);
-  if (blind.length) texts.push(blind.map((r) => r.name).join(", ") + " not predictable: no setting changes " + (blind.length > 1 ? "their" : "its") + " chance; maximize ranks by P of the predictable goals" + (sc.p === null ? "" : ", " + pct(sc.p)));
+  // a calibrated page: the user's prints pin an unpredictable response down near them, so its chance
+  // does change with the setting (though maximize does not act on it)
+  const their = (rs) => (rs.length > 1 ? "their" : "its");
+  const flat = blind.filter((r) => !r.calibrated), pinned = blind.filter((r) => r.calibrated);
+  const because = [];
+  if (flat.length) because.push(flat.map((r) => r.name).join(", ") + " not predictable: no setting changes " + their(flat) + " chance");
+  if (pinned.length) because.push(pinned.map((r) => r.name).join(", ") + " not predictable from the six factors: " + their(pinned) + " chance varies with the setting only through your prints (designer calibrate)");
+  if (blind.length) texts.push(because.join("; ") + "; maximize ranks by P of the predictable goals" + (sc.p === null ? "" : ", " + pct(sc.p)));
   if (sc.d !== null) texts.push("composite desirability (predictable responses) " + sc.d.toFixed(2));
   ov.textContent = texts.join("; ");
   const side = state.width <= state.height ? "width" : "height", core = state[side] - 2 * D.wall_mm;
