@@ -54,35 +54,11 @@ LAYER = _number("layer thickness, mm (0.12, 0.16 or 0.2)")
 RASTER = _number("raster angle, deg (0 or 45)")
 
 
-def _joint(
-    axis,
-    k,
-    c,
-    m,
-    density,
-    length,
-    width,
-    height,
-    layer,
-    raster,
-    from_,
-    candidate,
-    name,
-    allow_extrapolation,
-    surrogate=None,
-):
-    """The joint from exactly one source: --k/--c numbers, a design (six factors, predicted by
-    --surrogate or the shipped surrogate) or --from."""
+def _joint(axis, k, c, m, design, from_, candidate, name, allow_extrapolation, surrogate=None):
+    """The joint from exactly one source: --k/--c numbers, a design (the six factors given, None where
+    not; predicted by --surrogate or the shipped surrogate) or --from."""
     from designer.joint import from_one_source
 
-    design = {
-        "density": density,
-        "length": length,
-        "width": width,
-        "height": height,
-        "layer": layer,
-        "raster": raster,
-    }
     design = {n: v for n, v in design.items() if v is not None}
     coefficients = None
     if k or c or m:
@@ -182,23 +158,9 @@ def _snippet(
         from designer.files import check_output
 
         check_output(output)  # folder, writability, space; the writer checks its suffix
-        joint = _joint(
-            axis,
-            k,
-            c,
-            m,
-            density,
-            length,
-            width,
-            height,
-            layer,
-            raster,
-            from_,
-            candidate,
-            name,
-            allow_extrapolation,
-            surrogate,
-        )
+        design = {"density": density, "length": length, "width": width, "height": height}
+        design |= {"layer": layer, "raster": raster}
+        joint = _joint(axis, k, c, m, design, from_, candidate, name, allow_extrapolation, surrogate)
         result = write(joint, output, (from_, candidate) if from_ else None, **options)
         finishing()
         advice = getattr(result, "advice", {})

@@ -218,14 +218,7 @@ def test_a_bad_print_noise_gives_no_defect_rate(page, typed, said):
     if typed:
         page.type_text(typed)
     else:
-        for kind in ("rawKeyDown", "keyUp"):
-            page.call(
-                "Input.dispatchKeyEvent",
-                type=kind,
-                key="Backspace",
-                code="Backspace",
-                windowsVirtualKeyCode=8,
-            )
+        page.backspace()
     sim = page.js("document.getElementById('sim').textContent")
     assert sim.startswith("no defect rate: ") and said in sim and "NaN" not in sim, sim
     assert page.js("document.getElementById('sim-k_x')") is None

@@ -283,14 +283,7 @@ def test_a_bad_tolerance_computes_nothing_for_the_old_one(page, typed, said):
     assert page.js("document.querySelectorAll('rect.band').length") == 6
     type_keys(page, typed)
     if not typed:  # emptied: selected, then Backspace
-        for kind in ("rawKeyDown", "keyUp"):
-            page.call(
-                "Input.dispatchKeyEvent",
-                type=kind,
-                key="Backspace",
-                code="Backspace",
-                windowsVirtualKeyCode=8,
-            )
+        page.backspace()
     assert said in page.js("document.getElementById('tol-err').textContent")
     assert page.js("document.getElementById('tolerance').getAttribute('aria-invalid')") == "true"
     assert page.js("document.getElementById('tgt-k_x').dataset.probability") is None
