@@ -72,6 +72,23 @@ def test_profiler_data(sur, tmp_path):
     assert embedded["responses"][0]["vcov"] == np.asarray(sur.model("k_x").vcov).tolist()
 
 
+def test_command_lines_name_the_surrogate_they_need(sur):
+    """The page's suggest and export command lines carry --surrogate for any surrogate but the
+    shipped one: its file quoted for a shell, or, with no file known, its id in a form no shell
+    runs unchanged (never a line that silently answers from the study's surrogate)."""
+    from dataclasses import replace
+
+    assert profile.build_profiler(sur).data["surrogate_flag"] == ""
+    flag = profile.build_profiler(sur, surrogate_file=Path("my prints") / "mine.json").data["surrogate_flag"]
+    assert flag == "--surrogate 'my prints/mine.json'"
+    other = replace(sur, models={**sur.models, "k_x": replace(sur.models["k_x"], sigma=0.5)})
+    assert other.id != sur.id
+    assert (
+        profile.build_profiler(other).data["surrogate_flag"]
+        == f"--surrogate <the file of surrogate {other.id}>"
+    )
+
+
 def test_nested_figures_are_preferred(sur, monkeypatch):
     model = sur.model("k_x")
     monkeypatch.setattr(
