@@ -374,6 +374,23 @@ def _factors() -> list[dict[str, Any]]:
     ]
 
 
+def _check_axis(surrogate: Surrogate, axis: str) -> None:
+    """Refuse an axis the surrogate has no k and c of (a rotational one is derived by suggest, next
+    and export, not by the page)."""
+    units.check_axis(axis)
+    if axis in surrogate.axes:
+        return
+    derived = units.is_rotational(axis) and "x" in surrogate.axes
+    why = "; suggest, next and export derive a rotational axis from x, the page does not" if derived else ""
+    raise DesignerError(
+        f"the profiler shows the axes the surrogate has ({', '.join(surrogate.axes) or 'none'}), "
+        f"and {axis} is not one of them{why}",
+        f"profile the {surrogate.axes[0]} axis"
+        if surrogate.axes
+        else "fit a surrogate with k and c of an axis",
+    )
+
+
 def build_profiler(
     surrogate: Surrogate,
     *,
@@ -402,21 +419,7 @@ def build_profiler(
         DesignerError: unknown axis, quantity or factor; a value outside the tested ranges; a
             target that is not positive; a tolerance outside (0, 1); an unreadable suggestion.
     """
-    units.check_axis(axis)
-    if axis not in surrogate.axes:
-        has = ", ".join(surrogate.axes) or "none"
-        derived = units.is_rotational(axis) and "x" in surrogate.axes
-        raise DesignerError(
-            f"the profiler shows the axes the surrogate has ({has}), and {axis} is not one of them"
-            + (
-                "; suggest, next and export derive a rotational axis from x, the page does not"
-                if derived
-                else ""
-            ),
-            f"profile the {surrogate.axes[0]} axis"
-            if surrogate.axes
-            else "fit a surrogate with k and c of an axis",
-        )
+    _check_axis(surrogate, axis)
     suggestion = None if suggestion is None else _suggestion_dict(suggestion)
     found = _suggestion_goals(suggestion)
     # opened from a suggestion: its goals and tolerance unless given, its first candidate unless a
