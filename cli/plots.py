@@ -375,6 +375,7 @@ def profile_cmd(
         tolerance=None if tolerance is None else tolerance / 100,
         suggestion=suggestion,
         design=start or None,
+        surrogate_file=surrogate,
     )
     finishing()
     path = profile.write_profiler(page, output)
