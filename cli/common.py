@@ -275,6 +275,11 @@ FLAGS: tuple[Flag, ...] = (
     ),
     Flag(r"\bprint_id='(\w+)'", r"--print \1", "give print_id='P1' (the id engraved on the specimen)"),
     Flag(r"\bprint_id=(?!')", "--print", "identify one log at a time with print_id=, or name each"),
+    Flag(
+        r"\bruns_path=(?=')",
+        "--runs ",
+        "append this batch to it with runs_path='prints/runs.csv' (its ids continue)",
+    ),
     Flag(r"\bmax_cases=(\d+)", r"--max-cases \1", "or pass max_cases=2000000 if that many are meant"),
     Flag(r"\bpackage_paths\['([^']+)'\]=", r"--package-path \1=", "package_paths['arm']='x' is not a folder"),
 )

@@ -219,3 +219,32 @@ def test_print_cli_design_and_bad_input(tmp_path, capsys):
         code, _, err = run_inprocess(bad, capsys)
         assert_clean_failure(code, err, allowed=(2,))
         assert words in err, err
+
+
+def test_printing_again_into_a_folder_keeps_its_measured_runs_table(tmp_path, capsys):
+    """`print -o FOLDER` where FOLDER/runs.csv already holds measurements: the same batch again (say
+    with other blocks) keeps the table as it is; another batch is refused, naming --runs (the old
+    code replaced the table with an empty template, exit 0: the measured k and c were lost)."""
+    out = tmp_path / "batch one"
+    code, _, err = run_inprocess(["print", *SIX, "-o", out], capsys)
+    assert code == 0, err
+    table = pd.read_csv(out / "runs.csv")
+    table.loc[0, "k_x [N/mm]"], table.loc[0, "c_x [N.s/mm]"] = 0.91, 2.1e-3
+    table.to_csv(out / "runs.csv", index=False)
+    before = (out / "runs.csv").read_bytes()
+    code, _, err = run_inprocess(["print", *SIX, "--block-height", "18", "-o", out], capsys)
+    assert code == 0, err
+    assert (out / "runs.csv").read_bytes() == before
+    assert np.isclose(trimesh.load(out / "P1.stl").extents[2], 18.0)  # the parts are made again
+    other = [*SIX[: SIX.index("--density") + 1], "30", *SIX[SIX.index("--density") + 2 :]]
+    code, _, err = run_inprocess(["print", *other, "-o", out], capsys)
+    assert_clean_failure(code, err, allowed=(2,))
+    words = " ".join(err.split())
+    assert "P1" in words and "measured" in words and f"--runs '{out / 'runs.csv'}'" in words, err
+    assert (out / "runs.csv").read_bytes() == before
+    assert np.isclose(trimesh.load(out / "P1.stl").extents[2], 18.0)  # nothing replaced
+    # appending, as the message says, continues the ids beside the measured P1
+    code, _, err = run_inprocess(["print", *other, "--runs", out / "runs.csv", "-o", out], capsys)
+    assert code == 0, err
+    runs = pd.read_csv(out / "runs.csv")
+    assert list(runs["print"]) == ["P1", "P2"] and np.isclose(runs["k_x [N/mm]"].iloc[0], 0.91)
