@@ -200,3 +200,22 @@ def test_a_log_without_a_sidecar_is_named_on_the_command_line(tmp_path, capsys):
     code, _, err = run_inprocess(["identify", log, "--runs", runs, "--print", "P1"], capsys)
     assert_clean_failure(code, err, allowed=(2,))
     assert "names print P2, --print P1" in " ".join(err.split()), err
+
+
+def test_a_sidecar_with_the_designed_height_is_the_printed_print(tmp_path, capsys):
+    """A rig's software that writes the design's settings (next.json's height, 9.05 mm) into the
+    sidecar, where the table holds the height printed (9.0 mm: whole 0.16 mm layers over the 0.2 mm
+    first): the same print, filled, not refused as "mixed up" (the old code refused it, exit 2,
+    telling the user to check the engraved id)."""
+    runs = _template(tmp_path, capsys)
+    design = dict(zip(FACTORS, [60.0, 24.0, 4.5, 9.05, 0.16, 0.0], strict=True))
+    log = rig_log(tmp_path, "P1", design, 0.9, 2.2e-3)
+    code, _, err = run_inprocess(["identify", log, "--runs", runs], capsys)
+    assert code == 0, err
+    assert np.isclose(pd.read_csv(runs)["k_x [N/mm]"].iloc[0], 0.9, rtol=0.02)
+    # a height that prints another whole layer (9.1 mm prints 9.16) is still another print
+    runs = _template(tmp_path / "again", capsys)
+    log = rig_log(tmp_path, "P1", design | {"height": 9.1}, 0.9, 2.2e-3)
+    code, _, err = run_inprocess(["identify", log, "--runs", runs], capsys)
+    assert_clean_failure(code, err, allowed=(2,))
+    assert "height 9.1" in err and "mixed up" in err, err

@@ -21,6 +21,7 @@ from .. import units
 from ..errors import DesignerError
 from ..study import space
 from ..study.data import canonical_columns, load_table, read_frame
+from . import settings
 
 #: the print id column
 PRINT = "print"
@@ -200,7 +201,7 @@ def fill(
         i = int(rows[0])
         if res.factors is not None:
             table_row = {n: float(factors[n].iloc[i]) for n in space.FACTOR_NAMES}
-            off = [n for n in space.FACTOR_NAMES if not np.isclose(res.factors[n], table_row[n], atol=0.011)]
+            off = [n for n in space.FACTOR_NAMES if not _same_setting(n, res.factors, table_row)]
             if off:
                 logged = ", ".join(f"{n} {res.factors[n]:g}" for n in off)
                 raise DesignerError(
@@ -216,6 +217,19 @@ def fill(
         out.loc[i, k_col], out.loc[i, c_col], out.loc[i, LOG] = fit.k, fit.c, str(res.path)
         filled.append(pid)
     return out, filled
+
+
+def _same_setting(name: str, logged: dict[str, float], row: dict[str, float]) -> bool:
+    """Whether a log's sidecar and the runs table give one print's setting `name`: equal to the
+    hundredth, or, for the height, the design's height that `designer print` rounded to the whole
+    layers it printed (the table holds the height printed, a rig's software may log the design's)."""
+    if np.isclose(logged[name], row[name], atol=0.011):
+        return True
+    return (
+        name == "height"
+        and np.isclose(logged["layer"], row["layer"], atol=0.011)
+        and np.isclose(settings.printed_height(logged[name], row["layer"]), row[name], atol=0.011)
+    )
 
 
 def table_axis(table: pd.DataFrame) -> str:
