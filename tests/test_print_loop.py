@@ -219,3 +219,29 @@ def test_a_sidecar_with_the_designed_height_is_the_printed_print(tmp_path, capsy
     code, _, err = run_inprocess(["identify", log, "--runs", runs], capsys)
     assert_clean_failure(code, err, allowed=(2,))
     assert "height 9.1" in err and "mixed up" in err, err
+
+
+def test_a_rotational_k_in_si_is_refused_naming_the_unit(tmp_path, capsys):
+    """A runs table on theta (`print --axis theta`, k_theta [N.mm/rad]) filled from a log whose
+    torque is in N.m: K 0.4 where the study's relation predicts about 400 N.mm/rad. identify --runs
+    names the slip the x table's check names, exit 2 (the old code filled it: the study surrogate
+    has no theta response, so nothing was compared)."""
+    code, _, err = run_inprocess(["print", *SIX, "--axis", "theta", "-o", tmp_path / "one"], capsys)
+    assert code == 0, err
+    runs = tmp_path / "one" / "runs.csv"
+    log = make_log(
+        {"theta": {"k": 0.4, "c": 6e-4, "m": 1e-6, "amplitude": 0.05}}, duration=60.0, rate=500.0, seed=3
+    )
+    path = tmp_path / "p1_run.csv"
+    log.to_csv(path, index=False)
+    code, _, err = run_inprocess(["identify", path, "--runs", runs, "--print", "P1"], capsys)
+    assert_clean_failure(code, err, allowed=(2,))
+    words = " ".join(err.split())
+    assert "k_theta of print P1 is 0.4" in words and "N.m/rad rather than N.mm/rad" in words, err
+    assert "--accept-implausible" in words and pd.read_csv(runs)["k_theta [N.mm/rad]"].isna().all()
+    # the same joint logged in N.mm: about 400 N.mm/rad, filled
+    log["Ttheta"] *= 1000.0
+    log.to_csv(path, index=False)
+    code, _, err = run_inprocess(["identify", path, "--runs", runs, "--print", "P1"], capsys)
+    assert code == 0, err
+    assert np.isclose(pd.read_csv(runs)["k_theta [N.mm/rad]"].iloc[0], 400.0, rtol=0.02)

@@ -248,21 +248,26 @@ def fill_file(
 ) -> dict[str, list[str]]:
     """Fill the runs table at `path` (atomically) from identified logs (see `fill`, and its
     `print_id`), after checking each value against what a printer can give
-    (`designer.model.plausibility`, with the study's surrogate unless `surrogate` is given).
+    (`designer.model.plausibility`, with the study's surrogate unless `surrogate` is given; on a
+    rotational axis the surrogate lacks, through `designer.model.rotational`'s relation).
 
     Returns:
         {"filled": ids filled now, "waiting": ids of the table still without a measurement}.
     """
     from ..model.plausibility import check_measured
+    from ..model.rotational import with_axis
     from ..model.surrogate import Surrogate
     from ..study.data import write_frame
 
     table = read_runs(path)
-    out, filled = fill(table, results, axis=table_axis(table), print_id=print_id)
+    axis = table_axis(table)
+    out, filled = fill(table, results, axis=axis, print_id=print_id)
     done = out[PRINT].isin(filled).to_numpy()
     if done.any():
+        study = surrogate or Surrogate.load()
         check_measured(
-            surrogate or Surrogate.load(),
+            # a rotational table is compared through the relation `export --axis theta` uses
+            with_axis(study.prior if study.calibration else study, axis),
             load_table(out.loc[done].reset_index(drop=True)),
             accept_implausible=accept_implausible,
         )
