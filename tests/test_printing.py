@@ -9,6 +9,7 @@ import json
 import shutil
 import subprocess
 import xml.etree.ElementTree as ET
+import zipfile
 from pathlib import Path
 
 import gcode
@@ -248,3 +249,46 @@ def test_printing_again_into_a_folder_keeps_its_measured_runs_table(tmp_path, ca
     assert code == 0, err
     runs = pd.read_csv(out / "runs.csv")
     assert list(runs["print"]) == ["P1", "P2"] and np.isclose(runs["k_x [N/mm]"].iloc[0], 0.91)
+
+
+def _solid_layer(moves: gcode.Moves, obj: str, z: float) -> tuple[float, float]:
+    """(direction deg, density %) of the internal infill on the layer nearest z, for a pattern of
+    one direction per layer: every line longer than 1 mm along it, spaced by the flow's spacing at
+    100 % (density = spacing / pitch, PrusaSlicer's Flow::spacing: width - height (1 - pi/4))."""
+    seg = moves.segments[moves.select(obj, "Internal infill")]
+    levels = np.unique(seg[:, 4])
+    seg = seg[seg[:, 4] == levels[np.abs(levels - z).argmin()]]
+    length = np.hypot(seg[:, 2] - seg[:, 0], seg[:, 3] - seg[:, 1])
+    seg = seg[length > 1.0]
+    angles = np.round(np.degrees(np.arctan2(seg[:, 3] - seg[:, 1], seg[:, 2] - seg[:, 0])) % 180) % 180
+    assert len(set(angles)) == 1, sorted(set(angles))
+    a = np.radians(angles[0])
+    offsets = np.unique(np.round(seg[:, :2] @ np.array([-np.sin(a), np.cos(a)]), 3))
+    pitch = float(np.median(np.diff(offsets)))
+    spacing = seg[:, 6].mean() - seg[:, 5].mean() * (1.0 - np.pi / 4.0)
+    return float(angles[0]), 100.0 * spacing / pitch
+
+
+@needs_slicer
+def test_a_solid_print_slices_solid(tmp_path):
+    """A 100 % design (what next and suggest give a section the walls fill): PrusaSlicer refuses
+    cubic at 100 % ("The selected fill pattern is not supposed to work at 100% density", exit 1:
+    the old STL + .ini gave no G-code) and on the plate printed it as a cubic lattice, its three
+    crossing directions each a third full. Now rectilinear, as PrusaSlicer's own dialog switches:
+    lines along the raster and across it, layer by layer, one flow spacing apart."""
+    design = {"density": 100.0, "length": 20.0, "width": 5.0, "height": 6.0, "layer": 0.2, "raster": 45.0}
+    made = batch.prepare([design], ["P1"])
+    files = batch.write_batch(made, tmp_path / "solid")
+    params = made.prints[0].params
+    z = (params["height"] + Clamp().height) / 2
+    for moves, obj in (
+        (slice_(["--load", files["ini"][0], files["stl"][0]], tmp_path / "P1.gcode"), "P1.stl"),
+        (slice_([files["plate"]], tmp_path / "plate.gcode"), "P1"),
+    ):
+        layers = [_solid_layer(moves, obj, z + i * params["layer"]) for i in range(2)]
+        assert sorted(d for d, _ in layers) == [45.0, 135.0], layers
+        assert all(density == pytest.approx(100.0, abs=1.0) for _, density in layers), layers
+        beam = [_solid_layer(moves, obj, params["height"] / 2 + i * params["layer"]) for i in range(2)]
+        assert sorted(d for d, _ in beam) == [45.0, 135.0], beam
+    orca = ET.fromstring(zipfile.ZipFile(files["plate"]).read(plate.ORCA_OBJECTS.lstrip("/"))).find("object")
+    assert {m.get("key"): m.get("value") for m in orca.iter("metadata")}["sparse_infill_pattern"] == "zig-zag"
