@@ -91,7 +91,9 @@ def _joint(
 def _print_joint(joint, what: str, path: Path) -> None:
     from designer import units
 
-    console.print(f"wrote {what} [bold]{path}[/bold] for joint '{joint.name}'")
+    console.print(
+        f"wrote {what} [bold]{escape(str(path))}[/bold] for joint '{escape(joint.name)}'", markup=True
+    )
     for a, ac in joint.axes.items():
         si = ac.si()
         mass = "" if si["m"] is None else f", m = {si['m']:.4g} {units.si_unit('m', a)}"

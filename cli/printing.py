@@ -4,6 +4,7 @@ the runs table their measurements go into."""
 from __future__ import annotations
 
 import json
+import shlex
 from pathlib import Path
 from typing import Annotated
 
@@ -119,7 +120,7 @@ def _print_batch(data: dict) -> None:
     )
     console.print(
         f"runs table: {files['runs']}; after the rig, name the print in each log's sidecar "
-        '({"print": "P1"}) and run designer identify LOGS --runs ' + files["runs"]
+        '({"print": "P1"}) and run designer identify LOGS --runs ' + shlex.quote(files["runs"])
     )
 
 

@@ -292,3 +292,40 @@ def test_a_solid_print_slices_solid(tmp_path):
         assert sorted(d for d, _ in beam) == [45.0, 135.0], beam
     orca = ET.fromstring(zipfile.ZipFile(files["plate"]).read(plate.ORCA_OBJECTS.lstrip("/"))).find("object")
     assert {m.get("key"): m.get("value") for m in orca.iter("metadata")}["sparse_infill_pattern"] == "zig-zag"
+
+
+def test_output_names_the_files_written_whatever_the_folder_is_called(tmp_path, capsys, monkeypatch):
+    """Paths as typed, relative, with a space and brackets: the output names the files written,
+    and the identify command it suggests runs as pasted (the old output read "prints /plate.3mf":
+    rich took "[v2]" for markup; and "--runs prints [v2]/runs.csv", unquoted)."""
+    monkeypatch.chdir(tmp_path)
+    code, text, err = run_inprocess(["print", *SIX, "-o", "prints [v2]"], capsys)
+    assert code == 0, err
+    words = " ".join(text.split())
+    assert "plate: prints [v2]/plate.3mf" in words, text
+    assert "--runs 'prints [v2]/runs.csv'" in words, text
+    code, text, err = run_inprocess(
+        ["rig", "simulate", "--k", "0.9", "--c", "2e-3", "--duration", "5", "-o", "log [a].csv"], capsys
+    )
+    assert code == 0, err
+    assert "wrote log [a].csv" in text, text
+
+
+def test_a_candidate_out_of_range_is_named_by_its_flag(tmp_path, capsys):
+    """`print --from suggestion.json --candidate 4` of a 3-candidate suggestion: the flag and its
+    range (the old message said the library's "candidate=4 ... give candidate 1 to 3")."""
+    folder = tmp_path / "x"
+    doc = {"candidates": [{"params": DESIGNS[i]} for i in range(3)]}
+    (tmp_path / "s.json").write_text(json.dumps(doc))
+    code, _, err = run_inprocess(
+        ["print", "--from", tmp_path / "s.json", "--candidate", "4", "-o", folder], capsys
+    )
+    assert_clean_failure(code, err, allowed=(2,))
+    words = " ".join(err.split())
+    assert "--candidate 4 is not in the suggestion" in words and "give --candidate 1 to 3" in words, err
+    (tmp_path / "n.json").write_text(json.dumps({"prints": [], "recommendation": {"params": DESIGNS[0]}}))
+    code, _, err = run_inprocess(
+        ["print", "--from", tmp_path / "n.json", "--candidate", "2", "-o", folder], capsys
+    )
+    assert_clean_failure(code, err, allowed=(2,))
+    assert "--candidate is for a suggest output" in " ".join(err.split()), err
