@@ -285,6 +285,11 @@ FLAGS: tuple[Flag, ...] = (
         r"\bcandidate is for a suggest", "--candidate is for a suggest", "candidate is for a suggest output"
     ),
     Flag(
+        r"\bprint_id=(?='[^']*' cannot be engraved)",
+        "--id ",
+        "print_id='P 1' cannot be engraved (no stroke for ' ')",
+    ),
+    Flag(
         r"\bruns_path=(?=')",
         "--runs ",
         "append this batch to it with runs_path='prints/runs.csv' (its ids continue)",

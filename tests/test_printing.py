@@ -311,9 +311,10 @@ def test_output_names_the_files_written_whatever_the_folder_is_called(tmp_path, 
     assert "wrote log [a].csv" in text, text
 
 
-def test_a_candidate_out_of_range_is_named_by_its_flag(tmp_path, capsys):
+def test_a_candidate_or_id_out_of_range_is_named_by_its_flag(tmp_path, capsys):
     """`print --from suggestion.json --candidate 4` of a 3-candidate suggestion: the flag and its
-    range (the old message said the library's "candidate=4 ... give candidate 1 to 3")."""
+    range (the old message said the library's "candidate=4 ... give candidate 1 to 3"); an id
+    that cannot be engraved, its flag --id (it said "print_id='P 1'")."""
     folder = tmp_path / "x"
     doc = {"candidates": [{"params": DESIGNS[i]} for i in range(3)]}
     (tmp_path / "s.json").write_text(json.dumps(doc))
@@ -329,3 +330,6 @@ def test_a_candidate_out_of_range_is_named_by_its_flag(tmp_path, capsys):
     )
     assert_clean_failure(code, err, allowed=(2,))
     assert "--candidate is for a suggest output" in " ".join(err.split()), err
+    code, _, err = run_inprocess(["print", *SIX, "--id", "P 1", "-o", folder], capsys)
+    assert_clean_failure(code, err, allowed=(2,))
+    assert "--id 'P 1' cannot be engraved" in " ".join(err.split()), err
