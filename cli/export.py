@@ -178,7 +178,7 @@ def _snippet(
         for n, a in advice.items():
             console.print(f"  {n}: {a.text()}")
         for line in getattr(result, "notes", ()):
-            console.print(f"  {escape(flag_message(line))}")
+            console.print(f"  {flag_message(line)}")
 
     command.__doc__ = (
         f"Write the joint as {title.format(fmi='2|3', interface='force|body')}, SI units, "
