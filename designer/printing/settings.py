@@ -61,6 +61,10 @@ def prusa_object(params: Mapping[str, float]) -> dict[str, str]:
         "bottom_solid_layers": layers,
         "top_solid_min_thickness": _number(space.WALL_MM),
         "bottom_solid_min_thickness": _number(space.WALL_MM),
+        # no infill line anchored to the perimeter: in a narrow beam the anchors run along it,
+        # whatever the raster (a 3.5 mm beam at 45 deg: 31 % of its infill at 0 deg, 1.3x the density)
+        "infill_anchor": "0",
+        "infill_anchor_max": "0",
     }
 
 
@@ -116,6 +120,8 @@ ORCA_NAMES = {
     "bottom_solid_layers": "bottom_shell_layers",
     "top_solid_min_thickness": "top_shell_thickness",
     "bottom_solid_min_thickness": "bottom_shell_thickness",
+    "infill_anchor": "infill_anchor",
+    "infill_anchor_max": "infill_anchor_max",
 }
 
 
