@@ -245,3 +245,27 @@ def test_a_rotational_k_in_si_is_refused_naming_the_unit(tmp_path, capsys):
     code, _, err = run_inprocess(["identify", path, "--runs", runs, "--print", "P1"], capsys)
     assert code == 0, err
     assert np.isclose(pd.read_csv(runs)["k_theta [N.mm/rad]"].iloc[0], 400.0, rtol=0.02)
+
+
+def test_a_measured_print_is_not_replaced_by_another_log(tmp_path, capsys):
+    """P1 measured from its log; then another log named P1 (a slip of --print, meant P2): refused,
+    naming the measurement it would replace, the table unchanged (the old code replaced P1's k and
+    its log, exit 0). The same log again (identified anew) may refill its own row."""
+    runs = _template(tmp_path, capsys)
+    design = dict(zip(FACTORS, [60.0, 24.0, 4.5, 9.0, 0.16, 0.0], strict=True))
+    first = rig_log(tmp_path, "P1", design, 0.9, 2.2e-3)
+    code, _, err = run_inprocess(["identify", first, "--runs", runs], capsys)
+    assert code == 0, err
+    before = pd.read_csv(runs)
+    other = tmp_path / "p2_run.csv"
+    make_log({"x": {"k": 0.6, "c": 3e-3, "m": 2e-3, "amplitude": 1.0}}, duration=60.0, rate=500.0).to_csv(
+        other, index=False
+    )
+    code, _, err = run_inprocess(["identify", other, "--runs", runs, "--print", "P1"], capsys)
+    assert_clean_failure(code, err, allowed=(2,))
+    words = " ".join(err.split())
+    assert "print P1 is measured already" in words and str(first) in words, err
+    pd.testing.assert_frame_equal(pd.read_csv(runs), before)
+    code, _, err = run_inprocess(["identify", first, "--runs", runs], capsys)
+    assert code == 0, err
+    pd.testing.assert_frame_equal(pd.read_csv(runs), before)

@@ -9,6 +9,7 @@ reads; a row still empty (a print not measured yet) is left out of a calibration
 from __future__ import annotations
 
 import json
+import os
 import re
 from collections.abc import Sequence
 from pathlib import Path
@@ -156,8 +157,8 @@ def fill(
     Raises:
         DesignerError: a log whose sidecar names no print (and no `print_id`) or a print not in the
             table, `print_id` with several logs or against its sidecar, two logs of one print, a log
-            whose sidecar factors differ from its print's row (prints mixed up), or a log without
-            `axis`.
+            whose sidecar factors differ from its print's row (prints mixed up), a log of a print
+            measured already from another log (or by hand), or a log without `axis`.
     """
     if print_id is not None:
         print_id = print_key(print_id)
@@ -213,10 +214,26 @@ def fill(
             raise DesignerError(
                 f"{res.path}: no {axis} axis identified", f"log the {axis} axis of print {pid}"
             )
+        _check_not_measured(out, i, pid, (k_col, c_col), str(res.path))
         fit = res.axes[axis]
         out.loc[i, k_col], out.loc[i, c_col], out.loc[i, LOG] = fit.k, fit.c, str(res.path)
         filled.append(pid)
     return out, filled
+
+
+def _check_not_measured(table: pd.DataFrame, i: int, pid: str, columns: tuple[str, str], log: str) -> None:
+    """Refuse to replace row `i`'s measurement (`columns`) by another log than the one it came from:
+    a log named with the wrong print would overwrite a measured print (one log per print)."""
+    values = pd.to_numeric(table.loc[i, list(columns)], errors="coerce")
+    source = str(table.loc[i, LOG])
+    if values.isna().all() or (source and os.path.abspath(source) == os.path.abspath(log)):
+        return
+    held = ", ".join(f"{c} {v:.4g}" for c, v in values.items() if not np.isnan(v))
+    raise DesignerError(
+        f"{log}: print {pid} is measured already ({held}, {f'from {source}' if source else 'typed in'})",
+        "the prints may be mixed up: check the id engraved on the specimen; to measure it again, "
+        "empty its row's k, c and log first",
+    )
 
 
 def _same_setting(name: str, logged: dict[str, float], row: dict[str, float]) -> bool:
