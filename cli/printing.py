@@ -12,7 +12,7 @@ import typer
 
 from designer.errors import DesignerError
 
-from .common import AxisOpt, JsonOpt, console, design_text, finishing, print_json
+from .common import JsonOpt, console, design_text, finishing, print_json
 
 _FACTOR_HELP = "one design's setting (give all six, or --from)"
 
@@ -44,7 +44,15 @@ def print_(
             help="runs table to append this batch to (ids continue its own); default OUTPUT/runs.csv",
         ),
     ] = None,
-    axis: AxisOpt = "x",
+    axis: Annotated[
+        str,
+        typer.Option(
+            "--axis",
+            help="axis the rig measures, named in the runs table's k and c columns: x y z theta phi psi "
+            "(the study's surrogate calibrates from x; a theta goal of next or suggest is derived from x: "
+            "keep x)",
+        ),
+    ] = "x",
     block_length: Annotated[float, typer.Option(help="clamping block along the beam, mm")] = 12.0,
     block_width: Annotated[float, typer.Option(help="clamping block across the beam, mm")] = 20.0,
     block_height: Annotated[float, typer.Option(help="clamping block height, mm")] = 20.0,
