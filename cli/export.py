@@ -99,7 +99,9 @@ def _joint(axis, k, c, m, design, from_, candidate, name, allow_extrapolation, s
 def _print_joint(joint, what: str, path: Path) -> None:
     from designer import units
 
-    console.print(f"wrote {what} [bold]{path}[/bold] for joint '{joint.name}'")
+    console.print(
+        f"wrote {what} [bold]{escape(str(path))}[/bold] for joint '{escape(joint.name)}'", markup=True
+    )
     for a, ac in joint.axes.items():
         si = ac.si()
         mass = "" if si["m"] is None else f", m = {si['m']:.4g} {units.si_unit('m', a)}"
@@ -172,7 +174,7 @@ def _snippet(
         for n, a in advice.items():
             console.print(f"  {n}: {a.text()}")
         for line in getattr(result, "notes", ()):
-            console.print(f"  {escape(flag_message(line))}")
+            console.print(f"  {flag_message(line)}")
 
     command.__doc__ = (
         f"Write the joint as {title.format(fmi='2|3', interface='force|body')}, SI units, "
