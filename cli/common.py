@@ -139,7 +139,9 @@ def parse_fix(
     return pairs
 
 
-# piped output is not cut at rich's 80-column default: numbers must never be truncated
+# piped output is not cut at rich's 80-column default: numbers must never be truncated; no markup
+# unless a call asks for it (markup=True), so a path or a name in brackets ("prints [v2]") is printed
+# as it is, not taken for a style
 class _Console(Console):
     """rich's console, except that a closed stdout raises BrokenPipeError (rich exits 1 there): the
     one error path (`main.run`) ends such a command quietly with exit 0, as SIGPIPE would."""
@@ -148,7 +150,7 @@ class _Console(Console):
         raise BrokenPipeError
 
 
-console = _Console(highlight=False, width=None if sys.stdout.isatty() else 120)
+console = _Console(highlight=False, markup=False, width=None if sys.stdout.isatty() else 120)
 err_console = Console(stderr=True, highlight=False)
 
 
@@ -275,6 +277,23 @@ FLAGS: tuple[Flag, ...] = (
     ),
     Flag(r"\bprint_id='(\w+)'", r"--print \1", "give print_id='P1' (the id engraved on the specimen)"),
     Flag(r"\bprint_id=(?!')", "--print", "identify one log at a time with print_id=, or name each"),
+    Flag(
+        r"\bcandidate=(?=\d+ is not in)", "--candidate ", "candidate=4 is not in the suggestion (it holds 3)"
+    ),
+    Flag(r"\bgive candidate (?=\d+ to \d+)", "give --candidate ", "give candidate 1 to 3"),
+    Flag(
+        r"\bcandidate is for a suggest", "--candidate is for a suggest", "candidate is for a suggest output"
+    ),
+    Flag(
+        r"\bprint_id=(?='[^']*' cannot be engraved)",
+        "--id ",
+        "print_id='P 1' cannot be engraved (no stroke for ' ')",
+    ),
+    Flag(
+        r"\bruns_path=(?=')",
+        "--runs ",
+        "append this batch to it with runs_path='prints/runs.csv' (its ids continue)",
+    ),
     Flag(r"\bmax_cases=(\d+)", r"--max-cases \1", "or pass max_cases=2000000 if that many are meant"),
     Flag(r"\bpackage_paths\['([^']+)'\]=", r"--package-path \1=", "package_paths['arm']='x' is not a folder"),
 )

@@ -6,7 +6,6 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.markup import escape
 
 from .common import console, finishing, print_json, progress, quiet_mujoco
 
@@ -120,7 +119,7 @@ def _print(summary: dict) -> None:
     if val:
         _print_verdict(val)
     for note in summary.get("notes", []):
-        console.print(f"note: {escape(note)}")  # a note names TOML tables: [joints.j1] is not markup
+        console.print(f"note: {note}")  # a note names TOML tables: [joints.j1] (the console takes no markup)
     ran = {"kernel": "the compiled kernel", "python": "the Python master"}[summary["engine"]]
     console.print(f"loop run by {ran}")
     for f in summary["files"]:

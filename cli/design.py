@@ -6,6 +6,7 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 
 from designer.errors import DesignerError
 
@@ -161,7 +162,7 @@ def predict(
             f"{q}_{axis} = {pi_text(p)} {p['unit']}  (value [95 % PI]; nested LOO Q2 = {p['loo_q2']:.2f})"
         )
         if not p["predictable"]:
-            console.print(f"  [yellow]{info[q]['statement']}[/yellow]")
+            console.print(f"  [yellow]{escape(info[q]['statement'])}[/yellow]", markup=True)
     for note in notes:
         console.print(f"note: {note}")
 
@@ -287,7 +288,7 @@ def _print_suggestion(data: dict) -> None:
     )
     style = "green" if data["reachable"] else "bold red"
     for s in data["statements"]:
-        console.print(f"[{style}]-[/{style}] {s}")
+        console.print(f"[{style}]-[/{style}] {escape(s)}", markup=True)
     for q, info in data["predictability"].items():
         if data["targets"][q] is None or info["predictable"]:
             console.print(f"- {info['statement']}")

@@ -16,7 +16,17 @@ from rich.markup import escape
 
 from designer.errors import DesignerError
 
-from .common import Typer, console, err_console, finishing, flag_message, print_json, progress
+from .common import (
+    SurrogateOpt,
+    Typer,
+    console,
+    err_console,
+    finishing,
+    flag_message,
+    load_surrogate,
+    print_json,
+    progress,
+)
 
 export_app = Typer(
     help="Export a joint: FMU (FMI 2/3), Modelica, MJCF, URDF, SDF, USD or SSP.", no_args_is_help=True
@@ -44,20 +54,11 @@ LAYER = _number("layer thickness, mm (0.12, 0.16 or 0.2)")
 RASTER = _number("raster angle, deg (0 or 45)")
 
 
-def _joint(
-    axis, k, c, m, density, length, width, height, layer, raster, from_, candidate, name, allow_extrapolation
-):
-    """The joint from exactly one source: --k/--c numbers, a design (six factors) or --from."""
+def _joint(axis, k, c, m, design, from_, candidate, name, allow_extrapolation, surrogate=None):
+    """The joint from exactly one source: --k/--c numbers, a design (the six factors given, None where
+    not; predicted by --surrogate or the shipped surrogate) or --from."""
     from designer.joint import from_one_source
 
-    design = {
-        "density": density,
-        "length": length,
-        "width": width,
-        "height": height,
-        "layer": layer,
-        "raster": raster,
-    }
     design = {n: v for n, v in design.items() if v is not None}
     coefficients = None
     if k or c or m:
@@ -77,6 +78,12 @@ def _joint(
             "use --k and --c (rig units, N/mm and N.s/mm), or the six print settings --density ... --raster, "
             "or --from suggestion.json",
         )
+    if surrogate is not None and not design:
+        raise DesignerError(
+            "--surrogate predicts a joint from a design, and none is given",
+            "give the six print settings --density ... --raster with it, or leave --surrogate out: "
+            "--k/--c are the joint's own numbers, --from carries its suggestion's predictions",
+        )
     return from_one_source(
         coefficients=coefficients,
         design=design or None,
@@ -85,13 +92,16 @@ def _joint(
         axes=None if coefficients else axis or (None if from_ else ["x"]),
         name=name,
         allow_extrapolation=allow_extrapolation,
+        surrogate=None if surrogate is None else load_surrogate(surrogate),
     )
 
 
 def _print_joint(joint, what: str, path: Path) -> None:
     from designer import units
 
-    console.print(f"wrote {what} [bold]{path}[/bold] for joint '{joint.name}'")
+    console.print(
+        f"wrote {what} [bold]{escape(str(path))}[/bold] for joint '{escape(joint.name)}'", markup=True
+    )
     for a, ac in joint.axes.items():
         si = ac.si()
         mass = "" if si["m"] is None else f", m = {si['m']:.4g} {units.si_unit('m', a)}"
@@ -143,28 +153,16 @@ def _snippet(
         candidate: Annotated[int, typer.Option(help="candidate in --from, 1 = best")] = 1,
         name: Annotated[str, typer.Option(help="joint (model) name")] = "FlexJoint",
         allow_extrapolation: Annotated[bool, typer.Option(help="accept a design outside the ranges")] = False,
+        surrogate: SurrogateOpt = None,
         json_out: Annotated[bool, typer.Option("--json", help="print the result as JSON")] = False,
         **options,
     ) -> None:
         from designer.files import check_output
 
         check_output(output)  # folder, writability, space; the writer checks its suffix
-        joint = _joint(
-            axis,
-            k,
-            c,
-            m,
-            density,
-            length,
-            width,
-            height,
-            layer,
-            raster,
-            from_,
-            candidate,
-            name,
-            allow_extrapolation,
-        )
+        design = {"density": density, "length": length, "width": width, "height": height}
+        design |= {"layer": layer, "raster": raster}
+        joint = _joint(axis, k, c, m, design, from_, candidate, name, allow_extrapolation, surrogate)
         result = write(joint, output, (from_, candidate) if from_ else None, **options)
         finishing()
         advice = getattr(result, "advice", {})
@@ -176,7 +174,7 @@ def _snippet(
         for n, a in advice.items():
             console.print(f"  {n}: {a.text()}")
         for line in getattr(result, "notes", ()):
-            console.print(f"  {escape(flag_message(line))}")
+            console.print(f"  {flag_message(line)}")
 
     command.__doc__ = (
         f"Write the joint as {title.format(fmi='2|3', interface='force|body')}, SI units, "

@@ -6,6 +6,7 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 
 from .common import DataOpt, FixOpt, Typer, console, finishing, parse_fix, print_json, quiet_mujoco
 from .common import progress as progress_bar
@@ -309,7 +310,7 @@ def validate_cmd(
     else:
         for r in results:
             mark = "[green]PASS[/green]" if r.passed else "[red]FAIL[/red]"
-            console.print(f"{mark} {r.name} ({r.seconds:.1f} s): {r.summary}")
+            console.print(f"{mark} {escape(r.name)} ({r.seconds:.1f} s): {escape(r.summary)}", markup=True)
         console.print(
             f"{len(results) - len(failed)} of {len(results)} checks pass in {seconds:.1f} s; "
             f"wrote {page} and {md}"
@@ -375,6 +376,7 @@ def profile_cmd(
         tolerance=None if tolerance is None else tolerance / 100,
         suggestion=suggestion,
         design=start or None,
+        surrogate_file=surrogate,
     )
     finishing()
     path = profile.write_profiler(page, output)

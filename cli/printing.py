@@ -4,6 +4,7 @@ the runs table their measurements go into."""
 from __future__ import annotations
 
 import json
+import shlex
 from pathlib import Path
 from typing import Annotated
 
@@ -11,7 +12,7 @@ import typer
 
 from designer.errors import DesignerError
 
-from .common import AxisOpt, JsonOpt, console, design_text, finishing, print_json
+from .common import JsonOpt, console, design_text, finishing, print_json
 
 _FACTOR_HELP = "one design's setting (give all six, or --from)"
 
@@ -43,7 +44,15 @@ def print_(
             help="runs table to append this batch to (ids continue its own); default OUTPUT/runs.csv",
         ),
     ] = None,
-    axis: AxisOpt = "x",
+    axis: Annotated[
+        str,
+        typer.Option(
+            "--axis",
+            help="axis the rig measures, named in the runs table's k and c columns: x y z theta phi psi "
+            "(the study's surrogate calibrates from x; a theta goal of next or suggest is derived from x: "
+            "keep x)",
+        ),
+    ] = "x",
     block_length: Annotated[float, typer.Option(help="clamping block along the beam, mm")] = 12.0,
     block_width: Annotated[float, typer.Option(help="clamping block across the beam, mm")] = 20.0,
     block_height: Annotated[float, typer.Option(help="clamping block height, mm")] = 20.0,
@@ -55,7 +64,8 @@ def print_(
 
     Each specimen is the study's beam (length, width, height) between two clamping blocks, the print
     id engraved on the first block; layer height, infill density and angle (the raster) are the
-    design's; cubic infill, two 0.4 mm perimeters (0.8 mm shell), TPU at 210 C on a 60 C bed.
+    design's; cubic infill (rectilinear at 100 %), two 0.4 mm perimeters (0.8 mm shell), TPU at
+    210 C on a 60 C bed.
 
     Example: designer next --k 0.8 --n 3 --json > next.json && designer print --from next.json -o prints
     """
@@ -118,7 +128,7 @@ def _print_batch(data: dict) -> None:
     )
     console.print(
         f"runs table: {files['runs']}; after the rig, name the print in each log's sidecar "
-        '({"print": "P1"}) and run designer identify LOGS --runs ' + files["runs"]
+        '({"print": "P1"}) and run designer identify LOGS --runs ' + shlex.quote(files["runs"])
     )
 
 

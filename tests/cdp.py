@@ -207,6 +207,10 @@ class Page:
         for kind in ("rawKeyDown", "keyUp"):
             self.call("Input.dispatchKeyEvent", type=kind, key=key, code=key, windowsVirtualKeyCode=code)
 
+    def backspace(self) -> None:
+        """Press and release Backspace in the focused element (empties a selected box)."""
+        self.key("Backspace", 8)
+
     def type_text(self, text: str) -> None:
         """Type text into the focused element as a keyboard would (one input event)."""
         self.call("Input.insertText", text=text)

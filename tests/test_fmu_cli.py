@@ -138,6 +138,10 @@ def test_cli_exports_fmu_with_json(tmp_path, cache_env):
         (["--k", "0.8", "--c", "2e-3", "--fmi", "4"], "--fmi 4 is not supported"),
         (["--k", "0.8", "--c", "2e-3", "--interface", "spring"], "--interface 'spring' is not an interface"),
         (["--density", "60"], "missing factor"),
+        (
+            ["--k", "0.8", "--c", "2e-3", "--surrogate", "mine.json"],
+            "--surrogate predicts a joint from a design",
+        ),
     ],
 )
 def test_cli_bad_input_is_one_line(tmp_path, cache_env, args, message):

@@ -72,6 +72,23 @@ def test_profiler_data(sur, tmp_path):
     assert embedded["responses"][0]["vcov"] == np.asarray(sur.model("k_x").vcov).tolist()
 
 
+def test_command_lines_name_the_surrogate_they_need(sur):
+    """The page's suggest and export command lines carry --surrogate for any surrogate but the
+    shipped one: its file quoted for a shell, or, with no file known, its id in a form no shell
+    runs unchanged (never a line that silently answers from the study's surrogate)."""
+    from dataclasses import replace
+
+    assert profile.build_profiler(sur).data["surrogate_flag"] == ""
+    flag = profile.build_profiler(sur, surrogate_file=Path("my prints") / "mine.json").data["surrogate_flag"]
+    assert flag == "--surrogate 'my prints/mine.json'"
+    other = replace(sur, models={**sur.models, "k_x": replace(sur.models["k_x"], sigma=0.5)})
+    assert other.id != sur.id
+    assert (
+        profile.build_profiler(other).data["surrogate_flag"]
+        == f"--surrogate <the file of surrogate {other.id}>"
+    )
+
+
 def test_nested_figures_are_preferred(sur, monkeypatch):
     model = sur.model("k_x")
     monkeypatch.setattr(
@@ -131,6 +148,10 @@ def test_cli_profile(sur, tmp_path):
     for bad, message in (
         (["--design", "width=3", "--design", "width=4"], "twice"),
         (["--target", "k"], "is not NAME=VALUE"),
+        # suggest and export take --axis theta (derived from x); the page said "the surrogate has no
+        # response 'k_theta' ... fit one on a table with that axis: Surrogate().fit(table)", a Python
+        # call and a fit the study's table cannot give
+        (["--axis", "theta"], "the profiler shows the axes the surrogate has (x), and theta is not one"),
     ):
         run = designer("profile", *bad, cwd=tmp_path)
         assert run.returncode == 2 and message in run.stderr and "Traceback" not in run.stderr, (

@@ -200,3 +200,72 @@ def test_a_log_without_a_sidecar_is_named_on_the_command_line(tmp_path, capsys):
     code, _, err = run_inprocess(["identify", log, "--runs", runs, "--print", "P1"], capsys)
     assert_clean_failure(code, err, allowed=(2,))
     assert "names print P2, --print P1" in " ".join(err.split()), err
+
+
+def test_a_sidecar_with_the_designed_height_is_the_printed_print(tmp_path, capsys):
+    """A rig's software that writes the design's settings (next.json's height, 9.05 mm) into the
+    sidecar, where the table holds the height printed (9.0 mm: whole 0.16 mm layers over the 0.2 mm
+    first): the same print, filled, not refused as "mixed up" (the old code refused it, exit 2,
+    telling the user to check the engraved id)."""
+    runs = _template(tmp_path, capsys)
+    design = dict(zip(FACTORS, [60.0, 24.0, 4.5, 9.05, 0.16, 0.0], strict=True))
+    log = rig_log(tmp_path, "P1", design, 0.9, 2.2e-3)
+    code, _, err = run_inprocess(["identify", log, "--runs", runs], capsys)
+    assert code == 0, err
+    assert np.isclose(pd.read_csv(runs)["k_x [N/mm]"].iloc[0], 0.9, rtol=0.02)
+    # a height that prints another whole layer (9.1 mm prints 9.16) is still another print
+    runs = _template(tmp_path / "again", capsys)
+    log = rig_log(tmp_path, "P1", design | {"height": 9.1}, 0.9, 2.2e-3)
+    code, _, err = run_inprocess(["identify", log, "--runs", runs], capsys)
+    assert_clean_failure(code, err, allowed=(2,))
+    assert "height 9.1" in err and "mixed up" in err, err
+
+
+def test_a_rotational_k_in_si_is_refused_naming_the_unit(tmp_path, capsys):
+    """A runs table on theta (`print --axis theta`, k_theta [N.mm/rad]) filled from a log whose
+    torque is in N.m: K 0.4 where the study's relation predicts about 400 N.mm/rad. identify --runs
+    names the slip the x table's check names, exit 2 (the old code filled it: the study surrogate
+    has no theta response, so nothing was compared)."""
+    code, _, err = run_inprocess(["print", *SIX, "--axis", "theta", "-o", tmp_path / "one"], capsys)
+    assert code == 0, err
+    runs = tmp_path / "one" / "runs.csv"
+    log = make_log(
+        {"theta": {"k": 0.4, "c": 6e-4, "m": 1e-6, "amplitude": 0.05}}, duration=60.0, rate=500.0, seed=3
+    )
+    path = tmp_path / "p1_run.csv"
+    log.to_csv(path, index=False)
+    code, _, err = run_inprocess(["identify", path, "--runs", runs, "--print", "P1"], capsys)
+    assert_clean_failure(code, err, allowed=(2,))
+    words = " ".join(err.split())
+    assert "k_theta of print P1 is 0.4" in words and "N.m/rad rather than N.mm/rad" in words, err
+    assert "--accept-implausible" in words and pd.read_csv(runs)["k_theta [N.mm/rad]"].isna().all()
+    # the same joint logged in N.mm: about 400 N.mm/rad, filled
+    log["Ttheta"] *= 1000.0
+    log.to_csv(path, index=False)
+    code, _, err = run_inprocess(["identify", path, "--runs", runs, "--print", "P1"], capsys)
+    assert code == 0, err
+    assert np.isclose(pd.read_csv(runs)["k_theta [N.mm/rad]"].iloc[0], 400.0, rtol=0.02)
+
+
+def test_a_measured_print_is_not_replaced_by_another_log(tmp_path, capsys):
+    """P1 measured from its log; then another log named P1 (a slip of --print, meant P2): refused,
+    naming the measurement it would replace, the table unchanged (the old code replaced P1's k and
+    its log, exit 0). The same log again (identified anew) may refill its own row."""
+    runs = _template(tmp_path, capsys)
+    design = dict(zip(FACTORS, [60.0, 24.0, 4.5, 9.0, 0.16, 0.0], strict=True))
+    first = rig_log(tmp_path, "P1", design, 0.9, 2.2e-3)
+    code, _, err = run_inprocess(["identify", first, "--runs", runs], capsys)
+    assert code == 0, err
+    before = pd.read_csv(runs)
+    other = tmp_path / "p2_run.csv"
+    make_log({"x": {"k": 0.6, "c": 3e-3, "m": 2e-3, "amplitude": 1.0}}, duration=60.0, rate=500.0).to_csv(
+        other, index=False
+    )
+    code, _, err = run_inprocess(["identify", other, "--runs", runs, "--print", "P1"], capsys)
+    assert_clean_failure(code, err, allowed=(2,))
+    words = " ".join(err.split())
+    assert "print P1 is measured already" in words and str(first) in words, err
+    pd.testing.assert_frame_equal(pd.read_csv(runs), before)
+    code, _, err = run_inprocess(["identify", first, "--runs", runs], capsys)
+    assert code == 0, err
+    pd.testing.assert_frame_equal(pd.read_csv(runs), before)

@@ -195,6 +195,38 @@ def test_simulator_defect_rate_matches_an_independent_monte_carlo(page, sur):
     assert f"({n_page} draws)" in text and "with print noise" in text
 
 
+@pytest.mark.parametrize(
+    ("typed", "said"),
+    [
+        ("0,5", "width sd: '0,5' has a comma: write the decimal point as '.' (0.5)"),
+        ("-1", "width sd -1 mm must be 0 or more"),
+        ("", "width sd: empty"),
+        ("50", "of the draws put width at or below 0"),
+    ],
+)
+def test_a_bad_print_noise_gives_no_defect_rate(page, typed, said):
+    """The noise boxes were number inputs read with parseFloat: "0,5" became 5 mm (Chromium drops the
+    comma), "-1" and an emptied box kept the old sd beside what the box said, and a noise larger than
+    the part (width sd 5 or 50 mm) printed "NaN % +- NaN %". Now read as the other typed boxes, with
+    the error beside the box and no rate until it is fixed; draws at or below 0 give no rate either."""
+    _set_goal(page, "k_x", "target", 0.8)
+    page.click("#noise-width")
+    page.js("document.getElementById('noise-width').select()")
+    page.type_text("0.3")
+    assert float(page.js("document.getElementById('sim-k_x').dataset.defect")) > 0
+    page.js("document.getElementById('noise-width').select()")
+    if typed:
+        page.type_text(typed)
+    else:
+        page.backspace()
+    sim = page.js("document.getElementById('sim').textContent")
+    assert sim.startswith("no defect rate: ") and said in sim and "NaN" not in sim, sim
+    assert page.js("document.getElementById('sim-k_x')") is None
+    if typed != "50":  # a bad box: its message beside it, the old sd not used
+        assert said in page.js("document.getElementById('noise-err-width').textContent")
+        assert page.js("document.getElementById('noise-width').getAttribute('aria-invalid')") == "true"
+
+
 @pytest.mark.parametrize(("width", "height"), [(1280, 800), (390, 844)])
 def test_layout_fits_the_screen(browser, url, tmp_path, width, height):
     page = browser.new_page()
@@ -227,6 +259,26 @@ def test_layout_fits_the_screen(browser, url, tmp_path, width, height):
     assert small == [], f"touch targets under 44 px: {small}"
     shot = page.screenshot(tmp_path / f"profile_{width}.png")
     assert_picture(shot, min_size=(width - 20, height))  # less a scroll bar
+    page.call("Page.close")
+
+
+@pytest.mark.parametrize("width", [640, 720, 900, 1024, 1140])
+def test_panels_stay_readable_in_a_narrow_window(browser, url, width):
+    """Between the phone layout (600 px) and a wide screen the six panels stayed in one row beside
+    the summary and shrank with the window: 58 px wide at 640 px, 101 px at 900, their 11-unit labels
+    drawn at 3.6 and 6.3 px. A panel is now never narrower than 140 px (labels 8.8 px or more)."""
+    page = browser.new_page()
+    page.viewport(width, 800)
+    page.goto(url)
+    page.js("document.querySelector('details.flat').open = true")
+    _set_goal(page, "k_x", "target", 0.8)  # the P trace's row too
+    widths = page.js(
+        "[...document.querySelectorAll('svg[data-response], svg[data-trace]')]"
+        ".map(s => s.getBoundingClientRect().width)"
+    )
+    assert len(widths) == 18 and min(widths) >= 140, (width, widths)
+    sizes = page.js("[document.documentElement.scrollWidth, document.documentElement.clientWidth]")
+    assert sizes[0] <= sizes[1], f"horizontal overflow at {width} px: {sizes}"
     page.call("Page.close")
 
 
@@ -263,11 +315,10 @@ def test_accessibility_tree_names_every_control_with_its_unit(page, sur):
             assert pressed[f"{f.name} {lv:g} {f.unit}"] in (["true"], ["false"])
     checks = {name(n) for n in by_role["checkbox"]}
     assert {f"lock {f.name} (hold it when maximizing)" for f in space.FACTORS} <= checks
-    numbers = {name(n) for n in by_role["spinbutton"]}
     typed = {name(n) for n in by_role["textbox"]}  # typed numbers are read by the page, errors shown
     assert "target k_x (N/mm)" in typed and "tolerance around a target, \u00b1 %" in typed
     assert {f"{f.name} value ({f.unit})" for f in space.CONTINUOUS} <= typed
-    assert {f"print noise, standard deviation of {f.name} ({f.unit})" for f in space.CONTINUOUS} <= numbers
+    assert {f"print noise, standard deviation of {f.name} ({f.unit})" for f in space.CONTINUOUS} <= typed
     images = [name(n) for n in by_role["image"]]
     contour = [n for n in images if n.startswith("width against height")]
     trace = [n for n in images if n.startswith("P(every stated goal met) against ")]

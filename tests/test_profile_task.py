@@ -261,6 +261,63 @@ def test_a_bad_goal_is_an_error_beside_its_box(page, typed, said):
     assert "fix the goal of k_x" in page.js("document.getElementById('max-why').textContent")
 
 
+@pytest.mark.parametrize(
+    ("typed", "said"),
+    [
+        ("5,5", "has a comma: write the decimal point as '.' (5.5)"),
+        ("", "empty"),
+        ("0", "between 0 and 100 %"),
+    ],
+)
+def test_a_bad_tolerance_computes_nothing_for_the_old_one(page, typed, said):
+    """The tolerance box showed its error but P, the band, the defect rate and Maximize went on with
+    the old tolerance (5 %: "P(k_x +-5 % ...) 19 %" beside a box saying "5,5"); as a bad goal does,
+    it now leaves the targets without a P and Maximize greyed with the reason."""
+    page.js("document.getElementById('goal-kind-k_x').focus()")
+    choose(page, "goal-kind-k_x", "target")
+    press(page, "Tab")
+    type_keys(page, "0.8")
+    page.js("document.getElementById('tolerance').focus()")
+    type_keys(page, "5")
+    assert float(page.js("document.getElementById('tgt-k_x').dataset.probability")) > 0
+    assert page.js("document.querySelectorAll('rect.band').length") == 6
+    type_keys(page, typed)
+    if not typed:  # emptied: selected, then Backspace
+        page.backspace()
+    assert said in page.js("document.getElementById('tol-err').textContent")
+    assert page.js("document.getElementById('tolerance').getAttribute('aria-invalid')") == "true"
+    assert page.js("document.getElementById('tgt-k_x').dataset.probability") is None
+    assert said in page.js("document.getElementById('tgt-k_x').textContent")
+    assert page.js("document.getElementById('overall').dataset.probability") is None
+    assert page.js("document.querySelectorAll('rect.band').length") == 0
+    assert page.js("document.querySelectorAll('#sim [data-defect]').length") == 0
+    assert page.js("document.getElementById('maximize').disabled")
+    assert "fix the tolerance" in page.js("document.getElementById('max-why').textContent")
+    assert "tolerance error" in page.js("document.getElementById('readout').textContent")
+
+
+def test_a_goal_typed_in_si_units_is_named_as_suggest_names_it(page):
+    """k 800 and c 2 typed where N/mm and N.s/mm are asked (values in N/m, N.s/m): the page said
+    only "out of reach" and "probability 0.00", where `designer suggest` names the slip and the
+    value meant; the page now says suggest's words."""
+    said = {}
+    for response, value, flag in (("k_x", "800", "--k"), ("c_x", "2", "--c")):
+        page.js(
+            f"(() => {{ const s = document.getElementById('goal-kind-{response}');"
+            " s.value = 'target'; s.dispatchEvent(new Event('change')); })()"
+        )
+        page.js(f"document.getElementById('goal-value-{response}').focus()")
+        type_keys(page, value)
+        said[response] = page.js(f"document.getElementById('tgt-{response}').textContent")
+        _, want = _suggest(*(["--k", "0.8"] if flag == "--c" else []), flag, value)
+        hint = [s for s in want["statements"] if "rather than" in s]
+        assert hint, want["statements"]
+        named = hint[0][hint[0].index(" (a value in") : hint[0].index(")", hint[0].index(" (a value in")) + 1]
+        assert named in said[response], (named, said[response])
+    assert "(a value in N/m rather than N/mm? that is k=0.8 N/mm)" in said["k_x"]
+    assert "(a value in N.s/m rather than N.s/mm? that is c=0.002 N.s/mm)" in said["c_x"]
+
+
 def test_k_3_is_out_of_reach_as_suggest_says_and_old_suggestions_grey(browser, folder):
     page = _open(browser, folder / "s.html")
     assert page.js(

@@ -21,6 +21,7 @@ from __future__ import annotations
 import html
 import json
 import math
+import shlex
 from collections.abc import Mapping
 from dataclasses import dataclass
 from importlib import resources
@@ -34,8 +35,9 @@ from .. import units
 from ..errors import DesignerError
 from ..files import atomic_write
 from ..model.forms import columns
+from ..model.plausibility import SLIP_TOLERANCE, unit_slip
 from ..model.prediction import ResponseSurface
-from ..model.surrogate import Surrogate
+from ..model.surrogate import Surrogate, default_path
 from ..study import space
 
 #: the design the page opens at unless told otherwise (the study's centre, layer 0.16 mm, raster 0 deg)
@@ -159,6 +161,18 @@ def _value_range(model: ResponseSurface, observed: np.ndarray, target: float | N
     return [max(lo - pad, 0.0) if lo >= 0 else lo - pad, hi + pad]
 
 
+def _slips(quantity: str, axis: str) -> list[dict[str, Any]]:
+    """The unit slips a typed goal may carry (a value in N/m typed for N/mm), as `designer suggest`
+    names them: each with the ratio to the measured range it shows as, its cause and the multiplier
+    that corrects it; a goal within `SLIP_TOLERANCE` of that ratio is named on the page as by suggest."""
+    out = []
+    for ratio in (1e3, 1e-3):
+        slip = unit_slip(quantity, axis, ratio, logged=False)
+        if slip:
+            out.append({"ratio": ratio, "cause": slip[0], "multiplier": slip[1], "within": SLIP_TOLERANCE})
+    return out
+
+
 def _target(surrogate: Surrogate, quantity: str, axis: str, goal: float | str) -> dict[str, Any]:
     """A goal (a target value, "min" or "max") with its desirability bounds, as `designer suggest`
     sets them."""
@@ -189,6 +203,7 @@ def _response(surrogate: Surrogate, name: str, statement: str, target: float | s
         "accuracy": _accuracy(model),
         "range": _value_range(model, observed, target if isinstance(target, float | int) else None),
         "observed": [float(v) for v in model.observed_range],
+        "slips": _slips(model.quantity, model.axis),
         "target": None if target is None else _target(surrogate, model.quantity, model.axis, target),
     }
 
@@ -254,8 +269,9 @@ def _suggestions(suggestion: Any) -> list[dict[str, Any]]:
 
 
 def _suggestion_goals(suggestion: Any) -> dict[str, Any] | None:
-    """The goals and tolerance a suggestion was found for (its buttons grey out once the page's
-    goals differ), or None when it does not record them."""
+    """The goals, tolerance and surrogate id a suggestion was found for (its buttons grey out once
+    the page's goals differ, or when the page shows another surrogate), or None when it does not
+    record goals and tolerance."""
     if suggestion is None:
         return None
     data = _suggestion_dict(suggestion)
@@ -267,7 +283,12 @@ def _suggestion_goals(suggestion: Any) -> dict[str, Any] | None:
     for q in ("k", "c"):
         v = targets.get(q)
         goals[q] = float(v) if isinstance(v, int | float) else v if v in ("min", "max") else None
-    return {"targets": goals, "tolerance": float(tol)}
+    found_with = data.get("surrogate_id")
+    return {
+        "targets": goals,
+        "tolerance": float(tol),
+        "surrogate_id": found_with if isinstance(found_with, str) else None,
+    }
 
 
 def _within(f: space.Factor, v: float) -> bool:
@@ -324,6 +345,17 @@ def _calibrated(surrogate: Surrogate, responses: list[dict[str, Any]]) -> dict[s
     }
 
 
+def _surrogate_flag(surrogate: Surrogate, surrogate_file: str | Path | None) -> str:
+    """The `--surrogate FILE` the page's command lines (suggest, export) carry, "" for the shipped
+    surrogate: without it they would answer from the study's surrogate, not the page's. A surrogate
+    of no known file is named by its id in a form no shell runs unchanged."""
+    if surrogate_file is not None:
+        return "--surrogate " + shlex.quote(str(surrogate_file))
+    if surrogate.id == json.loads(default_path().read_text(encoding="utf-8")).get("id"):
+        return ""
+    return f"--surrogate <the file of surrogate {surrogate.id}>"
+
+
 def _factors() -> list[dict[str, Any]]:
     """The six factors as the page's sliders and boxes read them."""
     return [
@@ -342,6 +374,23 @@ def _factors() -> list[dict[str, Any]]:
     ]
 
 
+def _check_axis(surrogate: Surrogate, axis: str) -> None:
+    """Refuse an axis the surrogate has no k and c of (a rotational one is derived by suggest, next
+    and export, not by the page)."""
+    units.check_axis(axis)
+    if axis in surrogate.axes:
+        return
+    derived = units.is_rotational(axis) and "x" in surrogate.axes
+    why = "; suggest, next and export derive a rotational axis from x, the page does not" if derived else ""
+    raise DesignerError(
+        f"the profiler shows the axes the surrogate has ({', '.join(surrogate.axes) or 'none'}), "
+        f"and {axis} is not one of them{why}",
+        f"profile the {surrogate.axes[0]} axis"
+        if surrogate.axes
+        else "fit a surrogate with k and c of an axis",
+    )
+
+
 def build_profiler(
     surrogate: Surrogate,
     *,
@@ -350,6 +399,7 @@ def build_profiler(
     tolerance: float | None = None,
     suggestion: Any = None,
     design: Mapping[str, float] | None = None,
+    surrogate_file: str | Path | None = None,
 ) -> Profiler:
     """Gather what the profiler page needs for k and c of one axis.
 
@@ -362,12 +412,14 @@ def build_profiler(
         suggestion: a `Suggestion`, its `to_dict()` or the path of a JSON file of it (what the
             suggest command writes with its JSON option).
         design: factors the page opens at (the rest from `DEFAULT_DESIGN`), within the tested ranges.
+        surrogate_file: the file `surrogate` was read from, as a shell in the user's folder reaches
+            it: the page's suggest and export command lines carry `--surrogate` with it.
 
     Raises:
         DesignerError: unknown axis, quantity or factor; a value outside the tested ranges; a
             target that is not positive; a tolerance outside (0, 1); an unreadable suggestion.
     """
-    units.check_axis(axis)
+    _check_axis(surrogate, axis)
     suggestion = None if suggestion is None else _suggestion_dict(suggestion)
     found = _suggestion_goals(suggestion)
     # opened from a suggestion: its goals and tolerance unless given, its first candidate unless a
@@ -402,6 +454,7 @@ def build_profiler(
         {
             "axis": axis,
             "surrogate_id": surrogate.id,
+            "surrogate_flag": _surrogate_flag(surrogate, surrogate_file),
             "factors": _factors(),
             "design": start,
             "responses": responses,

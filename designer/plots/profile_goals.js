@@ -1,12 +1,13 @@
 // ---- goals set on the page: typed numbers read strictly, errors shown beside their box ----
 const goalError = {}; // response name -> the message shown beside its goal, or absent
 const reachCache = {}; // response name -> { key, range }: the predicted range over the search box
-// a number as typed: digits with a decimal point and an optional exponent; a comma is named, never misread
-function parseTyped(text) {
+// a number as typed: digits with a decimal point and an optional exponent; a comma is named, never misread;
+// `example` is a number the box takes, for the message
+function parseTyped(text, example = "0.8") {
   const t = String(text).trim();
   if (t === "") return { error: "empty: type a number" };
   if (/^[+-]?\d*,\d+$/.test(t)) return { error: "'" + t + "' has a comma: write the decimal point as '.' (" + t.replace(",", ".") + ")" };
-  if (!/^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$/.test(t)) return { error: "'" + t + "' is not a number: type e.g. 0.8" };
+  if (!/^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$/.test(t)) return { error: "'" + t + "' is not a number: type e.g. " + example };
   return { value: parseFloat(t) };
 }
 // a goal number of response r as designer.design.targets.make_target accepts it: positive (a low limit
@@ -73,6 +74,16 @@ function reachRange(r) {
   if (!c || c.key !== key) reachCache[r.name] = { key: key, range: predictedRange(r) };
   return reachCache[r.name].range;
 }
+// designer suggest's hint when a target lies about a unit's thousand from a range (its geometric
+// middle): " (a value in N/m rather than N/mm? that is k=0.8 N/mm)", else ""
+function slipHint(r, value, range) {
+  const ratio = value / Math.sqrt(range[0] * range[1]);
+  for (const s of r.slips) {
+    if (Math.abs(Math.log10(ratio) - Math.log10(s.ratio)) < Math.log10(s.within))
+      return " (" + s.cause + "? that is " + r.quantity + "=" + sig(value * s.multiplier, 6) + " " + r.unit + ")";
+  }
+  return "";
+}
 // designer suggest's statement when no design reaches a goal, or null when one does
 function outOfReach(r, g) {
   const l = limitsOf(g);
@@ -82,17 +93,20 @@ function outOfReach(r, g) {
   const held = Object.keys(searchBox().fixed);
   const what = g.kind === "target" ? r.quantity + " = " + sig(g.value, 6) + " " + r.unit + " is out of reach within \u00b1" + sig(100 * tolerance, 3) + " %"
     : r.quantity + " between " + sig(g.lsl, 6) + " and " + sig(g.usl, 6) + " " + r.unit + " is out of reach";
-  return what + ": over the tested ranges" + (held.length ? " (holding " + held.join(", ") + ")" : "") + " the surrogate predicts " + r.name + " from " + sig(lo, 3) + " to " + sig(hi, 3) + " " + r.unit;
+  return what + ": over the tested ranges" + (held.length ? " (holding " + held.join(", ") + ")" : "") + " the surrogate predicts " + r.name + " from " + sig(lo, 3) + " to " + sig(hi, 3) + " " + r.unit +
+    (g.kind === "target" ? slipHint(r, g.value, r.observed) : "");
 }
 function goalText(r, p, prob) {
   const g = goals[r.name];
   if (goalError[r.name]) return "no goal: " + goalError[r.name];
   if (!g) return "";
+  if (g.kind === "target" && toleranceError) return "no P: " + toleranceError;
   if (!r.predictable && r.calibrated && limitsOf(g))
     return "P(" + limitsText(r, g) + ") = " + pct(prob) + " here: your prints pin " + r.name + " down near the designs you printed (not predictable from the six factors elsewhere; maximize does not act on it)";
   if (!r.predictable) {
     if (!limitsOf(g)) return "goal " + g.kind + ": cannot be acted on, no setting changes it";
-    return r.name + " is not predictable: any design lands within " + limitsText(r, g) + " with probability " + prob.toFixed(2) + "; no setting can be chosen for it from this data";
+    const hint = g.kind === "target" && (g.value < p.low || g.value > p.high) ? slipHint(r, g.value, [p.low, p.high]) : "";
+    return r.name + " is not predictable: any design lands within " + limitsText(r, g) + hint + " with probability " + prob.toFixed(2) + "; no setting can be chosen for it from this data";
   }
   const d = desirability(g, p.value);
   if (!limitsOf(g)) return g.kind + " (desirability bounds " + sig(g.low, 3) + " to " + sig(g.high, 3) + " " + r.unit + "): desirability " + d.toFixed(2);
@@ -103,10 +117,13 @@ function goalText(r, p, prob) {
 function pct(p) { return (100 * p).toFixed(p < 0.1 ? 1 : 0) + " %"; }
 // the goal as the suggestion file records it: a number, "min", "max", "limits" or null
 function goalKey(g) { return !g ? null : g.kind === "target" ? g.value : g.kind; }
-// a suggestion found for other goals (or another tolerance) than the page's now: greyed, and says so
+// a suggestion found with another surrogate, or for other goals (or another tolerance) than the
+// page's now: greyed, and says so
 function suggestionStale() {
   const sg = D.suggestion_goals;
   if (!sg) return null;
+  if (sg.surrogate_id && sg.surrogate_id !== D.surrogate_id)
+    return "found with surrogate " + sg.surrogate_id + ", not this page's " + D.surrogate_id + ": its P is not this surrogate's";
   const diff = [];
   for (const r of R) {
     if (!r.predictable) continue;

@@ -3,6 +3,7 @@ const D = JSON.parse(document.getElementById("data").textContent);
 const F = D.factors, R = D.responses, FC = F.filter((f) => !f.categorical), FK = F.filter((f) => f.categorical);
 const state = Object.assign({}, D.design), locked = {}, goals = {};
 let tolerance = D.tolerance;
+let toleranceError = null; // the tolerance box's error: no target has limits (nor a P) until it is fixed
 for (const r of R) goals[r.name] = r.target ? Object.assign({}, r.target) : null;
 const NEAR = 0.25; // a run is near when its other factors lie within this share of their range
 const CURVE = 41; // points on each continuous panel's curve
@@ -135,7 +136,7 @@ function pBetween(r, p, low, high) {
 // the limits a goal is met within: +- the tolerance around a target value, or the goal's own low and high limits
 function limitsOf(g) {
   if (!g) return null;
-  if (g.kind === "target") return [g.value * (1 - tolerance), g.value * (1 + tolerance)];
+  if (g.kind === "target") return toleranceError ? null : [g.value * (1 - tolerance), g.value * (1 + tolerance)];
   if (g.kind === "limits") return [g.lsl, g.usl];
   return null;
 }

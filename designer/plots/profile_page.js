@@ -61,7 +61,7 @@ function buildControls() {
 // a factor value typed into its box: read strictly, rounded to the printable step and clamped to the
 // tested range; what was changed is said beside the box
 function typeValue(f, box) {
-  const msg = document.getElementById("e-" + f.name), n = parseTyped(box.value);
+  const msg = document.getElementById("e-" + f.name), n = parseTyped(box.value, sig(f.low + 0.5 * (f.high - f.low), 3));
   if (n.error) { msg.textContent = f.name + ": " + n.error; box.setAttribute("aria-invalid", "true"); return; }
   const v = Number((Math.round(n.value / f.step) * f.step).toFixed(6)), clamped = Math.min(f.high, Math.max(f.low, v));
   msg.textContent = clamped !== v ? f.name + " " + sig(n.value, 6) + " " + f.unit + " is outside the tested range " + sig(f.low, 4) + " to " + sig(f.high, 4) + " " + f.unit + ": set to " + sig(clamped, 6) + " " + f.unit :
@@ -113,12 +113,14 @@ function renderReadout(sc) {
   if (out.length) parts.push('<span class="out">' + esc(out.map((t) => t.split(":")[0]).join("; ")) + "</span>");
   const bad = Object.keys(goalError);
   if (bad.length) parts.push('<span class="out">goal error: ' + esc(bad.join(", ")) + "</span>");
+  if (toleranceError) parts.push('<span class="out">tolerance error</span>');
   document.getElementById("readout").innerHTML = parts.join(" ");
 }
 // why maximize cannot run now, or "" when it can
 function maximizeBlocked() {
   const bad = Object.keys(goalError);
   if (bad.length) return "fix the goal of " + bad.join(" and ") + " first";
+  if (toleranceError) return "fix the tolerance first";
   if (!Object.keys(weights()).length) return "set a goal (target, limits, min or max) on a predictable response first";
   return "";
 }
@@ -157,7 +159,14 @@ function render() {
   if (sc.joint !== null) texts.push("P(every stated goal met: " + named.map((r) => r.name + " " + limitsText(r, goals[r.name])).join(" and ") + ") = " + pct(sc.joint) +
     (named.length > 1 ? " (" + named.map((r) => r.name + " " + pct(sc.prob[r.name])).join(" \u00d7 ") + ": given the model the responses scatter independently)" : ""));
   const blind = named.filter((r) => !r.predictable);
-  if (blind.length) texts.push(blind.map((r) => r.name).join(", ") + " not predictable: no setting changes " + (blind.length > 1 ? "their" : "its") + " chance; maximize ranks by P of the predictable goals" + (sc.p === null ? "" : ", " + pct(sc.p)));
+  // a calibrated page: the user's prints pin an unpredictable response down near them, so its chance
+  // does change with the setting (though maximize does not act on it)
+  const their = (rs) => (rs.length > 1 ? "their" : "its");
+  const flat = blind.filter((r) => !r.calibrated), pinned = blind.filter((r) => r.calibrated);
+  const because = [];
+  if (flat.length) because.push(flat.map((r) => r.name).join(", ") + " not predictable: no setting changes " + their(flat) + " chance");
+  if (pinned.length) because.push(pinned.map((r) => r.name).join(", ") + " not predictable from the six factors: " + their(pinned) + " chance varies with the setting only through your prints (designer calibrate)");
+  if (blind.length) texts.push(because.join("; ") + "; maximize ranks by P of the predictable goals" + (sc.p === null ? "" : ", " + pct(sc.p)));
   if (sc.d !== null) texts.push("composite desirability (predictable responses) " + sc.d.toFixed(2));
   ov.textContent = texts.join("; ");
   const side = state.width <= state.height ? "width" : "height", core = state[side] - 2 * D.wall_mm;
@@ -182,7 +191,7 @@ function suggestCommand() {
   const set = R.filter((r) => goals[r.name]);
   if (set.some((r) => goals[r.name].kind === "limits")) return "no designer suggest command: it takes a target \u00b1 --tolerance, not low and high limits (the search aimed at the limits' midpoint)";
   return "the same search as: designer suggest " + set.map((r) => "--" + r.quantity + " " + (goals[r.name].kind === "target" ? sig(goals[r.name].value, 6) : goals[r.name].kind)).join(" ") +
-    (D.axis === "x" ? "" : " --axis " + D.axis) + F.filter((f) => locked[f.name]).map((f) => " --fix " + f.name + "=" + sig(state[f.name], 6)).join("") +
+    (D.axis === "x" ? "" : " --axis " + D.axis) + surrogateFlag() + F.filter((f) => locked[f.name]).map((f) => " --fix " + f.name + "=" + sig(state[f.name], 6)).join("") +
     (Math.abs(tolerance - 0.1) > 1e-12 ? " --tolerance " + sig(100 * tolerance, 4) : "");
 }
 function runMaximize() {
@@ -202,10 +211,12 @@ const tolEl = document.getElementById("tolerance");
 tolEl.value = sig(100 * tolerance, 4);
 tolEl.setAttribute("aria-label", "tolerance around a target, \u00b1 %");
 tolEl.oninput = () => {
-  const n = parseTyped(tolEl.value), err = document.getElementById("tol-err");
+  const n = parseTyped(tolEl.value, "10"), err = document.getElementById("tol-err");
   const bad = n.error ? "tolerance: " + n.error : !(n.value > 0 && n.value < 100) ? "tolerance " + sig(n.value, 6) + " % must lie between 0 and 100 %" : "";
   err.textContent = bad; tolEl.setAttribute("aria-invalid", bad ? "true" : "false");
-  if (!bad) { tolerance = n.value / 100; render(); }
+  toleranceError = bad || null;
+  if (!bad) tolerance = n.value / 100;
+  render();
 };
 document.getElementById("maximize").onclick = runMaximize;
 document.getElementById("remember").onclick = remember;

@@ -35,33 +35,49 @@ function rng(seed) {
   };
 }
 const noise = Object.assign({}, D.noise);
+const noiseError = {}; // factor name -> the message beside its noise box (no defect rate until fixed)
+// the draws put a factor at or below 0 (a noise larger than the part): the model has no value there,
+// so no rate is given; `nonphysical` is their share and `where` the factors they hit
 function simulate(x) {
   const n = D.mc_draws, normal = rng(20251125), out = {};
   const rs = R.filter((r) => r.predictable && limitsOf(goals[r.name]));
   for (const r of rs) out[r.name] = { sum: 0, sum2: 0 };
-  let outside = 0;
+  let outside = 0, nonphysical = 0;
+  const where = new Set();
   for (let i = 0; i < n; i++) {
     const y = Object.assign({}, x);
     for (const f of FC) y[f.name] += (noise[f.name] || 0) * normal();
     if (FC.some((f) => y[f.name] < f.low || y[f.name] > f.high)) outside++;
+    const hit = FC.filter((f) => y[f.name] <= 0);
+    if (hit.length) { nonphysical++; hit.forEach((f) => where.add(f.name)); continue; }
     for (const r of rs) { const p = pGoal(r, predict(r, y), goals[r.name]); out[r.name].sum += p; out[r.name].sum2 += p * p; }
   }
   for (const r of rs) {
     const o = out[r.name], mean = o.sum / n, v = Math.max(o.sum2 / n - mean * mean, 0) * n / (n - 1);
     o.defect = 1 - mean; o.se = Math.sqrt(v / n); o.noiseless = 1 - pGoal(r, predict(r, x), goals[r.name]);
   }
-  return { draws: n, outside: outside / n, responses: out };
+  return { draws: n, outside: outside / n, responses: out, nonphysical: nonphysical / n, where: [...where] };
 }
 function buildNoise() {
   const box = document.getElementById("noise");
   for (const f of FC) {
     const l = document.createElement("label");
     l.innerHTML = "<span>" + esc(f.name) + " sd (" + esc(f.unit) + ")</span>";
-    const inp = document.createElement("input");
-    Object.assign(inp, { type: "number", id: "noise-" + f.name, min: 0, step: f.unit === "%" ? 0.5 : 0.01, value: noise[f.name] || 0 });
+    const inp = document.createElement("input"), err = document.createElement("div"), item = document.createElement("div");
+    Object.assign(inp, { type: "text", id: "noise-" + f.name, className: "num", value: sig(noise[f.name] || 0, 6) });
+    inp.setAttribute("inputmode", "decimal");
     inp.setAttribute("aria-label", "print noise, standard deviation of " + f.name + " (" + f.unit + ")");
-    inp.oninput = () => { const v = parseFloat(inp.value); if (v >= 0) { noise[f.name] = v; renderSim(); } };
-    l.appendChild(inp); box.appendChild(l);
+    Object.assign(err, { className: "err", id: "noise-err-" + f.name }); err.setAttribute("role", "alert");
+    inp.setAttribute("aria-describedby", err.id);
+    // read strictly, as the other typed boxes ("0,5" is named, never read as 5; a negative sd refused)
+    inp.oninput = () => {
+      const n = parseTyped(inp.value, "0.1"), bad = n.error ? f.name + " sd: " + n.error :
+        !(n.value >= 0 && isFinite(n.value)) ? f.name + " sd " + sig(n.value, 6) + " " + f.unit + " must be 0 or more" : "";
+      err.textContent = bad; inp.setAttribute("aria-invalid", bad ? "true" : "false");
+      if (bad) noiseError[f.name] = bad; else { delete noiseError[f.name]; noise[f.name] = n.value; }
+      renderSim();
+    };
+    l.appendChild(inp); item.appendChild(l); item.appendChild(err); box.appendChild(item);
   }
   document.getElementById("sim-about").textContent = "Each of " + D.mc_draws + " draws adds independent normal noise (standard deviation below, rig units; defaults: " +
     FC.map((f) => sig(D.noise[f.name] || 0, 3) + " " + f.unit + " on " + f.name).join(", ") +
@@ -73,9 +89,14 @@ function mcText(o) {
   return (100 * o.defect).toFixed(d) + " % \u00b1 " + e.toFixed(d) + " % with print noise, " + (100 * o.noiseless).toFixed(d) + " % without";
 }
 function renderSim() {
-  const el = document.getElementById("sim"), s = simulate(asShown());
-  const names = Object.keys(s.responses);
-  if (!names.length) { el.textContent = "set a target on a predictable response to get a defect rate"; return; }
+  const el = document.getElementById("sim"), bad = Object.values(noiseError);
+  if (bad.length) { el.textContent = "no defect rate: " + bad.join("; "); return; }
+  const s = simulate(asShown()), names = Object.keys(s.responses);
+  if (!names.length) { el.textContent = toleranceError ? "no defect rate: " + toleranceError : "set a target on a predictable response to get a defect rate"; return; }
+  if (s.nonphysical > 0) {
+    el.textContent = "no defect rate: " + (100 * s.nonphysical).toFixed(1) + " % of the draws put " + s.where.join(" and ") + " at or below 0, where the model has no value (a noise larger than the part): lower its sd";
+    return;
+  }
   el.innerHTML = names.map((n) => {
     const o = s.responses[n];
     return '<div id="sim-' + n + '" data-defect="' + o.defect + '" data-se="' + o.se + '" data-noiseless="' + o.noiseless + '">' + esc(n) + ": defect rate (outside " + limitsText(R.find((r) => r.name === n), goals[n]) + ") " +
@@ -94,8 +115,10 @@ function remember() {
   saveMemory();
 }
 function saveMemory() { try { localStorage.setItem(KEY, JSON.stringify(memory)); } catch (e) { /* a private window: this page only */ } renderMemory(); }
+// the page's surrogate on a command line (" --surrogate mine.json"), "" for the shipped one
+function surrogateFlag() { return D.surrogate_flag ? " " + D.surrogate_flag : ""; }
 function commandLine(m, i) {
-  return "designer export fmu " + F.map((f) => "--" + f.name + " " + sig(m.params[f.name], 6)).join(" ") + (D.axis === "x" ? "" : " --axis " + D.axis) + " -o joint" + (i + 1) + ".fmu";
+  return "designer export fmu " + F.map((f) => "--" + f.name + " " + sig(m.params[f.name], 6)).join(" ") + (D.axis === "x" ? "" : " --axis " + D.axis) + surrogateFlag() + " -o joint" + (i + 1) + ".fmu";
 }
 function suggestionJson() {
   const goal = (q) => { const r = R.find((x) => x.quantity === q), g = r && goals[r.name]; return !g ? null : g.value !== null ? g.value : g.kind; };

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from ..errors import DesignerError
@@ -96,7 +97,13 @@ def write_batch(
     """Write the plate, each print's STL and PrusaSlicer `.ini`, and the runs table.
 
     The files go into `folder` (filled beside it and moved in at the end); the runs table is
-    `folder/runs.csv`, or `runs_path`, to which the batch's rows are appended when it exists.
+    `folder/runs.csv`, or `runs_path`, to which the batch's rows are appended when it exists. A
+    `folder/runs.csv` already there is kept as it is when it holds this batch (the same ids and
+    settings: parts made again, its measurements stay), and refused otherwise.
+
+    Raises:
+        DesignerError: `folder/runs.csv` holds other prints (see `_holds_batch`), or `runs_path`
+            holds one of the batch's ids.
 
     Returns:
         {"plate": path, "stl": [paths], "ini": [paths], "runs": path}.
@@ -116,12 +123,13 @@ def write_batch(
         rows = pd.concat([existing, rows], ignore_index=True)
     folder = Path(folder)
     table = Path(runs_path) if runs_path is not None else folder / "runs.csv"
+    keep = runs_path is None and _holds_batch(table, rows)
     with atomic_folder(folder) as stage:
         write_plate(batch.prints, stage / "plate.3mf")
         for p in batch.prints:
             p.mesh.export(stage / f"{p.print_id}.stl")
             (stage / f"{p.print_id}.ini").write_text(settings.prusa_ini(p.params, p.print_id))
-        if runs_path is None:
+        if runs_path is None and not keep:
             write_frame(rows, stage / "runs.csv")
     if runs_path is not None:
         write_frame(rows, table)
@@ -131,3 +139,40 @@ def write_batch(
         "ini": [str(folder / f"{p.print_id}.ini") for p in batch.prints],
         "runs": str(table),
     }
+
+
+def _holds_batch(table: Path, rows: pd.DataFrame) -> bool:
+    """Whether the runs table `table` in a batch's folder holds the batch of `rows` already (the
+    same print ids and settings, measured or not), so that it is kept; False when there is none.
+
+    Replacing any other table would lose what it holds: the measured k and c of prints already
+    made, or the settings of specimens already engraved with the ids this batch would reuse.
+
+    Raises:
+        DesignerError: `table` holds other prints or other settings, naming those measured.
+    """
+    from ..study.data import canonical_columns
+
+    if not table.exists():
+        return False
+    try:
+        old = runs.read_runs(table)
+        named = canonical_columns(old.drop(columns=[runs.PRINT]), source=str(table))
+        same = list(old[runs.PRINT]) == list(rows[runs.PRINT]) and all(
+            np.allclose(
+                pd.to_numeric(named[n], errors="coerce"), rows[runs.FACTOR_HEADERS[n]], rtol=0, atol=1e-9
+            )
+            for n in space.FACTOR_NAMES
+        )
+    except (DesignerError, KeyError, ValueError, TypeError):
+        old, same = None, False
+    if same:
+        return True
+    held = "" if old is None else f" (prints {', '.join(old[runs.PRINT])}"
+    if old is not None:
+        done = runs.measured_rows(old)[0]
+        held += f"; measured: {', '.join(done)})" if done else ")"
+    raise DesignerError(
+        f"{table} already holds another batch{held}, which this one would replace",
+        f"append this batch to it with runs_path='{table}' (its ids continue), or write to another folder",
+    )

@@ -9,6 +9,7 @@ reads; a row still empty (a print not measured yet) is left out of a calibration
 from __future__ import annotations
 
 import json
+import os
 import re
 from collections.abc import Sequence
 from pathlib import Path
@@ -21,6 +22,7 @@ from .. import units
 from ..errors import DesignerError
 from ..study import space
 from ..study.data import canonical_columns, load_table, read_frame
+from . import settings
 
 #: the print id column
 PRINT = "print"
@@ -155,8 +157,8 @@ def fill(
     Raises:
         DesignerError: a log whose sidecar names no print (and no `print_id`) or a print not in the
             table, `print_id` with several logs or against its sidecar, two logs of one print, a log
-            whose sidecar factors differ from its print's row (prints mixed up), or a log without
-            `axis`.
+            whose sidecar factors differ from its print's row (prints mixed up), a log of a print
+            measured already from another log (or by hand), or a log without `axis`.
     """
     if print_id is not None:
         print_id = print_key(print_id)
@@ -200,7 +202,7 @@ def fill(
         i = int(rows[0])
         if res.factors is not None:
             table_row = {n: float(factors[n].iloc[i]) for n in space.FACTOR_NAMES}
-            off = [n for n in space.FACTOR_NAMES if not np.isclose(res.factors[n], table_row[n], atol=0.011)]
+            off = [n for n in space.FACTOR_NAMES if not _same_setting(n, res.factors, table_row)]
             if off:
                 logged = ", ".join(f"{n} {res.factors[n]:g}" for n in off)
                 raise DesignerError(
@@ -212,10 +214,39 @@ def fill(
             raise DesignerError(
                 f"{res.path}: no {axis} axis identified", f"log the {axis} axis of print {pid}"
             )
+        _check_not_measured(out, i, pid, (k_col, c_col), str(res.path))
         fit = res.axes[axis]
         out.loc[i, k_col], out.loc[i, c_col], out.loc[i, LOG] = fit.k, fit.c, str(res.path)
         filled.append(pid)
     return out, filled
+
+
+def _check_not_measured(table: pd.DataFrame, i: int, pid: str, columns: tuple[str, str], log: str) -> None:
+    """Refuse to replace row `i`'s measurement (`columns`) by another log than the one it came from:
+    a log named with the wrong print would overwrite a measured print (one log per print)."""
+    values = pd.to_numeric(table.loc[i, list(columns)], errors="coerce")
+    source = str(table.loc[i, LOG])
+    if values.isna().all() or (source and os.path.abspath(source) == os.path.abspath(log)):
+        return
+    held = ", ".join(f"{c} {v:.4g}" for c, v in values.items() if not np.isnan(v))
+    raise DesignerError(
+        f"{log}: print {pid} is measured already ({held}, {f'from {source}' if source else 'typed in'})",
+        "the prints may be mixed up: check the id engraved on the specimen; to measure it again, "
+        "empty its row's k, c and log first",
+    )
+
+
+def _same_setting(name: str, logged: dict[str, float], row: dict[str, float]) -> bool:
+    """Whether a log's sidecar and the runs table give one print's setting `name`: equal to the
+    hundredth, or, for the height, the design's height that `designer print` rounded to the whole
+    layers it printed (the table holds the height printed, a rig's software may log the design's)."""
+    if np.isclose(logged[name], row[name], atol=0.011):
+        return True
+    return (
+        name == "height"
+        and np.isclose(logged["layer"], row["layer"], atol=0.011)
+        and np.isclose(settings.printed_height(logged[name], row["layer"]), row[name], atol=0.011)
+    )
 
 
 def table_axis(table: pd.DataFrame) -> str:
@@ -234,21 +265,26 @@ def fill_file(
 ) -> dict[str, list[str]]:
     """Fill the runs table at `path` (atomically) from identified logs (see `fill`, and its
     `print_id`), after checking each value against what a printer can give
-    (`designer.model.plausibility`, with the study's surrogate unless `surrogate` is given).
+    (`designer.model.plausibility`, with the study's surrogate unless `surrogate` is given; on a
+    rotational axis the surrogate lacks, through `designer.model.rotational`'s relation).
 
     Returns:
         {"filled": ids filled now, "waiting": ids of the table still without a measurement}.
     """
     from ..model.plausibility import check_measured
+    from ..model.rotational import with_axis
     from ..model.surrogate import Surrogate
     from ..study.data import write_frame
 
     table = read_runs(path)
-    out, filled = fill(table, results, axis=table_axis(table), print_id=print_id)
+    axis = table_axis(table)
+    out, filled = fill(table, results, axis=axis, print_id=print_id)
     done = out[PRINT].isin(filled).to_numpy()
     if done.any():
+        study = surrogate or Surrogate.load()
         check_measured(
-            surrogate or Surrogate.load(),
+            # a rotational table is compared through the relation `export --axis theta` uses
+            with_axis(study.prior if study.calibration else study, axis),
             load_table(out.loc[done].reset_index(drop=True)),
             accept_implausible=accept_implausible,
         )
