@@ -87,6 +87,13 @@ def prepare(designs: Sequence[Mapping[str, Any]], ids: Sequence[str], clamp: Cla
                 f"layers over the {settings.FIRST_LAYER_MM:g} mm first layer (the height the slicer prints)"
             )
             params["height"] = height
+        density = settings.printed_density(params)
+        if density != params["density"]:
+            notes.append(
+                f"{print_id}: sliced at {density:g} % infill, not {params['density']:g} %: its two "
+                f"{space.WALL_MM:g} mm walls leave at most one line inside, a section the model "
+                "predicts solid whatever the density"
+            )
         prints.append(specimen(params, print_id, clamp))
     return Batch(prints=prints, notes=notes)
 
