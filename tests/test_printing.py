@@ -130,6 +130,13 @@ def test_plate_reads_back_in_lib3mf(made):
     assert project["nozzle_temperature"] == ["210"] and project["hot_plate_temp"] == ["60"]
 
 
+def check_heaters(moves: gcode.Moves) -> None:
+    """TPU's temperatures while printing, and both heaters off at the end (PrusaSlicer's default end
+    G-code had left the bed at 60 C)."""
+    assert set(moves.nozzle_c) - {0.0} == {settings.NOZZLE_C} and moves.nozzle_c[-1] == 0
+    assert set(moves.bed_c) - {0.0} == {settings.BED_C} and moves.bed_c[-1] == 0
+
+
 def check_gcode(moves: gcode.Moves, obj: str, params: dict) -> None:
     """Everything the print asked of the slicer, read back from its G-code."""
     clamp = Clamp()
@@ -150,9 +157,23 @@ def test_prusaslicer_slices_the_plate_as_asked(made, tmp_path):
     prepared, files = made
     moves = slice_([files["plate"]], tmp_path / "plate.gcode")
     assert set(moves.objects) - {""} == {"P1", "P2", "P3"}
-    assert set(moves.nozzle_c) - {0.0} == {settings.NOZZLE_C} and set(moves.bed_c) == {settings.BED_C}
+    check_heaters(moves)
     for p in prepared.prints:
         check_gcode(moves, p.print_id, p.params)
+    # the config PrusaSlicer reports at the G-code's end is the plate's: the first print's own
+    # settings, not its defaults (0.3 mm layers, 3 perimeters, 20 % stars) that no object printed
+    config = dict(
+        line[2:].rstrip("\n").split(" = ", 1)
+        for line in open(tmp_path / "plate.gcode")
+        if line.startswith("; ") and " = " in line
+    )
+    first = prepared.prints[0].params
+    assert [config[k] for k in ("layer_height", "perimeters", "fill_density", "fill_pattern")] == [
+        f"{first['layer']:g}",
+        "2",
+        f"{first['density']:g}%",
+        "cubic",
+    ]
 
 
 @needs_slicer
@@ -161,7 +182,7 @@ def test_prusaslicer_slices_each_stl_with_its_ini(made, tmp_path, i):
     prepared, files = made
     p = prepared.prints[i]
     moves = slice_(["--load", files["ini"][i], files["stl"][i]], tmp_path / f"{p.print_id}.gcode")
-    assert set(moves.nozzle_c) - {0.0} == {settings.NOZZLE_C} and set(moves.bed_c) == {settings.BED_C}
+    check_heaters(moves)
     check_gcode(moves, f"{p.print_id}.stl", p.params)
 
 

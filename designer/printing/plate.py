@@ -85,9 +85,9 @@ def _orca_objects(prints: Sequence[Specimen], ids: Sequence[int]) -> bytes:
     return ET.tostring(root, encoding="utf-8", xml_declaration=True)
 
 
-def _prusa_plate() -> bytes:
+def _prusa_plate(first: Specimen) -> bytes:
     lines = ["; plate settings written by flexjoint designer (PrusaSlicer option names)"]
-    lines += [f"; {key} = {value}" for key, value in sorted(settings.prusa_plate().items())]
+    lines += [f"; {key} = {value}" for key, value in sorted(settings.prusa_plate_of(first.params).items())]
     return ("\n".join(lines) + "\n").encode()
 
 
@@ -144,10 +144,10 @@ def _model(prints: Sequence[Specimen]) -> Any:
     meta.AddMetaData("", "Application", "flexjoint designer", "xs:string", False)
     meta.AddMetaData("", "Title", "TPU joint specimens " + ", ".join(names), "xs:string", False)
     parts = {
-        PRUSA_PLATE: _prusa_plate(),
+        PRUSA_PLATE: _prusa_plate(prints[0]),
         PRUSA_OBJECTS: _prusa_objects(prints, ids),
         ORCA_OBJECTS: _orca_objects(prints, ids),
-        ORCA_PLATE: json.dumps(settings.orca_plate(), indent=2).encode(),
+        ORCA_PLATE: json.dumps(settings.orca_plate(prints[0].params), indent=2).encode(),
     }
     for uri, data in parts.items():
         model.AddAttachment(uri, RELATIONSHIP).ReadFromBuffer(bytearray(data))

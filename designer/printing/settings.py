@@ -32,6 +32,9 @@ PERIMETERS = round(space.WALL_MM / space.NOZZLE_MM)
 MAX_FLOW = 2.5
 #: the study's printer, an Ender 3: 220 x 220 mm build plate
 BED_MM = 220.0
+#: the G-code's end: both heaters off (PrusaSlicer's default end switches the nozzle off only and
+#: leaves the bed at 60 C), the head homed along X, the motors off
+END_GCODE = ("M104 S0 ; nozzle heater off", "M140 S0 ; bed heater off", "G28 X0 ; home X", "M84 ; motors off")
 
 
 def solid_layers(layer: float) -> int:
@@ -110,13 +113,22 @@ def prusa_plate() -> dict[str, str]:
         "top_infill_extrusion_width": width,
         "solid_infill_below_area": "0",
         "gcode_label_objects": "1",
+        "end_gcode": "\\n".join(END_GCODE) + "\\n",
     }
+
+
+def prusa_plate_of(params: Mapping[str, float]) -> dict[str, str]:
+    """The plate's options in a 3MF whose first print has settings `params`: the plate-wide ones and
+    that print's own. Each object's options override the plate's; without them PrusaSlicer fills
+    the plate's with its defaults (0.3 mm layers, 3 perimeters, 20 % stars infill), which its G-code
+    then reports as the print's settings and which no object of the plate is printed with."""
+    return prusa_plate() | prusa_object(params)
 
 
 def prusa_ini(params: Mapping[str, float], print_id: str) -> str:
     """A PrusaSlicer config (`--load FILE.ini`) slicing one print as the study printed it."""
     lines = [f"# print {print_id}: PrusaSlicer settings written by flexjoint designer"]
-    options = prusa_plate() | prusa_object(params)
+    options = prusa_plate_of(params)
     lines += [f"{key} = {value}" for key, value in sorted(options.items())]
     return "\n".join(lines) + "\n"
 
@@ -155,10 +167,12 @@ def orca_object(params: Mapping[str, float]) -> dict[str, str]:
     }
 
 
-def orca_plate() -> dict[str, list[str] | str]:
-    """OrcaSlicer / Bambu Studio's plate-wide options (project_settings.config; filament options are
-    lists, one entry per filament)."""
-    return {
+def orca_plate(params: Mapping[str, float]) -> dict[str, list[str] | str]:
+    """OrcaSlicer / Bambu Studio's plate options in a 3MF whose first print has settings `params`
+    (project_settings.config; filament options are lists, one entry per filament): the plate-wide
+    ones and that print's own, as `prusa_plate_of`."""
+    return orca_object(params) | {
+        "machine_end_gcode": "\n".join(END_GCODE) + "\n",
         "nozzle_diameter": [_number(space.NOZZLE_MM)],
         "filament_type": [MATERIAL],
         "filament_diameter": [_number(FILAMENT_MM)],
