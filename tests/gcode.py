@@ -176,3 +176,23 @@ def beam(moves: Moves, obj: str, above: float, within: float) -> tuple[float, fl
     t = (mid - low[:, 0]) / (low[:, 2] - low[:, 0])
     ys = low[:, 1] + t * (low[:, 3] - low[:, 1])
     return float(right - left - width), float(ys.max() - ys.min() + width), float(top)
+
+
+def walls(moves: Moves, obj: str, z: float, x: float) -> tuple[float, float]:
+    """The two walls' thickness (mm) across the line at `x` on the layer nearest z: from the part's
+    edge (the external perimeter's centre less half its width) to where PrusaSlicer bounds the infill,
+    half a flow spacing (width - height (1 - pi/4)) beyond the centre of the innermost perimeter."""
+    rows = _layer(moves, moves.select(obj), z)
+    seg = moves.segments[rows]
+    kinds = np.array([moves.kinds[i] for i in rows])
+    cross = (np.minimum(seg[:, 0], seg[:, 2]) < x) & (np.maximum(seg[:, 0], seg[:, 2]) > x)
+    cross &= np.isin(kinds, ["External perimeter", "Perimeter"])
+    seg = seg[cross]
+    ys = seg[:, 1] + (x - seg[:, 0]) / (seg[:, 2] - seg[:, 0]) * (seg[:, 3] - seg[:, 1])
+    order = np.argsort(ys)
+    ys, seg = ys[order], seg[order]
+    half = len(ys) // 2
+    spacing = seg[:, 6] - seg[:, 5] * (1.0 - np.pi / 4.0)
+    low = ys[half - 1] + spacing[half - 1] / 2 - (ys[0] - seg[0, 6] / 2)
+    high = ys[-1] + seg[-1, 6] / 2 - (ys[half] - spacing[half] / 2)
+    return float(low), float(high)

@@ -42,6 +42,20 @@ def solid_layers(layer: float) -> int:
     return math.ceil(space.WALL_MM / layer - 1e-9)
 
 
+def wall_line_width(layer: float) -> float:
+    """The perimeter line width (mm) at which the PERIMETERS lines make the model's 0.8 mm wall at
+    this layer height, the infill starting WALL_MM in from the part's edge.
+
+    PrusaSlicer lays the external perimeter's centre half a width in from the edge, each next one a
+    flow spacing further (spacing = width - layer (1 - pi/4), its Flow::spacing) and bounds the
+    infill half a spacing beyond the last: the wall is width / 2 + (n - 1/2) spacing. With 0.4 mm
+    lines that was 0.74 mm at 0.2 mm layers and 0.76 mm at 0.12 mm, leaving a wider core than the
+    model's (a 2.0 mm beam's 0.53 mm, not 0.4 mm).
+    """
+    n, flat = PERIMETERS, layer * (1 - math.pi / 4)
+    return round((space.WALL_MM + (n - 0.5) * flat) / n, 4)
+
+
 def _number(value: float) -> str:
     return f"{value:g}"
 
@@ -72,6 +86,11 @@ def prusa_object(params: Mapping[str, float]) -> dict[str, str]:
         "fill_pattern": infill_pattern(density),
         "fill_angle": _number(params["raster"]),
         "perimeters": str(PERIMETERS),
+        # fixed-width perimeters: Arachne (PrusaSlicer 2.5's default) varies them along the beam,
+        # its walls 0.791 to 0.799 mm where the classic generator's are 0.7996 all along
+        "perimeter_generator": "classic",
+        "perimeter_extrusion_width": _number(wall_line_width(params["layer"])),
+        "external_perimeter_extrusion_width": _number(wall_line_width(params["layer"])),
         "top_solid_layers": layers,
         "bottom_solid_layers": layers,
         "top_solid_min_thickness": _number(space.WALL_MM),
@@ -86,8 +105,9 @@ def prusa_object(params: Mapping[str, float]) -> dict[str, str]:
 def prusa_plate() -> dict[str, str]:
     """PrusaSlicer's plate-wide options: printer, TPU filament, line widths, temperatures.
 
-    Every line is one nozzle wide (0.4 mm), so two perimeters make the 0.8 mm wall; sparse infill is
-    never turned solid for being small (`solid_infill_below_area` 0), which would print a narrow
+    Every line but the perimeters (per object, `wall_line_width`) is one nozzle wide (0.4 mm); the
+    first layer's too, perimeters included, inside the solid bottom shell; sparse infill is never
+    turned solid for being small (`solid_infill_below_area` 0), which would print a narrow
     beam solid whatever its density; objects are labelled in the G-code.
     """
     width = _number(space.NOZZLE_MM)
@@ -106,8 +126,6 @@ def prusa_plate() -> dict[str, str]:
         "first_layer_height": _number(FIRST_LAYER_MM),
         "extrusion_width": width,
         "first_layer_extrusion_width": width,
-        "perimeter_extrusion_width": width,
-        "external_perimeter_extrusion_width": width,
         "infill_extrusion_width": width,
         "solid_infill_extrusion_width": width,
         "top_infill_extrusion_width": width,
@@ -140,6 +158,9 @@ ORCA_NAMES = {
     "fill_pattern": "sparse_infill_pattern",
     "fill_angle": "infill_direction",
     "perimeters": "wall_loops",
+    "perimeter_generator": "wall_generator",
+    "perimeter_extrusion_width": "inner_wall_line_width",
+    "external_perimeter_extrusion_width": "outer_wall_line_width",
     "top_solid_layers": "top_shell_layers",
     "bottom_solid_layers": "bottom_shell_layers",
     "top_solid_min_thickness": "top_shell_thickness",
@@ -155,13 +176,11 @@ ORCA_PATTERNS = {INFILL_PATTERN: "cubic", SOLID_PATTERN: "zig-zag"}
 
 def orca_object(params: Mapping[str, float]) -> dict[str, str]:
     """OrcaSlicer / Bambu Studio's per-object options of one print (model_settings.config): the
-    PrusaSlicer options under their names, the line widths and no small infill turned solid."""
+    PrusaSlicer options under their names, the infill's line width and no small infill turned solid."""
     width = _number(space.NOZZLE_MM)
     options = {ORCA_NAMES[key]: value for key, value in prusa_object(params).items()}
     options["sparse_infill_pattern"] = ORCA_PATTERNS[options["sparse_infill_pattern"]]
     return options | {
-        "outer_wall_line_width": width,
-        "inner_wall_line_width": width,
         "sparse_infill_line_width": width,
         "minimum_sparse_infill_area": "0",
     }
