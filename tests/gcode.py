@@ -196,3 +196,12 @@ def walls(moves: Moves, obj: str, z: float, x: float) -> tuple[float, float]:
     low = ys[half - 1] + spacing[half - 1] / 2 - (ys[0] - seg[0, 6] / 2)
     high = ys[-1] + seg[-1, 6] / 2 - (ys[half] - spacing[half] / 2)
     return float(low), float(high)
+
+
+def share_within(seg: np.ndarray, start: float, end: float) -> np.ndarray:
+    """Each segment's share of its length between x = start and x = end (a segment across x, of no
+    length along it, counts whole when it lies between)."""
+    lo, hi = seg[:, [0, 2]].min(axis=1), seg[:, [0, 2]].max(axis=1)
+    across = hi - lo < 1e-6
+    inside = np.clip(np.minimum(hi, end) - np.maximum(lo, start), 0, None)
+    return np.where(across, (lo >= start) & (lo <= end), inside / np.where(across, 1, hi - lo))

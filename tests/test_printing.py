@@ -385,13 +385,7 @@ def test_a_narrow_beam_is_filled_at_its_raster_and_density(tmp_path):
         seg = seg[(seg[:, 4] > 1.2) & (seg[:, 4] < params["height"] - 1.2)]  # between the solid layers
         # each segment's share inside the beam, 1 mm clear of the blocks
         start, end = x0 + clamp.length + 1.0, x0 + clamp.length + params["length"] - 1.0
-        lo, hi = seg[:, [0, 2]].min(axis=1), seg[:, [0, 2]].max(axis=1)
-        across = hi - lo < 1e-6
-        part = np.where(
-            across,
-            (lo >= start) & (lo <= end),
-            np.clip(np.minimum(hi, end) - np.maximum(lo, start), 0, None) / np.where(across, 1, hi - lo),
-        )
+        part = gcode.share_within(seg, start, end)
         length = np.hypot(seg[:, 2] - seg[:, 0], seg[:, 3] - seg[:, 1]) * part
         angle = np.round(np.degrees(np.arctan2(seg[:, 3] - seg[:, 1], seg[:, 2] - seg[:, 0])) % 180) % 180
         share = {a: length[angle == a].sum() / length.sum() for a in np.unique(angle)}
@@ -413,13 +407,7 @@ def _beam_fill(moves: gcode.Moves, obj: str, params: dict) -> tuple[float, float
     kinds = np.array([moves.kinds[i] for i in moves.select(obj)])
     inside = (every[:, 4] > 1.2) & (every[:, 4] < params["height"] - 1.2)
     seg, kinds = every[inside], kinds[inside]
-    lo, hi = seg[:, [0, 2]].min(axis=1), seg[:, [0, 2]].max(axis=1)
-    across = hi - lo < 1e-6
-    part = np.where(
-        across,
-        (lo >= start) & (lo <= end),
-        np.clip(np.minimum(hi, end) - np.maximum(lo, start), 0, None) / np.where(across, 1, hi - lo),
-    )
+    part = gcode.share_within(seg, start, end)
     volume = seg[:, 7] * part * np.pi * (1.75 / 2) ** 2
     layers = len(np.unique(seg[:, 4]))
     slab = (end - start) * params["layer"] * layers
