@@ -205,3 +205,19 @@ def share_within(seg: np.ndarray, start: float, end: float) -> np.ndarray:
     across = hi - lo < 1e-6
     inside = np.clip(np.minimum(hi, end) - np.maximum(lo, start), 0, None)
     return np.where(across, (lo >= start) & (lo <= end), inside / np.where(across, 1, hi - lo))
+
+
+def bottom_shell(moves: Moves, obj: str, start: float, end: float, height: float) -> float:
+    """The top (print z, mm) of the solid layers at the bottom of the part between x = start and
+    x = end: the last of the layers from the first up, below `height` / 2, extruding there no
+    sparse infill ("Internal infill")."""
+    rows = moves.select(obj)
+    seg = moves.segments[rows]
+    kinds = np.array([moves.kinds[i] for i in rows])
+    there = share_within(seg, start, end) > 0
+    top = 0.0
+    for z in np.unique(seg[there, 4]):
+        if z > height / 2 or (there & (seg[:, 4] == z) & (kinds == "Internal infill")).any():
+            break
+        top = float(z)
+    return top

@@ -6,6 +6,7 @@ temperatures as asked, and the printed beam's extents equal l, b, h within 0.05 
 from __future__ import annotations
 
 import json
+import math
 import shutil
 import subprocess
 import xml.etree.ElementTree as ET
@@ -151,6 +152,10 @@ def check_gcode(moves: gcode.Moves, obj: str, params: dict) -> None:
     # made them 0.74 mm at 0.2 mm layers, 0.75 at 0.16, 0.76 at 0.12)
     every = moves.segments[moves.select(obj)]
     mid = every[:, [0, 2]].min() + 0.2 + Clamp().length + params["length"] / 2
+    # the bottom shell: whole layers over the 0.2 mm first one, the first to make 0.8 mm (at 0.12 mm
+    # layers 0.8 mm; 7 layers, counted as the top's, had made 0.92)
+    shell = gcode.bottom_shell(moves, obj, mid - 5, mid + 5, params["height"])
+    assert shell == pytest.approx(0.2 + math.ceil((0.8 - 0.2) / params["layer"] - 1e-9) * params["layer"])
     for x in (mid - params["length"] / 3, mid, mid + params["length"] / 3):
         assert gcode.walls(moves, obj, params["height"] / 2, x) == pytest.approx((0.8, 0.8), abs=0.002)
     assert abs(length - params["length"]) < 0.05
