@@ -366,6 +366,8 @@ def profile_cmd(
         raise DesignerError(
             f"--tolerance {tolerance:g} is not a percentage in (0, 100)", "give e.g. --tolerance 10"
         )
+    if suggestion is not None:
+        _refuse_next_output(suggestion, surrogate)
     sur = _surrogate(surrogate)
     targets = parse_fix(target, flag="--target", example="k=0.8", names=None)
     start = parse_fix(design, flag="--design", example="width=3.5")
@@ -396,6 +398,31 @@ def profile_cmd(
     _saved(path)
     at = ", ".join(f"{k} {v:g} {space.factor(k).unit}" for k, v in opened.items())
     console.print(f"open it in a browser; it starts at {at}")
+
+
+def _refuse_next_output(path: Path, surrogate: Path | None) -> None:
+    """Refuse a `designer next --json` output given as --suggestion, naming the suggest command line
+    with next's own goals that makes one (the library says why such a file is no suggestion)."""
+    from designer.errors import DesignerError
+    from designer.plots.profile import is_next_prints, suggestion_data
+
+    data = suggestion_data(path)
+    if not is_next_prints(data):
+        return
+    goals = [
+        f"--{q} {v:g}" if isinstance(v, int | float) else f"--{q} {v}" for q, v in data["targets"].items()
+    ]
+    if data.get("axis", "x") != "x":
+        goals.append(f"--axis {data['axis']}")
+    if isinstance(data.get("tolerance"), int | float) and data["tolerance"] != 0.1:
+        goals.append(f"--tolerance {100 * data['tolerance']:g}")
+    if surrogate is not None:
+        goals.append(f"--surrogate {surrogate}")
+    raise DesignerError(
+        f"--suggestion {path} is an output of designer next (a recommendation and prints to measure), "
+        "not of designer suggest",
+        f"make one with designer suggest {' '.join(goals)} --json > s.json and give --suggestion s.json",
+    )
 
 
 def register(app: typer.Typer) -> None:
