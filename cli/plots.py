@@ -207,15 +207,26 @@ def loo_cmd(
         }
         for r in responses
     }
+    # of a calibrated surrogate: the user's own prints, each predicted from every other run
+    own = {r: d for r in responses if (d := loo.own_loo_table(sur, r)) is not None}
     if as_json:
-        print_json({"figure": str(path), "loo": metrics})
+        mine = {r: {**loo.own_accuracy(d), "runs": d.to_dict("records")} for r, d in own.items()}
+        print_json({"figure": str(path), "loo": metrics} | ({"loo_user": mine} if own else {}))
         return
+    for r, d in own.items():
+        a = loo.own_accuracy(d)
+        console.print(
+            f"{r}: your {a['n']} prints, each predicted by the calibrated surrogate from the others: "
+            f"median error {a['mape']:.0f} %, RMSE {a['rmse']:.3g} {sur.model(r).unit}, "
+            f"95 % PI covers {int(d.covered.sum())} of {a['n']}"
+        )
+    whose = f"the study's {len(sur.table)} runs, " if own else ""
     for r, m in metrics.items():
         unit = sur.model(r).unit
         kind = "nested leave-one-out" if m["nested"] else "leave-one-out of the selected form (optimistic)"
         tail = f" (selected form alone: Q2 {m['selected_form']['q2']:.2f}, optimistic)" if m["nested"] else ""
         console.print(
-            f"{r}: {m['form']}, {kind} Q2 {m['q2']:.2f}, RMSE {m['rmse']:.3g} {unit}, "
+            f"{r}: {whose}{m['form']}, {kind} Q2 {m['q2']:.2f}, RMSE {m['rmse']:.3g} {unit}, "
             f"95 % PI coverage {m['coverage95']:.0%}{tail}"
         )
     _saved(path)
