@@ -216,7 +216,7 @@ def loo_cmd(
     for r, d in own.items():
         a = loo.own_accuracy(d)
         console.print(
-            f"{r}: your {a['n']} prints, each predicted by the calibrated surrogate from the others: "
+            f"{r}: {loo.your_prints(a['n'])}, each predicted by the calibrated surrogate from the others: "
             f"median error {a['mape']:.0f} %, RMSE {a['rmse']:.3g} {sur.model(r).unit}, "
             f"95 % PI covers {int(d.covered.sum())} of {a['n']}"
         )

@@ -55,6 +55,11 @@ def _table(run: np.ndarray, observed: np.ndarray, pred) -> pd.DataFrame:
     ).assign(covered=lambda d: (d.observed >= d.lo) & (d.observed <= d.hi))
 
 
+def your_prints(n: int) -> str:
+    """'your print' or 'your 3 prints'."""
+    return "your print" if n == 1 else f"your {n} prints"
+
+
 def own_accuracy(d: pd.DataFrame) -> dict[str, float]:
     """The figures of a leave-one-out table: runs, median absolute error (%), 95 % PI coverage, RMSE."""
     err = d.predicted - d.observed
@@ -88,15 +93,12 @@ def plot_loo(surrogate, *, responses: list[str] | None = None, fig: Figure | Non
                 axes[0][col].set_axis_off()
                 axes[0][col].text(0.5, 0.5, f"no print of yours measured {resp}", ha="center", va="center")
             else:
-                acc = own_accuracy(d)
                 _panel(
                     axes[0][col],
                     d,
                     resp,
                     ylabel=f"predicted from your other runs {response_label(resp)}",
-                    title=f"{resp}: your {len(d)} prints, each predicted by the calibrated model\n"
-                    f"from the others: median error {acc['mape']:.0f} %, "
-                    f"95 % PI covers {int(d.covered.sum())} of {len(d)}",
+                    title=_own_title(resp, d),
                     colors=(OWN_COLOR, "tab:red"),
                     marker="D",
                     name="your print",
@@ -118,6 +120,20 @@ def plot_loo(surrogate, *, responses: list[str] | None = None, fig: Figure | Non
             name="run",
         )
     return fig
+
+
+def _own_title(resp: str, d: pd.DataFrame) -> str:
+    """The title of a panel of the user's prints: whose runs, how predicted, and the figures."""
+    acc = own_accuracy(d)
+    how = (
+        "each predicted by the calibrated model\nfrom the others"
+        if len(d) > 1
+        else "predicted by the calibrated model\nfrom the study's runs alone"
+    )
+    return (
+        f"{resp}: {your_prints(len(d))}, {how}: median error {acc['mape']:.0f} %, "
+        f"95 % PI covers {int(d.covered.sum())} of {len(d)}"
+    )
 
 
 def _panel(
@@ -149,17 +165,23 @@ def _panel(
         ax.plot(
             cut.observed, np.zeros(len(cut)), "v", ms=5, color="0.3", label=f"interval cut at 0 ({len(cut)})"
         )
+    lim = [0.0, 1.04 * max(d.observed.max(), d.hi.max())]
+    placed: list[tuple[float, float]] = []
     for r in (d if mine else d[~d.covered]).itertuples():  # the user's few prints: each named
+        # a label whose point lies close to one already labelled steps down a line per such neighbour
+        at = (r.observed / lim[1], r.predicted / lim[1])
+        below = sum(abs(at[0] - u) < 0.12 and abs(at[1] - v) < 0.04 for u, v in placed)
+        placed.append(at)
         ax.annotate(
             f"{name} {r.run}",
             (r.observed, r.predicted),
-            xytext=(5, 3),
+            xytext=(5, 3 - 10 * below),
             textcoords="offset points",
             fontsize=7.5,
             color=colors[0] if r.covered else colors[1],
             bbox={"fc": "white", "ec": "none", "alpha": 0.8, "pad": 0.6},
+            zorder=1.5,  # under the markers: a label never hides another run
         )
-    lim = [0.0, 1.04 * max(d.observed.max(), d.hi.max())]
     ax.plot(lim, lim, "k--", lw=0.8, label="predicted = observed")
     ax.set_xlim(lim)
     ax.set_ylim(lim)
