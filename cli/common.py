@@ -294,6 +294,11 @@ FLAGS: tuple[Flag, ...] = (
         "--runs ",
         "append this batch to it with runs_path='prints/runs.csv' (its ids continue)",
     ),
+    Flag(
+        r"pass a Suggestion, its to_dict\(\) or such a JSON file|give a JSON file of Suggestion\.to_dict\(\)",
+        "give the output of `designer suggest ... --json`",
+        "suggestion has no list of candidates (pass a Suggestion, its to_dict() or such a JSON file)",
+    ),
     Flag(r"\bmax_cases=(\d+)", r"--max-cases \1", "or pass max_cases=2000000 if that many are meant"),
     Flag(r"\bpackage_paths\['([^']+)'\]=", r"--package-path \1=", "package_paths['arm']='x' is not a folder"),
 )

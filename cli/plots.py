@@ -207,15 +207,26 @@ def loo_cmd(
         }
         for r in responses
     }
+    # of a calibrated surrogate: the user's own prints, each predicted from every other run
+    own = {r: d for r in responses if (d := loo.own_loo_table(sur, r)) is not None}
     if as_json:
-        print_json({"figure": str(path), "loo": metrics})
+        mine = {r: {**loo.own_accuracy(d), "runs": d.to_dict("records")} for r, d in own.items()}
+        print_json({"figure": str(path), "loo": metrics} | ({"loo_user": mine} if own else {}))
         return
+    for r, d in own.items():
+        a = loo.own_accuracy(d)
+        console.print(
+            f"{r}: {loo.your_prints(a['n'])}, each predicted by the calibrated surrogate from the others: "
+            f"median error {a['mape']:.0f} %, RMSE {a['rmse']:.3g} {sur.model(r).unit}, "
+            f"95 % PI covers {int(d.covered.sum())} of {a['n']}"
+        )
+    whose = f"the study's {len(sur.table)} runs, " if own else ""
     for r, m in metrics.items():
         unit = sur.model(r).unit
         kind = "nested leave-one-out" if m["nested"] else "leave-one-out of the selected form (optimistic)"
         tail = f" (selected form alone: Q2 {m['selected_form']['q2']:.2f}, optimistic)" if m["nested"] else ""
         console.print(
-            f"{r}: {m['form']}, {kind} Q2 {m['q2']:.2f}, RMSE {m['rmse']:.3g} {unit}, "
+            f"{r}: {whose}{m['form']}, {kind} Q2 {m['q2']:.2f}, RMSE {m['rmse']:.3g} {unit}, "
             f"95 % PI coverage {m['coverage95']:.0%}{tail}"
         )
     _saved(path)
@@ -366,6 +377,8 @@ def profile_cmd(
         raise DesignerError(
             f"--tolerance {tolerance:g} is not a percentage in (0, 100)", "give e.g. --tolerance 10"
         )
+    if suggestion is not None:
+        _refuse_next_output(suggestion, surrogate)
     sur = _surrogate(surrogate)
     targets = parse_fix(target, flag="--target", example="k=0.8", names=None)
     start = parse_fix(design, flag="--design", example="width=3.5")
@@ -396,6 +409,31 @@ def profile_cmd(
     _saved(path)
     at = ", ".join(f"{k} {v:g} {space.factor(k).unit}" for k, v in opened.items())
     console.print(f"open it in a browser; it starts at {at}")
+
+
+def _refuse_next_output(path: Path, surrogate: Path | None) -> None:
+    """Refuse a `designer next --json` output given as --suggestion, naming the suggest command line
+    with next's own goals that makes one (the library says why such a file is no suggestion)."""
+    from designer.errors import DesignerError
+    from designer.plots.profile import is_next_prints, suggestion_data
+
+    data = suggestion_data(path)
+    if not is_next_prints(data):
+        return
+    goals = [
+        f"--{q} {v:g}" if isinstance(v, int | float) else f"--{q} {v}" for q, v in data["targets"].items()
+    ]
+    if data.get("axis", "x") != "x":
+        goals.append(f"--axis {data['axis']}")
+    if isinstance(data.get("tolerance"), int | float) and data["tolerance"] != 0.1:
+        goals.append(f"--tolerance {100 * data['tolerance']:g}")
+    if surrogate is not None:
+        goals.append(f"--surrogate {surrogate}")
+    raise DesignerError(
+        f"--suggestion {path} is an output of designer next (a recommendation and prints to measure), "
+        "not of designer suggest",
+        f"make one with designer suggest {' '.join(goals)} --json > s.json and give --suggestion s.json",
+    )
 
 
 def register(app: typer.Typer) -> None:

@@ -351,3 +351,52 @@ def test_readme_shows_one_picture_of_each_figure_command():
         "profiler",
     ):
         assert f"docs/figures/{name}.png" in pictures, name
+
+
+def test_plot_loo_of_a_calibrated_surrogate_shows_your_own_prints(tmp_path):
+    """The walk of the calibration: `plot loo --surrogate mine.json` drew the study's 44 runs only.
+    It shows the user's prints first, each predicted by the calibrated surrogate from every other run
+    (README's loop: the stand-in prints, then `designer calibrate`), and says which runs each row is.
+    The reference: each print predicted by `designer.calibrate` on the others, recalibrated."""
+    import designer as lib
+    from designer.model.surrogate import Surrogate
+    from designer.plots import loo
+
+    t = load_table().iloc[[3, 12, 30]]
+    t.assign(k_x=t.k_x * 0.8).to_csv(tmp_path / "my_prints.csv", index=False)
+    run = designer("calibrate", "my_prints.csv", "-o", "mine.json", cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    run = designer("plot", "loo", "--surrogate", "mine.json", "-o", "loo.png", "--json", cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    mine = json.loads(run.stdout)["loo_user"]["k_x"]
+    prints = pd.read_csv(tmp_path / "my_prints.csv")
+    prior = Surrogate.load()
+    for i, row in enumerate(mine["runs"]):
+        alone = lib.calibrate(prior, prints.drop(index=i)).predict(prints.iloc[[i]], responses=["k_x"])["k_x"]
+        assert row["observed"] == pytest.approx(prints.k_x[i], rel=1e-12)
+        for key, want in (("predicted", alone.value), ("lo", alone.low), ("hi", alone.high)):
+            assert row[key] == pytest.approx(float(want[0]), rel=1e-9), (i, key)
+    # the calibration's own summary of the same leave-one-out
+    run = designer("calibrate", "my_prints.csv", "-o", "again.json", "--json", cwd=tmp_path)
+    user = json.loads(run.stdout)["responses"]["k_x"]["loo_user"]
+    assert mine["mape"] == pytest.approx(user["mape"]) and mine["coverage95"] == user["coverage95"]
+    run = designer("plot", "loo", "--surrogate", "mine.json", "-o", "loo.png", cwd=tmp_path)
+    assert "k_x: your 3 prints, each predicted by the calibrated surrogate from the others" in run.stdout
+    assert "k_x: the study's 44 runs, powerlaw, nested" in run.stdout
+    assert_picture(tmp_path / "loo.png")
+    # the figure: the user's prints as orange diamonds at those numbers, above the study's runs
+    sur = Surrogate.load(tmp_path / "mine.json")
+    fig = loo.plot_loo(sur, responses=["k_x"])
+    top, bottom = fig.axes
+    assert top.get_title().startswith("k_x: your 3 prints") and "the study's runs" in bottom.get_title()
+    assert "of 44 runs" in bottom.get_title()
+    drawn = [line for line in top.get_lines() if line.get_marker() == "D"]
+    xy = np.vstack(
+        [np.c_[np.asarray(ln.get_xdata(), float), np.asarray(ln.get_ydata(), float)] for ln in drawn]
+    )
+    want = np.c_[[r["observed"] for r in mine["runs"]], [r["predicted"] for r in mine["runs"]]]
+    np.testing.assert_allclose(xy[np.argsort(xy[:, 0])], want[np.argsort(want[:, 0])], rtol=1e-12)
+    assert {t.get_text() for t in top.texts} == {"your print 1", "your print 2", "your print 3"}
+    assert_inside(fig)
+    # the study's surrogate draws one row, as before
+    assert len(loo.plot_loo(prior, responses=["k_x"]).axes) == 1

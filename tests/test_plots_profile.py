@@ -158,3 +158,32 @@ def test_cli_profile(sur, tmp_path):
             bad,
             run.stderr,
         )
+
+
+def test_a_next_output_as_suggestion_is_refused_naming_suggest(sur, tmp_path):
+    """The walk of the profiler page: `profile --suggestion next.json` (a `designer next` output) was
+    refused in Python's words ("pass a Suggestion, its to_dict() or such a JSON file"). next's prints
+    are chosen for what measuring them teaches, not ranked by P as the page's buttons are, so it stays
+    refused, in one line naming the suggest command line with next's own goals."""
+    run = designer("next", "--k", "0.8", "--n", "2", "--tolerance", "15", "--json", cwd=tmp_path)
+    assert run.returncode in (0, 1), run.stderr
+    (tmp_path / "next.json").write_text(run.stdout)
+    run = designer("profile", "--suggestion", "next.json", "-o", "p.html", cwd=tmp_path)
+    assert run.returncode == 2 and "Traceback" not in run.stderr and not (tmp_path / "p.html").exists()
+    line = run.stderr.strip()
+    assert "\n" not in line and "to_dict" not in line and "an output of designer next" in line, line
+    fix = "designer suggest --k 0.8 --tolerance 15 --json > s.json"
+    assert fix in line, line
+    # the command it names makes a file the page takes
+    run = designer(*fix.split(" > ")[0].split()[1:], cwd=tmp_path)
+    (tmp_path / "s.json").write_text(run.stdout)
+    run = designer("profile", "--suggestion", "s.json", "-o", "p.html", cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    # the library refuses it naming its own arguments
+    with pytest.raises(DesignerError, match="suggestion is a next_prints result"):
+        profile.build_profiler(sur, suggestion=tmp_path / "next.json")
+    # a file that is neither names the command whose output it takes, not a Python call
+    (tmp_path / "rows.json").write_text('{"rows": []}')
+    run = designer("profile", "--suggestion", "rows.json", "-o", "p.html", cwd=tmp_path)
+    assert run.returncode == 2 and "`designer suggest ... --json`" in run.stderr, run.stderr
+    assert "to_dict" not in run.stderr

@@ -192,3 +192,60 @@ def test_loo_table_and_png(sur, tmp_path):
     rgb = load_rgb(common.save_figure(loo.plot_loo(sur), tmp_path / "loo.png"))
     assert_picture(tmp_path / "loo.png", min_size=(800, 400))
     assert rgb.shape[1] > rgb.shape[0]
+
+
+def _orange_pixels(path) -> int:
+    """Pixels of the user's prints' orange (`space.OWN_COLOR`, shaded by the light: hue kept)."""
+    rgb = load_rgb(path)
+    r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
+    return int(np.sum((r > 0.6) & (g > 0.35 * r) & (g < 0.7 * r) & (b < 0.25 * r)))
+
+
+def test_space_of_a_calibrated_surrogate_draws_your_prints(sur, tmp_path):
+    """The walk of the calibration: `plot space --surrogate mine.json` drew the study's 44 runs only.
+    The user's prints (README's stand-in: three study designs at 0.8 times their k) are drawn where the
+    study's runs are, in orange and named in the legend: at the held values at their measured k, the
+    others on the floor; in the volume too."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import designer as lib
+
+    t = lib.load_table().iloc[[3, 12, 30]]
+    t = t.assign(k_x=t.k_x * 0.8)
+    t.to_csv(tmp_path / "my_prints.csv", index=False)
+    cal = lib.calibrate(sur, t)
+    first = t.iloc[0]
+    fix = {n: float(first[n]) for n in ("density", "length", "layer", "raster")}
+    view = space.surface_view(cal, "k_x", x="width", y="height", fixed=fix)
+    layers = {layer.name: layer for layer in view.scene.layers}
+    here = layers["your prints at the held values (1)"]
+    assert (
+        here.color == space.OWN_COLOR
+        and "your other prints (2), at other held values: on the floor" in layers
+    )
+    zlo, zhi = view.scene.axis_ranges[2]
+    want = [(first.width - 2) / 5, (first.height - 4) / 10, (first.k_x - zlo) / (zhi - zlo)]
+    np.testing.assert_allclose(np.asarray(here.mesh.points)[0], want, atol=1e-6)
+    assert any(name.startswith("study runs at the held values") for name in layers)
+    # the study's surrogate: as before, no print of yours
+    assert not any("your" in layer.name for layer in space.surface_view(sur, "k_x", fixed=fix).scene.layers)
+    names = [
+        layer.name
+        for layer in space.volume_view(cal, "k_x", factors=["width", "height", "density"]).scene.layers
+    ]
+    assert "your prints (3), orange" in names
+    # the command line, as typed: the PNG shows orange where the study's picture has none
+    exe = str(Path(sys.executable).with_name("designer"))
+    run = subprocess.run(
+        [exe, "calibrate", "my_prints.csv", "-o", "mine.json"], capture_output=True, cwd=tmp_path
+    )
+    assert run.returncode == 0, run.stderr
+    args = [a for n, v in fix.items() for a in ("--fix", f"{n}={v:g}")]
+    for name, extra in (("mine.png", ["--surrogate", "mine.json"]), ("study.png", [])):
+        run = subprocess.run(
+            [exe, "plot", "space", *args, *extra, "-o", name], capture_output=True, text=True, cwd=tmp_path
+        )
+        assert run.returncode == 0, run.stderr
+    assert _orange_pixels(tmp_path / "mine.png") > 100 and _orange_pixels(tmp_path / "study.png") == 0

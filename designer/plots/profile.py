@@ -208,7 +208,7 @@ def _response(surrogate: Surrogate, name: str, statement: str, target: float | s
     }
 
 
-def _suggestion_dict(suggestion: Any) -> Any:
+def suggestion_data(suggestion: Any) -> Any:
     """A `Suggestion`, its `to_dict()` or the path of a JSON file of it, as the dict."""
     if isinstance(suggestion, str | Path):
         p = Path(suggestion)
@@ -227,11 +227,27 @@ def _suggestion_dict(suggestion: Any) -> Any:
     return suggestion
 
 
+def is_next_prints(data: Any) -> bool:
+    """Whether `data` is a `designer.next_prints` result as a dict (`designer next --json`): a
+    recommendation and the prints to measure, not a suggestion's candidates."""
+    return isinstance(data, Mapping) and "recommendation" in data and "prints" in data
+
+
 def _suggestions(suggestion: Any) -> list[dict[str, Any]]:
-    """Candidates of a `Suggestion`, of its `to_dict()`, or of a JSON file holding that dict."""
+    """Candidates of a `Suggestion`, of its `to_dict()`, or of a JSON file holding that dict.
+
+    A `next_prints` result is refused: its prints after the first are chosen for what measuring them
+    teaches, not ranked by the chance of landing as the page's buttons are, and before a calibration
+    its P counts an unmeasured printer's departure, which the page does not."""
     if suggestion is None:
         return []
-    suggestion = _suggestion_dict(suggestion)
+    suggestion = suggestion_data(suggestion)
+    if is_next_prints(suggestion):
+        raise DesignerError(
+            "suggestion is a next_prints result (a recommendation and prints to measure), not a Suggestion",
+            "pass designer.suggest(...) with the same goals, or its to_dict(); open the page at the "
+            "recommendation with design=",
+        )
     candidates = suggestion.get("candidates") if isinstance(suggestion, Mapping) else None
     if not isinstance(candidates, list):
         raise DesignerError(
@@ -274,7 +290,7 @@ def _suggestion_goals(suggestion: Any) -> dict[str, Any] | None:
     record goals and tolerance."""
     if suggestion is None:
         return None
-    data = _suggestion_dict(suggestion)
+    data = suggestion_data(suggestion)
     targets = data.get("targets") if isinstance(data, Mapping) else None
     tol = data.get("tolerance") if isinstance(data, Mapping) else None
     if not isinstance(targets, Mapping) or not isinstance(tol, int | float):
@@ -420,7 +436,7 @@ def build_profiler(
             target that is not positive; a tolerance outside (0, 1); an unreadable suggestion.
     """
     _check_axis(surrogate, axis)
-    suggestion = None if suggestion is None else _suggestion_dict(suggestion)
+    suggestion = None if suggestion is None else suggestion_data(suggestion)
     found = _suggestion_goals(suggestion)
     # opened from a suggestion: its goals and tolerance unless given, its first candidate unless a
     # design is given (and the candidate lies in the tested ranges)

@@ -31,6 +31,11 @@ WINDOW = (1200, 900)
 CMAP = "viridis"
 PI_COLOR = (0.35, 0.45, 0.85)
 TARGET_COLOR = (0.9, 0.05, 0.05)
+#: the study's runs: black at the held values, grey elsewhere (on the floor)
+BLACK_GREY = ((0.0, 0.0, 0.0), (0.55, 0.55, 0.55))
+#: the user's own prints (a calibrated surrogate's): orange, as the profiler page and `plot loo` draw them
+OWN_COLOR = (1.0, 0.5, 0.05)
+OWN_FLOOR = (1.0, 0.72, 0.45)
 
 
 @dataclass
@@ -308,20 +313,33 @@ def save_screenshot(plotter, path: str | Path) -> Path:
     return p
 
 
-def _run_layers(points: np.ndarray, near: np.ndarray) -> list[Layer]:
+def own_runs(surrogate, response: str) -> pd.DataFrame | None:
+    """Of a calibrated surrogate (`designer.calibrate`): the user's prints that measured `response`
+    (the six factors and the response); None for a surrogate not calibrated on it."""
+    cal = surrogate.calibration
+    if cal is None or response not in cal["table"]:
+        return None
+    table = cal["table"]
+    mine = table[np.isfinite(table[response].to_numpy(float))]
+    return mine if len(mine) else None
+
+
+def _run_layers(points: np.ndarray, near: np.ndarray, *, own: bool = False, study: str = "") -> list[Layer]:
     """The measured runs (unit-cube points): those at the held values in black at their response; the
     others, measured at other held values, grey on the floor (where they lie in x and y only: drawn at
-    their response they would stand in stacks that read like replicates)."""
+    their response they would stand in stacks that read like replicates). The user's own prints
+    (`own`) in orange, larger, light orange on the floor; `study` names the study's runs beside them."""
     import pyvista as pv
 
+    who, colors, size = ("your prints", (OWN_COLOR, OWN_FLOOR), 5) if own else (f"{study}runs", BLACK_GREY, 4)
     layers = []
     if near.any():
         layers.append(
             Layer(
-                f"runs at the held values ({int(near.sum())})",
+                f"{who} at the held values ({int(near.sum())})",
                 pv.PolyData(points[near]),
-                color=(0, 0, 0),
-                size=4,
+                color=colors[0],
+                size=size,
             )
         )
     if (~near).any():
@@ -329,10 +347,11 @@ def _run_layers(points: np.ndarray, near: np.ndarray) -> list[Layer]:
         floor[:, 2] = 0.0
         layers.append(
             Layer(
-                f"other runs ({int((~near).sum())}), at other held values: on the floor",
+                f"{'your other prints' if own else f'other {study}runs'} ({int((~near).sum())}), "
+                "at other held values: on the floor",
                 pv.PolyData(floor),
-                color=(0.55, 0.55, 0.55),
-                size=2.5,
+                color=colors[1],
+                size=size - 1.5,
             )
         )
     return layers
@@ -413,8 +432,10 @@ def surface_view(
     X[x], X[y] = gx.ravel(), gy.ravel()
     pred = surrogate.predict(X, responses=[response])[response]  # as printed (solid at 2 mm)
     observed = table[response].to_numpy(float)
-    zlo = float(min(pred.low.min(), observed.min(), target if target is not None else np.inf))
-    zhi = float(max(pred.high.max(), observed.max(), target if target is not None else -np.inf))
+    mine = own_runs(surrogate, response)
+    measured = observed if mine is None else np.r_[observed, mine[response].to_numpy(float)]
+    zlo = float(min(pred.low.min(), measured.min(), target if target is not None else np.inf))
+    zhi = float(max(pred.high.max(), measured.max(), target if target is not None else -np.inf))
     zlo, zhi = zlo - 0.02 * (zhi - zlo), zhi + 0.02 * (zhi - zlo)
 
     def grid(z: np.ndarray) -> pv.PolyData:
@@ -435,10 +456,14 @@ def surface_view(
         Layer("95 % PI lower", grid(pred.low), color=PI_COLOR, opacity=0.25),
         Layer("95 % PI upper", grid(pred.high), color=PI_COLOR, opacity=0.25),
     ]
-    runs = np.c_[
-        _unit(table[x], fx.low, fx.high), _unit(table[y], fy.low, fy.high), _unit(observed, zlo, zhi)
-    ]
-    layers += _run_layers(runs, _runs_near(table, held))
+    for runs, own in ((table, False), (mine, True)):
+        if runs is None:
+            continue
+        points = np.c_[
+            _unit(runs[x], fx.low, fx.high), _unit(runs[y], fy.low, fy.high), _unit(runs[response], zlo, zhi)
+        ]
+        study = "" if mine is None else "study "
+        layers += _run_layers(points, _runs_near(runs, held), own=own, study=study)
     share = None
     if target is not None:
         layers += _target_layers(
@@ -521,15 +546,21 @@ def volume_view(
         share = float(np.mean((pred.low <= target) & (target <= pred.high)))
     pts = np.c_[[_unit(table[f.name], f.low, f.high) for f in fs]].T
     observed = table[response].to_numpy(float)
+    mine = own_runs(surrogate, response)
     layers.append(
         Layer(
-            f"measured runs ({len(table)}), coloured by {response}",
+            f"{'measured' if mine is None else 'study'} runs ({len(table)}), coloured by {response}",
             pv.PolyData(pts),
             rgb=_rgb(observed, *colour_limits(vlo, vhi)[:2]),
             color=(0.4, 0.4, 0.4),
             size=3,
         )
     )
+    if mine is not None:
+        mine_pts = np.c_[[_unit(mine[f.name], f.low, f.high) for f in fs]].T
+        layers.append(
+            Layer(f"your prints ({len(mine)}), orange", pv.PolyData(mine_pts), color=OWN_COLOR, size=5)
+        )
     held_txt = ", ".join(f"{k} {v:g} {space.factor(k).unit}" for k, v in held.items()) or "none"
     title = f"{response_label(response)} isosurfaces over {', '.join(factors)}; held: {held_txt}"
     scene = Scene(
