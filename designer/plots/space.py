@@ -431,12 +431,8 @@ def surface_view(
     X = pd.DataFrame({n: np.full(gx.size, held.get(n, 0.0)) for n in space.FACTOR_NAMES})
     X[x], X[y] = gx.ravel(), gy.ravel()
     pred = surrogate.predict(X, responses=[response])[response]  # as printed (solid at 2 mm)
-    observed = table[response].to_numpy(float)
     mine = own_runs(surrogate, response)
-    measured = observed if mine is None else np.r_[observed, mine[response].to_numpy(float)]
-    zlo = float(min(pred.low.min(), measured.min(), target if target is not None else np.inf))
-    zhi = float(max(pred.high.max(), measured.max(), target if target is not None else -np.inf))
-    zlo, zhi = zlo - 0.02 * (zhi - zlo), zhi + 0.02 * (zhi - zlo)
+    zlo, zhi = _z_range(pred, [table, mine], response, target)
 
     def grid(z: np.ndarray) -> pv.PolyData:
         g = pv.StructuredGrid(
@@ -457,13 +453,11 @@ def surface_view(
         Layer("95 % PI upper", grid(pred.high), color=PI_COLOR, opacity=0.25),
     ]
     for runs, own in ((table, False), (mine, True)):
-        if runs is None:
-            continue
-        points = np.c_[
-            _unit(runs[x], fx.low, fx.high), _unit(runs[y], fy.low, fy.high), _unit(runs[response], zlo, zhi)
-        ]
-        study = "" if mine is None else "study "
-        layers += _run_layers(points, _runs_near(runs, held), own=own, study=study)
+        if runs is not None:  # the user's prints beside the study's runs: the study's named as such
+            points = np.c_[_unit(runs[x], fx.low, fx.high), _unit(runs[y], fy.low, fy.high)]
+            points = np.c_[points, _unit(runs[response], zlo, zhi)]
+            near = _runs_near(runs, held)
+            layers += _run_layers(points, near, own=own, study="" if mine is None else "study ")
     share = None
     if target is not None:
         layers += _target_layers(
@@ -544,23 +538,7 @@ def volume_view(
                 )
             )
         share = float(np.mean((pred.low <= target) & (target <= pred.high)))
-    pts = np.c_[[_unit(table[f.name], f.low, f.high) for f in fs]].T
-    observed = table[response].to_numpy(float)
-    mine = own_runs(surrogate, response)
-    layers.append(
-        Layer(
-            f"{'measured' if mine is None else 'study'} runs ({len(table)}), coloured by {response}",
-            pv.PolyData(pts),
-            rgb=_rgb(observed, *colour_limits(vlo, vhi)[:2]),
-            color=(0.4, 0.4, 0.4),
-            size=3,
-        )
-    )
-    if mine is not None:
-        mine_pts = np.c_[[_unit(mine[f.name], f.low, f.high) for f in fs]].T
-        layers.append(
-            Layer(f"your prints ({len(mine)}), orange", pv.PolyData(mine_pts), color=OWN_COLOR, size=5)
-        )
+    layers += _volume_run_layers(table, own_runs(surrogate, response), fs, response, (vlo, vhi))
     held_txt = ", ".join(f"{k} {v:g} {space.factor(k).unit}" for k, v in held.items()) or "none"
     title = f"{response_label(response)} isosurfaces over {', '.join(factors)}; held: {held_txt}"
     scene = Scene(
@@ -568,3 +546,35 @@ def volume_view(
     )
     scene.ticks = axis_ticks(scene)
     return SpaceView(response, model.unit, list(factors), held, (vlo, vhi), target, share, scene)
+
+
+def _z_range(pred, runs: list, response: str, target: float | None) -> tuple[float, float]:
+    """The z axis's range: the 95 % PI, every measured run (`runs`: tables, None skipped) and the
+    target, widened by 2 % each side."""
+    measured = np.concatenate([r[response].to_numpy(float) for r in runs if r is not None])
+    zlo = float(min(pred.low.min(), measured.min(), target if target is not None else np.inf))
+    zhi = float(max(pred.high.max(), measured.max(), target if target is not None else -np.inf))
+    return zlo - 0.02 * (zhi - zlo), zhi + 0.02 * (zhi - zlo)
+
+
+def _volume_run_layers(table, mine, fs: list, response: str, values: tuple[float, float]) -> list[Layer]:
+    """The study's runs as points coloured by the response, and the user's prints (`mine`, or None)
+    in orange, in a volume over the factors `fs`."""
+    import pyvista as pv
+
+    pts = np.c_[[_unit(table[f.name], f.low, f.high) for f in fs]].T
+    layers = [
+        Layer(
+            f"{'measured' if mine is None else 'study'} runs ({len(table)}), coloured by {response}",
+            pv.PolyData(pts),
+            rgb=_rgb(table[response].to_numpy(float), *colour_limits(*values)[:2]),
+            color=(0.4, 0.4, 0.4),
+            size=3,
+        )
+    ]
+    if mine is not None:
+        mine_pts = np.c_[[_unit(mine[f.name], f.low, f.high) for f in fs]].T
+        layers.append(
+            Layer(f"your prints ({len(mine)}), orange", pv.PolyData(mine_pts), color=OWN_COLOR, size=5)
+        )
+    return layers

@@ -417,18 +417,31 @@ def fit_axis(
     fit.warnings.extend(plausibility.range_warnings(axis, spec.scale_r, spec.scale_f))
     if drift is not None:
         fit.warnings.append(sensor_drift.describe(drift, axis))
-    faked = [d for d in faked if abs(d.z) > departures.Z_CRIT]
-    # named when it made a departure up or moves k or c beyond the fit's own 2-SE interval (a 4096-count
-    # encoder on 0.3 rad: 0.014 %, 1.2 SE; in the errors, not worth a warning)
-    named = encoder is not None and (bool(faked) or k * bias > 2 * k_se or c * bias > 2 * c_se)
-    if named:  # the encoder's steps also vary k and c over the bands: its sentence says so
-        fit.warnings.append(quantization.describe(encoder, axis, faked, k_lin))
+    named = _name_encoder(fit, encoder, faked, k_lin, (c_se, k_se))
     fit.warnings.extend(
         saturation.describe(col, UNITS[col], found) + ": those samples are left out of the fit"
         for col, found in _saturated(log, axis)
     )
     fit.warnings.extend(_warnings(fit, stable, amp.varies and not named, freq.varies and not named, log.rate))
     return fit
+
+
+def _name_encoder(
+    fit: AxisFit, encoder: quantization.Effect | None, faked: list, k_lin: float, fit_se: tuple[float, float]
+) -> bool:
+    """Add the coarse encoder's warning to `fit` when it made a departure up or moves k or c beyond the
+    fit's own 2-SE interval (`fit_se`: c's and k's, without the encoder's share; a 4096-count encoder
+    on 0.3 rad moves k 0.014 %, 1.2 SE: in the errors, not worth a warning). Its sentence also says
+    the steps vary k and c over the bands, so the caller then skips those warnings; returns whether
+    it was named."""
+    if encoder is None:
+        return False
+    faked = [d for d in faked if abs(d.z) > departures.Z_CRIT]
+    c_se, k_se = fit_se
+    if not (faked or fit.k * encoder.bias > 2 * k_se or fit.c * encoder.bias > 2 * c_se):
+        return False
+    fit.warnings.append(quantization.describe(encoder, fit.axis, faked, k_lin))
+    return True
 
 
 def _genuine(tests: dict[str, departures.Departure], faked: list) -> dict[str, departures.Departure]:
