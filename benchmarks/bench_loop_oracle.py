@@ -202,6 +202,11 @@ def main() -> None:
         "median_ess_by_round": ess_by_round,
         "stated_p": calibration_table([(p, hit) for p, _, _, hit in stated]),
         "stated_p_later_prints": calibration_table([(p, hit) for p, _, r, hit in stated if r > 1]),
+        # by round: a belief of few effective particles (late rounds) overstates its P
+        "stated_p_by_round": {
+            str(r): calibration_table([(p, hit) for p, _, rr, hit in stated if min(rr, 4) == r])
+            for r in (1, 2, 3, 4)
+        },
         "seconds_particles": round(t_particles, 1),
         "seconds": round(time.perf_counter() - t0, 1),
     }
