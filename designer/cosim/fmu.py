@@ -24,6 +24,7 @@ import functools
 import importlib
 import itertools
 import shutil
+import threading
 from abc import ABC, abstractmethod
 from collections import deque
 from collections.abc import Mapping, Sequence
@@ -33,6 +34,12 @@ import numpy as np
 
 from ..errors import DesignerError
 from . import binding as kb
+
+#: fmpy's FMU constructor changes the process's working directory to the library's folder while it
+#: loads it, then back: two threads constructing at once could leave the process in one FMU's unpacked
+#: folder, which its session then removes (the next os.getcwd() raised FileNotFoundError, found by
+#: test_cosim_kernel's sessions in threads, about 1 run in 6). Construction takes this lock.
+_CONSTRUCTING = threading.Lock()
 
 PARAMETERS = ("m", "c", "k", "offset")
 STATUS = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
@@ -388,13 +395,14 @@ class FmuSystem:
         """An fmpy FMU2/FMU3 Model or Slave (as the mode drives it), instantiated from this machine's
         own binary (`library_path`)."""
         iface = self.mode.interface(md)
-        fmu = self.mode.fmpy_class(self.version)(
-            guid=md.guid,
-            unzipDirectory=self._dir,
-            modelIdentifier=iface.modelIdentifier,
-            instanceName=name,
-            libraryPath=library_path(Path(self._dir), self.version, iface.modelIdentifier),
-        )
+        with _CONSTRUCTING:  # fmpy's constructor changes the process's working directory meanwhile
+            fmu = self.mode.fmpy_class(self.version)(
+                guid=md.guid,
+                unzipDirectory=self._dir,
+                modelIdentifier=iface.modelIdentifier,
+                instanceName=name,
+                libraryPath=library_path(Path(self._dir), self.version, iface.modelIdentifier),
+            )
         self._instantiate_logging(fmu)
         problems = [c.name for c in md.logCategories if c.name in PROBLEM_CATEGORIES]
         if problems:  # only problems: an FMU logging every call would slow each step
