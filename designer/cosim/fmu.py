@@ -35,12 +35,7 @@ import numpy as np
 from ..errors import DesignerError
 from . import binding as kb
 
-#: fmpy's FMU constructor changes the process's working directory to the library's folder while it
-#: loads it, then back: two threads constructing at once could leave the process in one FMU's unpacked
-#: folder, which its session then removes (the next os.getcwd() raised FileNotFoundError, found by
-#: test_cosim_kernel's sessions in threads, about 1 run in 6). Construction takes this lock.
-_CONSTRUCTING = threading.Lock()
-
+_CONSTRUCTING = threading.Lock()  # fmpy's FMU constructor changes the working directory: one at a time
 PARAMETERS = ("m", "c", "k", "offset")
 STATUS = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
 #: the log categories the FMI standard suggests for problems, enabled where an FMU declares them
@@ -395,7 +390,7 @@ class FmuSystem:
         """An fmpy FMU2/FMU3 Model or Slave (as the mode drives it), instantiated from this machine's
         own binary (`library_path`)."""
         iface = self.mode.interface(md)
-        with _CONSTRUCTING:  # fmpy's constructor changes the process's working directory meanwhile
+        with _CONSTRUCTING:  # two at once could leave the process in a folder a session removes
             fmu = self.mode.fmpy_class(self.version)(
                 guid=md.guid,
                 unzipDirectory=self._dir,
